@@ -1,0 +1,28 @@
+#pragma once
+/// The cheap result of a ray-primitive test (16 bytes). Rich surface data is
+/// computed once, for the accepted hit only (see scene/scene.h).
+#include <cstdint>
+
+#include "math/ray.h"
+
+namespace sahara {
+
+inline constexpr uint32_t kNoPrim = 0xFFFFFFFFu;
+
+/// Primitive ids carry their kind in the top two bits so that a leaf can hold
+/// mixed primitives and dispatch with a switch (no virtual call per test).
+enum class PrimKind : uint32_t { triangle = 0, sphere = 1, box = 2, plane = 3 };
+inline constexpr uint32_t kPrimIndexMask = 0x3FFFFFFFu;
+constexpr uint32_t make_prim_id(PrimKind kind, uint32_t index) { return (uint32_t(kind) << 30) | index; }
+constexpr PrimKind prim_kind(uint32_t id) { return PrimKind(id >> 30); }
+constexpr uint32_t prim_index(uint32_t id) { return id & kPrimIndexMask; }
+
+struct Hit {
+    float t = kInfinity;
+    uint32_t prim = kNoPrim;  ///< made by make_prim_id; kNoPrim = miss
+    float u = 0, v = 0;       ///< triangle barycentrics (of v1, v2); unused by spheres
+    bool hit() const { return prim != kNoPrim; }
+};
+static_assert(sizeof(Hit) == 16);
+
+}  // namespace sahara

@@ -1,0 +1,29 @@
+#pragma once
+/// Loads a downloaded model (.obj with its .mtl, .gltf, .glb) into plain scene
+/// data. Loaders never build acceleration structures.
+#include <filesystem>
+#include <vector>
+
+#include "math/transform.h"
+#include "scene/scene_desc.h"
+
+namespace sahara {
+
+/// Everything a model file holds that sahara can show. Material and texture
+/// indices in `meshes` refer into this struct's own vectors.
+struct LoadedModel {
+    std::vector<TriangleMesh> meshes;
+    std::vector<MaterialDesc> materials;
+    std::vector<TextureDesc> textures;
+    std::vector<LightDesc> lights;    ///< KHR_lights_punctual
+    std::vector<CameraDesc> cameras;  ///< glTF cameras, world space
+    size_t dropped_degenerate = 0;    ///< zero-area triangles removed
+};
+
+/// Picks the loader by extension. Throws InputError naming the file and element.
+/// `world_from_model` is applied to positions/normals (and glTF node transforms before it).
+LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+
+}  // namespace sahara
