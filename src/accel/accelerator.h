@@ -1,23 +1,76 @@
 #pragma once
 /// The acceleration structure over all bounded primitives of a Scene
-/// (spheres, triangles, boxes). Planes are unbounded and handled by Scene.
+/// (triangles, spheres, boxes); planes are unbounded and handled by Scene.
+/// One binary SAH BVH holds every kind; a leaf dispatches on the kind stored
+/// in the primitive id (geometry/hit.h) with a switch, never a virtual call.
+/// The accelerator copies the primitive data it tests (triangle vertices in
+/// leaf order, spheres, boxes), so it stays valid when the Scene is moved.
+#include <vector>
+
+#include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "geometry/hit.h"
+#include "geometry/sphere.h"
+#include "geometry/triangle.h"
 #include "math/bounds.h"
 
 namespace sahara {
 
 class Scene;
 
+/// Largest primitive count for which one flat loop beats the tree (measured
+/// with `sahara bench --small`; see the comment in accelerator.cpp).
+inline constexpr uint32_t kFlatLoopMaxPrims = 4;
+
+/// Build choices for an Accelerator.
+struct AcceleratorOptions {
+    BvhBuilder builder = BvhBuilder::binned;
+    BvhBuildParams params;
+    /// Scenes with at most this many primitives skip the tree and test every
+    /// primitive in one root leaf; the value comes from measurement (see
+    /// kFlatLoopMaxPrims). Set to 0 to always build a tree.
+    uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
+};
+
 class Accelerator {
 public:
-    explicit Accelerator(const Scene& scene);
+    explicit Accelerator(const Scene& scene, const AcceleratorOptions& options = {});
+
+    /// Nearest hit with t in (ray.tmin, ray.tmax); on a hit, ray.tmax becomes hit.t.
     bool intersect(Ray& ray, Hit& hit) const;
+    /// Whether any primitive blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
+    /// intersect() that also counts node visits and primitive tests into `counters`.
+    bool intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const;
+    /// occluded() that also counts node visits and primitive tests into `counters`.
+    bool occluded_counted(const Ray& ray, TraversalCounters& counters) const;
+    /// Reference answer: tests every primitive, no tree (for tests).
+    bool intersect_brute_force(Ray& ray, Hit& hit) const;
+
     Bounds3 bounds() const { return bounds_; }
+    const Bvh& bvh() const { return bvh_; }
+    /// False when the scene was small enough for the flat loop.
+    bool uses_tree() const { return uses_tree_; }
+    double build_ms() const { return build_ms_; }
+    size_t primitive_count() const { return slot_prim_.size(); }
+    /// Bytes of the tree plus the leaf-ordered primitive data it tests.
+    size_t bytes() const;
 
 private:
-    const Scene* scene_;
+    template <bool kAnyHit, class Counters>
+    bool trace(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit>
+    bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
+                    Hit& hit) const;
+
+    Bvh bvh_;
+    std::vector<uint32_t> slot_prim_;        ///< per leaf slot: primitive id (make_prim_id)
+    std::vector<TriangleVerts> slot_tri_;    ///< per leaf slot: vertices when the slot is a triangle
+    std::vector<Sphere> spheres_;            ///< copy of Scene::spheres (indexed by sphere index)
+    std::vector<Bounds3> boxes_;             ///< copy of Scene::boxes (indexed by box index)
     Bounds3 bounds_;
+    bool uses_tree_ = false;
+    double build_ms_ = 0;
 };
 
 }  // namespace sahara
