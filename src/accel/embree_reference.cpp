@@ -32,12 +32,13 @@ struct EmbreeReference::Impl {
 
 bool EmbreeReference::available() { return true; }
 
-EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices)
+EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust)
     : impl_(std::make_unique<Impl>()) {
     const auto start = std::chrono::steady_clock::now();
     impl_->device = rtcNewDevice(nullptr);
     if (!impl_->device) throw std::runtime_error("embree: rtcNewDevice failed");
     impl_->scene = rtcNewScene(impl_->device);
+    if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), positions.size()));
@@ -99,7 +100,7 @@ bool EmbreeReference::occluded(const Ray& ray) const {
 
 struct EmbreeReference::Impl {};
 bool EmbreeReference::available() { return false; }
-EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>) {
+EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool) {
     throw std::runtime_error("this sahara was built without Embree");
 }
 EmbreeReference::~EmbreeReference() = default;

@@ -16,8 +16,10 @@ class EmbreeReference {
 public:
     /// Whether this build has Embree.
     static bool available();
-    /// Builds an Embree scene (default quality, no robust flag) over the indexed triangles.
-    EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices);
+    /// Builds an Embree scene over the indexed triangles. `robust` sets
+    /// RTC_SCENE_FLAG_ROBUST (Embree's slower, watertight-leaning mode); the
+    /// default mode is the fast one and can let rays slip through shared edges.
+    EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false);
     ~EmbreeReference();
     EmbreeReference(const EmbreeReference&) = delete;
     EmbreeReference& operator=(const EmbreeReference&) = delete;

@@ -43,12 +43,12 @@ TraversalCounters count_work(const Accelerator& accel, const std::vector<Ray>& r
     return total;
 }
 
-nlohmann::json work_json(const TraversalCounters& c, size_t rays) {
+nlohmann::ordered_json work_json(const TraversalCounters& c, size_t rays) {
     const double n = rays ? double(rays) : 1.0;
     return {{"count", rays}, {"nodes_visited", double(c.nodes_visited) / n}, {"prims_tested", double(c.prims_tested) / n}};
 }
 
-nlohmann::json bvh_report(const std::string& file, BvhBuilder builder, int size) {
+nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, int size) {
     const TriangleMesh mesh = read_obj_triangles(file);
     const Scene scene = scene_from_mesh(mesh);
     AcceleratorOptions opt;
@@ -58,7 +58,7 @@ nlohmann::json bvh_report(const std::string& file, BvhBuilder builder, int size)
     const BvhStats s = compute_bvh_stats(accel.bvh(), opt.params);
     const BenchRaySets rays = make_bench_rays(mesh, accel, size, size);
     const size_t prims = accel.primitive_count();
-    nlohmann::json j = {{"mesh", file},
+    nlohmann::ordered_json j = {{"mesh", file},
                         {"builder", bvh_builder_name(builder)},
                         {"primitives", prims},
                         {"nodes", s.nodes},
@@ -79,7 +79,7 @@ nlohmann::json bvh_report(const std::string& file, BvhBuilder builder, int size)
     return j;
 }
 
-void print_text(const nlohmann::json& j) {
+void print_text(const nlohmann::ordered_json& j) {
     std::printf("mesh              %s\n", j["mesh"].get<std::string>().c_str());
     std::printf("builder           %s\n", j["builder"].get<std::string>().c_str());
     std::printf("primitives        %zu\n", j["primitives"].get<size_t>());
@@ -119,7 +119,7 @@ int run_bvh_command(int argc, char** argv) {
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
         return usage_error("bvh", "--size must be a positive integer", kBvhUsage);
     try {
-        const nlohmann::json j = bvh_report(args.positional[0], builder, size);
+        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, size);
         if (args.switches.count("--json")) std::printf("%s\n", j.dump().c_str());
         else print_text(j);
     } catch (const InputError& e) {

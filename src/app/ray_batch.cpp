@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace sahara {
 
@@ -60,17 +61,55 @@ double trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays,
     });
 }
 
-Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b) {
+double nearest_hit_double(const Ray& ray, const TriangleMesh& mesh) {
+    const Vec3d o(ray.origin), d(ray.dir);
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < mesh.triangle_count(); ++i) {
+        Vec3d p[3];
+        for (size_t k = 0; k < 3; ++k) p[k] = Vec3d(mesh.positions[mesh.indices[3 * i + k]]);
+        const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0], pv = cross(d, e2);
+        const double det = dot(e1, pv);
+        if (det == 0.0) continue;
+        const Vec3d tv = o - p[0], q = cross(tv, e1);
+        const double u = dot(tv, pv) / det, v = dot(d, q) / det, t = dot(e2, q) / det;
+        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > double(ray.tmin) && t < double(ray.tmax) && t < best) best = t;
+    }
+    return best;
+}
+
+namespace {
+
+/// Whether answer (t, prim) of a pass agrees with the double-precision nearest hit `td`.
+bool agrees_with_double(float t, uint32_t prim, double td, float tol) {
+    if (prim == kNoPrim) return std::isinf(td);
+    if (t == 0.0f) return !std::isinf(td);  // occlusion answer
+    return std::fabs(td - double(t)) <= double(tol);
+}
+
+}  // namespace
+
+Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b, const std::vector<Ray>& rays,
+                              const TriangleMesh& mesh) {
+    // Arbitration is a brute-force loop per ray; beyond this many it is skipped.
+    constexpr size_t kMaxArbitrations = 1000;
     Disagreements d;
+    size_t arbitrations = 0;
     for (size_t i = 0; i < a.t.size(); ++i) {
         const bool ha = a.prim[i] != kNoPrim, hb = b.prim[i] != kNoPrim;
-        if (ha != hb) { ++d.total; continue; }
-        if (!ha) continue;
+        if (!ha && !hb) continue;
         const float diff = std::fabs(a.t[i] - b.t[i]), scale = std::max(std::fabs(a.t[i]), std::fabs(b.t[i]));
-        if (diff > 1e-4f * scale) { ++d.total; continue; }
-        if (a.prim[i] == b.prim[i]) continue;
-        if (diff <= 1e-6f * scale) ++d.ties;
-        else ++d.total;
+        const Ray& r = rays[i];
+        const float tol = 1e-4f * (std::isinf(scale) ? 0.0f : scale) + 1e-6f * max_component(abs(r.origin)) / length(r.dir);
+        if (ha == hb && a.prim[i] == b.prim[i] && diff <= tol) continue;
+        if (ha == hb && a.prim[i] != b.prim[i] && diff <= 1e-6f * scale) {
+            ++d.ties;
+            continue;
+        }
+        if (arbitrations++ < kMaxArbitrations &&
+            agrees_with_double(a.t[i], a.prim[i], nearest_hit_double(r, mesh), tol + 1e-4f * std::fabs(a.t[i])))
+            ++d.confirmed_for_a;
+        else
+            ++d.total;
     }
     return d;
 }

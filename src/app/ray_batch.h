@@ -6,6 +6,7 @@
 
 #include "accel/accelerator.h"
 #include "accel/embree_reference.h"
+#include "scene/scene_desc.h"
 
 namespace sahara {
 
@@ -25,12 +26,22 @@ double trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays,
                     bool ftz, RayAnswers& out);
 
 struct Disagreements {
-    size_t total = 0;  ///< hit/miss differ, t beyond 1e-4 relative, or another primitive at a different t
+    size_t total = 0;  ///< hit/miss differ, t differs beyond tolerance, or another primitive at a different t
     size_t ties = 0;   ///< another primitive at t equal within 1e-6 relative (not counted in total)
+    /// Differences where a double-precision brute-force test over all triangles
+    /// sides with `a` (not counted in total). Embree's default triangle test is
+    /// not watertight: rays slip through shared edges and hit something farther.
+    size_t confirmed_for_a = 0;
 };
 
-/// Compares two passes over the same rays. Triangle ids of the Accelerator are
-/// prim ids (make_prim_id); Embree's are plain triangle indices: both are compared as indices.
-Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b);
+/// Compares two passes (answers: triangle indices) over the same `rays` of `mesh`.
+/// t tolerance: 1e-4 relative plus 1e-6 of the origin's magnitude in units of |dir|
+/// (float cannot resolve a smaller t near the start of a ray far from the origin).
+Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b, const std::vector<Ray>& rays,
+                              const TriangleMesh& mesh);
+
+/// Nearest hit distance of `ray` over all triangles of `mesh` in double precision
+/// (Moller-Trumbore, barycentrics >= 0, t in (tmin, tmax)); +inf on a miss. Slow: for arbitration only.
+double nearest_hit_double(const Ray& ray, const TriangleMesh& mesh);
 
 }  // namespace sahara
