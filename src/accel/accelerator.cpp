@@ -72,17 +72,15 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
                       : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
-    slot_prim_.resize(slots);
-    slot_tri_.resize(slots);
+    slots_.resize(slots);
     const TriangleSoup& soup = scene.triangles;
     for (size_t s = 0; s < slots; ++s) {
         const uint32_t id = prims.ids[bvh_.prim_indices[s]];
-        slot_prim_[s] = id;
+        slots_[s].id = id;
+        slots_[s].tri = TriangleVerts{};
         if (prim_kind(id) == PrimKind::triangle) {
             const uint32_t* v = &soup.indices[3 * size_t(prim_index(id))];
-            slot_tri_[s] = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
-        } else {
-            slot_tri_[s] = TriangleVerts{};
+            slots_[s].tri = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
         }
     }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
@@ -90,7 +88,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 }
 
 size_t Accelerator::bytes() const {
-    return bvh_.bytes() + slot_prim_.size() * sizeof(uint32_t) + slot_tri_.size() * sizeof(TriangleVerts) +
+    return bvh_.bytes() + slots_.size() * sizeof(Slot) +
            spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3);
 }
 
@@ -100,12 +98,12 @@ bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr, uint32_t fir
                              Hit& hit) const {
     bool found = false;
     for (uint32_t s = first; s < first + count; ++s) {
-        const uint32_t id = slot_prim_[s];
+        const uint32_t id = slots_[s].id;
         float t = 0.0f, u = 0.0f, v = 0.0f;
         switch (prim_kind(id)) {
             case PrimKind::triangle: {
                 TriangleHit th;
-                if (!intersect_triangle(tr, slot_tri_[s], ray.tmin, tmax, th)) continue;
+                if (!intersect_triangle(tr, slots_[s].tri, ray.tmin, tmax, th)) continue;
                 t = th.t, u = th.u, v = th.v;
                 break;
             }
@@ -176,7 +174,7 @@ bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;
     Hit best;
-    if (!test_slots<false>(ray, tr, 0, uint32_t(slot_prim_.size()), tmax, best)) return false;
+    if (!test_slots<false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)) return false;
     hit = best;
     ray.tmax = best.t;
     return true;

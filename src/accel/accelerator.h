@@ -52,7 +52,7 @@ public:
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
     double build_ms() const { return build_ms_; }
-    size_t primitive_count() const { return slot_prim_.size(); }
+    size_t primitive_count() const { return slots_.size(); }
     /// Bytes of the tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
@@ -64,8 +64,13 @@ private:
                     Hit& hit) const;
 
     Bvh bvh_;
-    std::vector<uint32_t> slot_prim_;        ///< per leaf slot: primitive id (make_prim_id)
-    std::vector<TriangleVerts> slot_tri_;    ///< per leaf slot: vertices when the slot is a triangle
+    /// What a leaf slot holds: the primitive id and, for triangles, the vertices
+    /// (together, so a leaf's data is one contiguous read).
+    struct Slot {
+        TriangleVerts tri;  ///< 36 bytes; zero for other kinds
+        uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
+    };
+    std::vector<Slot> slots_;                ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
     std::vector<Sphere> spheres_;            ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;             ///< copy of Scene::boxes (indexed by box index)
     Bounds3 bounds_;

@@ -4,10 +4,13 @@
 /// triangle or a sphere; traversal (accel/bvh_traverse.h) hands leaf ranges to
 /// a caller-supplied functor, so the caller owns the primitive tests.
 ///
-/// Layout: 32-byte nodes, the two children of an inner node adjacent
-/// (nodes[i], nodes[i + 1]), root at nodes[0]. A leaf's primitives are the
-/// slots prim_indices[index .. index + count).
+/// Layout: 32-byte nodes in 64-byte aligned storage, the two children of an
+/// inner node adjacent (nodes[i], nodes[i + 1], i even, so a sibling pair is
+/// one cache line), root at nodes[0], nodes[1] unused padding. A leaf's
+/// primitives are the slots prim_indices[index .. index + count).
+#include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -34,13 +37,31 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");
 
+/// Minimal allocator returning `Align`-byte aligned storage.
+template <class T, size_t Align>
+struct AlignedAllocator {
+    using value_type = T;
+    template <class U>
+    struct rebind {
+        using other = AlignedAllocator<U, Align>;
+    };
+    AlignedAllocator() = default;
+    template <class U>
+    AlignedAllocator(const AlignedAllocator<U, Align>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align))); }
+    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(Align)); }
+    friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
+};
+
 /// The hierarchy. An empty Bvh (no nodes) has no primitives.
 struct Bvh {
-    std::vector<BvhNode> nodes;
+    /// Index of the first sibling pair (nodes[1] is padding).
+    static constexpr uint32_t kFirstPair = 2;
+    std::vector<BvhNode, AlignedAllocator<BvhNode, 64>> nodes;
     std::vector<uint32_t> prim_indices;  ///< leaf slot -> index of the primitive given to the builder
 
     bool empty() const { return nodes.empty(); }
-    /// Bytes of nodes and slot indices (what traversal reads besides primitive data).
+    /// Bytes of nodes (padding included) and slot indices (what traversal reads besides primitive data).
     size_t bytes() const { return nodes.size() * sizeof(BvhNode) + prim_indices.size() * sizeof(uint32_t); }
 };
 

@@ -39,12 +39,13 @@ public:
         out_.prim_indices.resize(n);
         for (uint32_t i = 0; i < n; ++i) out_.prim_indices[i] = i;
         if (n == 0) return;
-        out_.nodes.resize(2 * size_t(n) - 1);
-        node_count_ = 1;
+        out_.nodes.resize(2 * size_t(n));  // at most 2n - 1 nodes, plus the padding node
+        node_count_ = Bvh::kFirstPair;
 #pragma omp parallel
 #pragma omp single
         build_node(0, 0, n, 0);
-        out_.nodes.resize(node_count_.load());
+        out_.nodes.resize(out_.nodes[0].is_leaf() ? 1 : node_count_.load());
+        if (out_.nodes.size() > 1) out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
     }
 
 private:

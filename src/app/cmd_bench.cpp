@@ -22,6 +22,7 @@ namespace {
 constexpr const char* kBenchUsage =
     "usage: sahara bench MESH [--threads N] [--rays primary|diffuse|shadow|all] [--json]\n"
     "                         [--builder binned|sweep] [--size N] [--repeat K] [--no-embree]\n"
+    "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  MESH        a mesh (.obj)\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
     "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh,\n"
@@ -123,6 +124,47 @@ void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
     }
 }
 
+/// Times the flat loop against the tree on scenes of n random spheres and n random
+/// triangles in a unit cube (200k random rays, one thread, median of 5); this
+/// measurement sets kFlatLoopMaxPrims.
+int run_small_scenes() {
+    std::printf("%-6s %-9s %12s %12s %8s\n", "prims", "kind", "flat ns/ray", "tree ns/ray", "flat/tree");
+    for (uint32_t n : {1u, 2u, 3u, 4u, 6u, 8u, 12u, 16u, 24u, 32u}) {
+        for (int kind = 0; kind < 2; ++kind) {
+            Scene scene;
+            uint64_t state = 12345 + n;
+            auto rnd = [&state] {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                return float(state >> 40) * 0x1p-24f;
+            };
+            for (uint32_t i = 0; i < n; ++i) {
+                const Vec3 c(rnd(), rnd(), rnd());
+                if (kind == 0) {
+                    scene.spheres.push_back(Sphere{c, 0.05f + 0.1f * rnd()});
+                } else {
+                    for (int k = 0; k < 3; ++k) scene.triangles.positions.push_back(c + Vec3(rnd(), rnd(), rnd()) * 0.2f);
+                    for (uint32_t k = 0; k < 3; ++k) scene.triangles.indices.push_back(3 * i + k);
+                }
+            }
+            std::vector<Ray> rays(200000);
+            for (Ray& r : rays) r = Ray{Vec3(rnd(), rnd(), rnd()) * 3.0f - Vec3(1.0f), Vec3(rnd(), rnd(), rnd()) - Vec3(0.5f)};
+            AcceleratorOptions flat, tree;
+            flat.flat_loop_max_prims = 1000;
+            tree.flat_loop_max_prims = 0;
+            const Accelerator a(scene, flat), b(scene, tree);
+            std::vector<double> ta, tb;
+            RayAnswers answers;
+            for (int k = 0; k < 5; ++k) {
+                ta.push_back(trace_sahara(a, rays, false, 1, true, answers));
+                tb.push_back(trace_sahara(b, rays, false, 1, true, answers));
+            }
+            const double fa = median(ta) / double(rays.size()) * 1e9, fb = median(tb) / double(rays.size()) * 1e9;
+            std::printf("%-6u %-9s %12.1f %12.1f %8.2f\n", n, kind ? "triangles" : "spheres", fa, fb, fa / fb);
+        }
+    }
+    return 0;
+}
+
 /// Fills `opt` from the flags; returns an error message (empty on success).
 std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
     if (args.positional.size() != 1) return "expected one mesh file";
@@ -150,12 +192,13 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
 int run_bench_command(int argc, char** argv) {
     ToolArgs args;
     std::string err = parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--size", "--repeat"},
-                                      {"--json", "--no-embree"}, args);
+                                      {"--json", "--no-embree", "--small-scenes"}, args);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     if (args.help) {
         std::fputs(kBenchUsage, stdout);
         return 0;
     }
+    if (args.switches.count("--small-scenes")) return run_small_scenes();
     BenchOptions opt;
     err = bench_options(args, opt);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
