@@ -6,6 +6,7 @@
 #include <string>
 
 #include "accel/accelerator.h"
+#include "accel/bvh_pairs.h"
 #include "accel/bvh_stats.h"
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
@@ -217,6 +218,56 @@ TEST_CASE("axis-parallel rays with the origin on a node's slab plane are not los
             if (!acc.intersect(r, h) || !acc.occluded(Ray{{px, py, 1}, {0, 0, -1}})) ++missed;
         }
     CHECK(missed == 0);
+}
+
+TEST_CASE("pair-node box test matches the single-node test, including zero directions on slab planes") {
+    std::mt19937 rng(21);
+    std::uniform_int_distribution<int> coord(-2, 2);  // small integers: origins often exactly on planes
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0;
+    for (int i = 0; i < 200000 / kSanitizerDivisor; ++i) {
+        BvhNode child[2];
+        for (BvhNode& c : child) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};  // empty box
+            c.set_box(b);
+            c.index = 0;
+            c.count = 1;
+        }
+        BvhPairNode p{};
+        for (int c = 0; c < 2; ++c) {
+            p.x[c] = child[c].bounds[0]; p.x[c + 2] = child[c].bounds[1];
+            p.y[c] = child[c].bounds[2]; p.y[c + 2] = child[c].bounds[3];
+            p.z[c] = child[c].bounds[4]; p.z[c + 2] = child[c].bounds[5];
+        }
+        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+        const BvhRay r(ray);
+        float t_pair[2], t_single[2];
+        const int mask = intersect_bvh_pair(p, r, t_pair);
+        for (int c = 0; c < 2; ++c) {
+            const bool hit = intersect_bvh_node(child[c], r, t_single[c]);
+            if (hit != bool(mask & (1 << c)) || (hit && t_single[c] != t_pair[c])) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("pair layout mirrors the canonical tree") {
+    const TriangleMesh m = make_icosphere(3);
+    const Bvh bvh = build_for_mesh(m, BvhBuilder::binned);
+    const BvhPairs pairs = make_bvh_pairs(bvh);
+    CHECK(pairs.nodes.size() == compute_bvh_stats(bvh).leaves - 1);
+    size_t leaf_prims = 0;
+    for (const BvhPairNode& n : pairs.nodes)
+        for (int c = 0; c < 2; ++c) {
+            leaf_prims += n.count[c];
+            if (!n.count[c]) CHECK(n.index[c] < pairs.nodes.size());
+        }
+    CHECK(leaf_prims == m.triangle_count());
 }
 
 TEST_CASE("flat loop and tree give the same answers on small scenes") {

@@ -83,18 +83,19 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
             slots_[s].tri = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
         }
     }
+    pairs_ = make_bvh_pairs(bvh_);
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 size_t Accelerator::bytes() const {
-    return bvh_.bytes() + slots_.size() * sizeof(Slot) +
+    return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
            spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3);
 }
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in `hit`.
 template <bool kAnyHit>
-bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
+__attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                              Hit& hit) const {
     bool found = false;
     for (uint32_t s = first; s < first + count; ++s) {
@@ -135,8 +136,8 @@ bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
-    const bool found = traverse_bvh<kAnyHit>(
-        bvh_, br,
+    const bool found = traverse_bvh_pairs<kAnyHit>(
+        pairs_, br,
         [&](uint32_t first, uint32_t count, float& tmax) {
             return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
         },

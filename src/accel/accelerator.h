@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"
 #include "geometry/hit.h"
 #include "geometry/sphere.h"
@@ -53,7 +54,7 @@ public:
     bool uses_tree() const { return uses_tree_; }
     double build_ms() const { return build_ms_; }
     size_t primitive_count() const { return slots_.size(); }
-    /// Bytes of the tree plus the leaf-ordered primitive data it tests.
+    /// Bytes of the traversal tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
 private:
@@ -63,7 +64,8 @@ private:
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
 
-    Bvh bvh_;
+    Bvh bvh_;          ///< canonical tree (statistics, validation)
+    BvhPairs pairs_;   ///< the same tree in traversal layout
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).
     struct Slot {

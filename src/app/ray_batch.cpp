@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -17,25 +19,34 @@ size_t RayAnswers::hits() const {
 namespace {
 
 /// Runs `trace_one(i, t, prim)` for every ray index on `threads` threads and times the whole pass.
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 template <class TraceOne>
-double timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceOne&& trace_one) {
+PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceOne&& trace_one) {
     out.t.assign(count, kInfinity);
     out.prim.assign(count, kNoPrim);
+    double cpu = 0;
     const auto start = std::chrono::steady_clock::now();
-#pragma omp parallel num_threads(threads)
+#pragma omp parallel num_threads(threads) reduction(+ : cpu)
     {
+        const double cpu_start = thread_cpu_seconds();
         set_flush_denormals(ftz);
         // Chunks of 1024 rays: coherent primary rays stay together, dynamic balances the rest.
-#pragma omp for schedule(dynamic, 1024)
+#pragma omp for schedule(dynamic, 1024) nowait
         for (size_t i = 0; i < count; ++i) trace_one(i, out.t[i], out.prim[i]);
         set_flush_denormals(false);
+        cpu += thread_cpu_seconds() - cpu_start;
     }
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
 }
 
 }  // namespace
 
-double trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
+PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
                     RayAnswers& out) {
     return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
         if (occlusion) {
@@ -48,7 +59,7 @@ double trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool
     });
 }
 
-double trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
+PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
                     bool ftz, RayAnswers& out) {
     return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
         if (occlusion) {

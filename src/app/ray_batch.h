@@ -18,12 +18,18 @@ struct RayAnswers {
     size_t hits() const;
 };
 
-/// Traces `rays` with sahara on `threads` threads (FTZ/DAZ as given); returns seconds.
-double trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
-                    RayAnswers& out);
+/// Duration of one pass over a ray set.
+struct PassTime {
+    double wall_s = 0;  ///< elapsed time
+    double cpu_s = 0;   ///< CPU time summed over the tracing threads (robust when cores are shared)
+};
+
+/// Traces `rays` with sahara on `threads` threads (FTZ/DAZ as given).
+PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
+                      RayAnswers& out);
 /// The same with Embree's rtcIntersect1 / rtcOccluded1.
-double trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
-                    bool ftz, RayAnswers& out);
+PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
+                      bool ftz, RayAnswers& out);
 
 struct Disagreements {
     size_t total = 0;  ///< hit/miss differ, t differs beyond tolerance, or another primitive at a different t
