@@ -114,7 +114,7 @@ TEST_CASE("validator catches a broken tree") {
     dup.prim_indices[1] = dup.prim_indices[0];
     CHECK(validate_bvh(dup, triangle_boxes(m)) != "");
     Bvh shrunk = bvh;
-    shrunk.nodes[1].bounds[1] = shrunk.nodes[1].bounds[0];
+    shrunk.nodes[Bvh::kFirstPair].bounds[1] = shrunk.nodes[Bvh::kFirstPair].bounds[0];
     CHECK(validate_bvh(shrunk, triangle_boxes(m)) != "");
 }
 
