@@ -102,7 +102,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
                         {"primitives", accel.primitive_count()},
                         {"threads", opt.threads},
                         {"builder", bvh_builder_name(opt.builder)},
-                        {"build_ms", accel.build_ms()}};
+                        {"build_ms", accel.build_ms()},
+                        {"build_cpu_ms", accel.build_cpu_ms()}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
     for (const std::string& set : opt.sets) {
         const std::vector<Ray>& r = set == "primary" ? rays.primary : set == "diffuse" ? rays.diffuse : rays.shadow;
@@ -114,7 +115,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
 void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
     std::printf("mesh        %s\nprimitives  %zu\nthreads     %d\n", j["mesh"].get<std::string>().c_str(),
                 j["primitives"].get<size_t>(), j["threads"].get<int>());
-    std::printf("build       %.1f ms (%s SAH)", j["build_ms"].get<double>(), j["builder"].get<std::string>().c_str());
+    std::printf("build       %.1f ms, CPU %.1f ms (%s SAH)", j["build_ms"].get<double>(), j["build_cpu_ms"].get<double>(),
+                j["builder"].get<std::string>().c_str());
     if (j.contains("embree_build_ms")) std::printf(", Embree %.1f ms", j["embree_build_ms"].get<double>());
     std::printf("\n");
     const bool embree = j.contains("embree_build_ms");
