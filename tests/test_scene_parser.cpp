@@ -450,6 +450,8 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
         {R"({"camera": {"look_at": [0, 0, 0]}, "objects": []})", {"camera: missing key \"position\""}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 0]}, "objects": []})", {"camera.look_at: look_at must differ from position"}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "up": [0, 2, 0]}, "objects": []})", {"camera.up: up must not be parallel"}},
+        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]}, "objects": []})",
+         {"camera.look_at: the viewing direction is parallel to the default up"}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "shutter": [1, 0]}, "objects": []})", {"camera.shutter: expected [open, close] with open <= close"}},
         {R"({"camera": {"position": [0, 0, 0], "euler": [0, 0, 0], "focal_length": -1}, "objects": []})", {"camera.focal_length: expected a number > 0"}},
         {R"({"objects": []})", {"missing key \"camera\""}},

@@ -39,12 +39,6 @@ bool is_identifier(const std::string& s) {
     });
 }
 
-std::string format_number(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
-    return buf;
-}
-
 /// The container frames the parser is inside; rebuilds the JSON path of a
 /// duplicate key, which nlohmann would otherwise silently overwrite.
 class DuplicateKeyCheck {
@@ -113,6 +107,12 @@ Json parse_json_text(const std::string& text, const std::string& file) {
         }
         throw input_error(file, where, "invalid JSON: " + what + " (numbers must be finite doubles)");
     }
+}
+
+std::string format_number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
 }
 
 std::string json_member_path(const std::string& parent, const std::string& key) {

@@ -103,6 +103,9 @@ private:
     std::vector<std::string> allowed_;
 };
 
+/// Shortest faithful text of a number for messages ("0.5", "1e+39").
+std::string format_number(double v);
+
 /// Appends `.key` (or `["odd key"]`) to a JSON path.
 std::string json_member_path(const std::string& parent, const std::string& key);
 

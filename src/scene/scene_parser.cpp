@@ -45,10 +45,11 @@ void parse_look_at_camera(JsonObject& o, CameraDesc& cam) {
     JsonValue look = o.require("look_at", "the point [x, y, z] the camera looks at");
     cam.look_at = look.vec3();
     if (length(cam.look_at - cam.position) == 0.0f) look.fail("look_at must differ from position");
-    if (auto v = o.get("up")) {
-        cam.up = normalize(v->nonzero_vec3());
-        Vec3 forward = normalize(cam.look_at - cam.position);
-        if (length(cross(forward, cam.up)) < 1e-6f) v->fail("up must not be parallel to the viewing direction");
+    auto up = o.get("up");
+    if (up) cam.up = normalize(up->nonzero_vec3());
+    if (length(cross(normalize(cam.look_at - cam.position), cam.up)) < 1e-6f) {
+        if (up) up->fail("up must not be parallel to the viewing direction");
+        look.fail("the viewing direction is parallel to the default up [0, 0, 1]; give \"up\"");
     }
     if (auto v = o.get("vfov")) cam.vfov = v->number_f(NumberRange::open(0, 180));
 }

@@ -151,8 +151,9 @@ void parse_box(JsonObject& o, ParseContext& ctx, size_t index) {
     if (max_v) hi = max_v->vec3();
     if (hi.x <= lo.x || hi.y <= lo.y || hi.z <= lo.z) {
         JsonValue where = max_v ? *max_v : o.value();
-        where.fail("expected max > min in every component, got min [" + std::to_string(lo.x) + ", " +
-                   std::to_string(lo.y) + ", " + std::to_string(lo.z) + "]");
+        where.fail("expected max > min in every component, got min [" + format_number(lo.x) + ", " +
+                   format_number(lo.y) + ", " + format_number(lo.z) + "] and max [" + format_number(hi.x) +
+                   ", " + format_number(hi.y) + ", " + format_number(hi.z) + "]");
     }
     uint32_t material = object_material(o, ctx);
     auto m = object_transform(o);
@@ -267,8 +268,8 @@ void parse_named_quadric(JsonObject& o, QuadricDesc& q, const char* origin_key) 
             if (waist) q.waist = waist->number_f(pos);
             if (!(q.waist < q.radius)) {
                 JsonValue where = waist ? *waist : o.value();
-                where.fail("expected waist < radius (" + std::to_string(q.radius) + "), got waist " +
-                           std::to_string(q.waist));
+                where.fail("expected waist < radius (" + format_number(q.radius) + "), got waist " +
+                           format_number(q.waist));
             }
             double r = q.radius, w = q.waist, half = 0.5 * double(q.height);
             c = {1, 1, -(r * r - w * w) / (half * half), 0, 0, 0, 0, 0, 0, -w * w};
