@@ -298,7 +298,7 @@ SceneDesc default_scene() {
     red.name = "red";
     red.albedo.color = Rgb(0.8f, 0.1f, 0.1f);
     green.name = "green";
-    green.albedo.color = Rgb(0.2f, 0.6f, 0.2f);
+    green.albedo.color = Rgb(0.2f, 0.7f, 0.2f);
     s.materials.push_back(red);
     s.materials.push_back(green);
     s.spheres.push_back(SphereDesc{Vec3(0, 10, 0), 5.0f, 1, Vec3(0, 0, 0)});
