@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "app/cmd_info.h"
+#include "geometry/sphere.h"
 #include "io/image_io.h"
 
 extern char** environ;
@@ -263,4 +265,22 @@ TEST_CASE("cli: --stats prints grouped statistics") {
     CHECK(r.code == 0);
     for (const char* s : {"Statistics:", "Render", "Camera rays", "768", "BVH", "Memory", "Time", "Write"})
         CHECK_MESSAGE(r.err.find(s) != std::string::npos, s);
+}
+
+TEST_CASE("info: the default scene's contents, memory and times") {
+    const nlohmann::json j = scene_info(std::nullopt).to_json();
+    CHECK(j["Scene"]["Source"] == "<default>");
+    CHECK(j["Objects"]["Spheres"] == 2);
+    CHECK(j["Objects"]["Triangles"] == 0);
+    CHECK(j["Materials"]["Total"] == 3);
+    CHECK(j["Materials"]["lambertian"] == 3);
+    CHECK(j["Memory"]["Geometry"] == 2 * sizeof(Sphere));
+    CHECK(j["Bounds"]["Max"][1].get<double>() == doctest::Approx(105.0));
+    CHECK(j["Time"].contains("Build"));
+}
+
+TEST_CASE("info: bad inputs exit 2") {
+    CHECK(run_info_command({"--bogus"}) == 2);
+    CHECK(run_info_command({"model.xyz"}) == 2);
+    CHECK(run_info_command({"a.json", "b.json"}) == 2);
 }
