@@ -35,9 +35,12 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 /// Frames never come faster than this, and each frame's cost is kept under
-/// 1/kBudgetDivisor of the wall time between frames.
+/// 1/kBudgetDivisor of the wall time between frames (5% of the main thread,
+/// which shares the cores with the workers). The title is cheap and updates
+/// at its own rate.
 constexpr double kMinFrameSeconds = 1.0 / 30.0;
-constexpr double kBudgetDivisor = 50.0;
+constexpr double kBudgetDivisor = 20.0;
+constexpr double kTitleSeconds = 0.25;
 
 std::string format_duration(double s) {
     char buf[32];
@@ -57,7 +60,7 @@ struct Preview::Impl {
     float exposure = 0;
     Tonemap curve = Tonemap::clamp;
     std::vector<uint64_t> seen;  ///< tile generations already drawn
-    Clock::time_point next_frame = Clock::now();
+    Clock::time_point next_frame = Clock::now(), next_title = Clock::now();
     bool stop = false, snapshot = false;
 
     ~Impl() {
@@ -79,6 +82,14 @@ struct Preview::Impl {
         if (target->w == image->w && target->h == image->h) SDL_BlitSurface(image, nullptr, target, nullptr);
         else SDL_BlitScaled(image, nullptr, target, nullptr);
         SDL_UpdateWindowSurface(window);
+    }
+
+    void set_title(const RenderSession& session) {
+        char title[160];
+        std::snprintf(title, sizeof title, "sahara - %d/%d spp%s - %s - ETA %s", session.spp_complete(),
+                      session.spp_target(), session.pass_target() > 0 ? "" : " (adaptive)",
+                      format_duration(session.elapsed_seconds()).c_str(), format_duration(session.eta_seconds()).c_str());
+        SDL_SetWindowTitle(window, title);
     }
 
     void poll_events() {
@@ -134,6 +145,10 @@ void Preview::update(RenderSession& session) {
     Impl& p = *impl_;
     p.poll_events();
     const auto start = Clock::now();
+    if (start >= p.next_title) {
+        p.set_title(session);
+        p.next_title = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTitleSeconds));
+    }
     if (start < p.next_frame) return;
     const Film* film = nullptr;
     bool changed = false;
@@ -144,12 +159,6 @@ void Preview::update(RenderSession& session) {
         changed = true;
     });
     if (changed) p.present();
-    const int target = session.pass_target();
-    char title[160];
-    std::snprintf(title, sizeof title, "sahara - %d/%d spp%s - %s - ETA %s", session.spp_complete(),
-                  session.spp_target(), target > 0 ? "" : " (adaptive)", format_duration(session.elapsed_seconds()).c_str(),
-                  format_duration(session.eta_seconds()).c_str());
-    SDL_SetWindowTitle(p.window, title);
     const double cost = std::chrono::duration<double>(Clock::now() - start).count();
     p.next_frame = start + std::chrono::duration_cast<Clock::duration>(
                                std::chrono::duration<double>(std::max(kMinFrameSeconds, kBudgetDivisor * cost)));
