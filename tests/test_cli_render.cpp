@@ -81,6 +81,20 @@ pid_t spawn_sahara(const std::vector<std::string>& args, const std::string& err_
     return pid;
 }
 
+/// Waits until the child catches SIGINT (its handler is installed: /proc shows
+/// it in SigCgt), so that a signal sent next reaches sahara, not the default action.
+void wait_for_sigint_handler(pid_t pid) {
+    for (int i = 0; i < 1200; ++i) {
+        std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+        std::string line;
+        while (std::getline(status, line))
+            if (line.rfind("SigCgt:", 0) == 0 && (std::stoull(line.substr(7), nullptr, 16) & (1ull << (SIGINT - 1))))
+                return;
+        std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    FAIL("sahara never installed its SIGINT handler");
+}
+
 int wait_exit_code(pid_t pid) {
     int status = 0;
     REQUIRE(waitpid(pid, &status, 0) == pid);
@@ -191,7 +205,8 @@ TEST_CASE("cli: SIGINT stops, writes the samples done and exits 130") {
     const std::string out = dir / "long.png";
     const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out},
                                    dir / "err.txt");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    wait_for_sigint_handler(pid);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
     ::kill(pid, SIGINT);
     CHECK(wait_exit_code(pid) == 130);
     REQUIRE(fs::exists(out));
@@ -209,7 +224,8 @@ TEST_CASE("cli: a second SIGINT exits at once and leaves no partial file") {
     const std::string out = dir / "long.exr";
     const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out},
                                    dir / "err.txt");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    wait_for_sigint_handler(pid);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
     ::kill(pid, SIGINT);
     ::kill(pid, SIGINT);
     CHECK(wait_exit_code(pid) == 130);
@@ -237,6 +253,7 @@ TEST_CASE("cli: --checkpoint writes the image while the render runs") {
     const std::string out = dir / "c.png";
     const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "--checkpoint",
                                     "0.2", "-o", out}, dir / "err.txt");
+    wait_for_sigint_handler(pid);
     bool appeared = false;
     for (int i = 0; i < 600 && !appeared; ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
