@@ -27,7 +27,7 @@ struct RenderOptions {
     const std::atomic<bool>* stop = nullptr;
     /// Called on the thread that called run() about every tick_seconds while the
     /// workers render (preview, checkpoints). Keep it short.
-    std::function<void(RenderSession&)> on_tick;
+    std::function<void(RenderSession&)> on_tick = nullptr;
     double tick_seconds = 1.0 / 30.0;
 };
 
