@@ -19,6 +19,7 @@ const char* const kUsage =
     "\n"
     "commands:\n"
     "  render [SCENE.json]   render a scene (or the built-in default scene) to an image\n"
+    "  view MODEL            render a downloaded model (.obj, .gltf, .glb) with no scene file\n"
     "  info [SCENE|MODEL]    what a scene holds: objects, triangles, materials, memory\n"
     "  bvh MESH              build the BVH and print its statistics\n"
     "  bench MESH            trace fixed ray sets and compare with Embree\n"
@@ -47,6 +48,7 @@ int run_cli(int argc, char** argv) {
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     if (cmd == "render") return run_render_command(rest);
     if (cmd == "info") return run_info_command(rest);
+    if (cmd == "view") return run_view_command(rest);
     std::fprintf(stderr, "sahara: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
 }
