@@ -1,7 +1,26 @@
 #pragma once
-/// Subcommands of the BVH tools. argv[0] is the subcommand name; each returns
-/// the process exit code (0 ok, 2 bad usage or bad input) and prints its usage on --help.
+/// The subcommands of `sahara`; each returns the process exit code.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/render_args.h"
+#include "scene/scene_desc.h"
+
 namespace sahara {
+
+/// `sahara render`: arguments after the command name.
+int run_render_command(const std::vector<std::string>& args);
+
+/// Renders the scene `load_scene` returns with parsed render arguments (used by
+/// `render` and `view`): output checks, signals, preview, resume, stats.
+int run_render(const RenderArgs& args, const std::function<SceneDesc()>& load_scene);
+
+/// `sahara view MODEL`: renders a downloaded model with no scene file.
+int run_view_command(const std::vector<std::string>& args);
+
+// BVH tools: argv[0] is the subcommand name; exit code 0 ok, 2 bad usage or
+// bad input; each prints its usage on --help.
 
 /// `sahara bvh FILE [--builder binned|sweep] [--json]`: tree statistics.
 int run_bvh_command(int argc, char** argv);
