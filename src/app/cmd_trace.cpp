@@ -16,6 +16,7 @@
 #include "app/mesh_input.h"
 #include "app/tool_args.h"
 #include "base/error.h"
+#include "base/pending_file.h"
 
 namespace sahara {
 
@@ -56,6 +57,7 @@ std::vector<Ray> read_ray_file(const std::string& path) {
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, then rename.
 void write_atomically(const std::string& path, const std::vector<char>& bytes) {
     const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+    const PendingFile pending(tmp);  // an interrupt removes the temporary
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         if (!out) throw input_error(path, "", "cannot write output");
