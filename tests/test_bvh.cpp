@@ -256,6 +256,44 @@ TEST_CASE("pair-node box test matches the single-node test, including zero direc
     CHECK(bad == 0);
 }
 
+TEST_CASE("generic traversal of the canonical tree with a caller-supplied leaf test") {
+    const TriangleMesh m = make_slivers(2000);
+    const Bvh bvh = build_for_mesh(m, BvhBuilder::sweep);
+    Scene scene = scene_from_mesh(m);
+    const Accelerator acc(scene);
+    int bad = 0;
+    for (const Ray& r0 : make_random_rays(mesh_bounds(m), 20000 / kSanitizerDivisor, 33)) {
+        const TriangleRay tr(r0);
+        BvhRay br(r0);
+        uint32_t best = kNoPrim;
+        auto leaf = [&](uint32_t first, uint32_t count, float& tmax) {
+            bool hit = false;
+            for (uint32_t s = first; s < first + count; ++s) {
+                const uint32_t t = bvh.prim_indices[s];
+                const uint32_t* v = &m.indices[3 * size_t(t)];
+                TriangleHit h{};
+                if (intersect_triangle(tr, TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]),
+                                       r0.tmin, tmax, h)) {
+                    tmax = h.t;
+                    best = t;
+                    hit = true;
+                }
+            }
+            return hit;
+        };
+        NoTraversalCounters none;
+        const bool found = traverse_bvh<false>(bvh, br, leaf, none);
+        BvhRay any_ray(r0);
+        const bool any = traverse_bvh<true>(bvh, any_ray, leaf, none);
+        Ray r = r0;
+        Hit h;
+        const bool ref = acc.intersect(r, h);
+        if (found != ref || any != ref || (ref && (br.tmax != h.t))) ++bad;
+        if (ref && best != prim_index(h.prim) && br.tmax != h.t) ++bad;
+    }
+    CHECK(bad == 0);
+}
+
 TEST_CASE("pair layout mirrors the canonical tree") {
     const TriangleMesh m = make_icosphere(3);
     const Bvh bvh = build_for_mesh(m, BvhBuilder::binned);
