@@ -1,6 +1,8 @@
 #include <doctest/doctest.h>
+#include <omp.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -292,6 +294,22 @@ TEST_CASE("generic traversal of the canonical tree with a caller-supplied leaf t
         if (ref && best != prim_index(h.prim) && br.tmax != h.t) ++bad;
     }
     CHECK(bad == 0);
+}
+
+TEST_CASE("the built tree does not depend on the thread count") {
+    const TriangleMesh m = make_icosphere(5);  // 20k triangles: subtrees are built as parallel tasks
+    BvhBuildParams p;
+    p.parallel_threshold = 512;
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const Bvh one = build_for_mesh(m, BvhBuilder::binned, p);
+    omp_set_num_threads(2);
+    const Bvh two = build_for_mesh(m, BvhBuilder::binned, p);
+    omp_set_num_threads(saved);
+    CHECK(one.prim_indices == two.prim_indices);
+    const BvhPairs a = make_bvh_pairs(one), b = make_bvh_pairs(two);
+    REQUIRE(a.nodes.size() == b.nodes.size());
+    CHECK(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhPairNode)) == 0);
 }
 
 TEST_CASE("pair layout mirrors the canonical tree") {
