@@ -20,7 +20,7 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
 
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (int tile = 0; tile < tile_count; ++tile) {
-        Sampler sampler(scene.render.seed);
+        Sampler sampler(scene.render.seed, scene.render.sampler);
         const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
         const int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
         for (int y = y0; y < y1; ++y)
