@@ -71,6 +71,11 @@ TEST_CASE("sobol: scrambling is a bijection that keeps elementary intervals") {
     CHECK(sobol::sobol_dim1(1) == 0x80000000u);
     CHECK(sobol::sobol_dim1(2) == 0xC0000000u);  // 0.75, as in Sobol's second dimension
     CHECK(sobol::sobol_dim1(3) == 0x40000000u);  // 0.25
+    for (uint32_t i : {5u, 77u, 0xdeadbeefu, 0xffffffffu, 1u << 31}) {
+        CHECK(sobol::sobol_dim1(i) == sobol::sobol_dim1_bitwise(i));
+        CHECK(sobol::scrambled_dim0(i, 99u) == sobol::nested_uniform_scramble(sobol::sobol_dim0(i), 99u));
+        CHECK(sobol::scrambled_dim1(i, 99u) == sobol::nested_uniform_scramble(sobol::sobol_dim1(i), 99u));
+    }
 }
 
 TEST_CASE("sobol sampler: every power-of-two block of a pixel is a (0,2) net") {

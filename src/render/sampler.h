@@ -19,7 +19,7 @@ public:
     /// Positions the sampler at the start of sample `index` of pixel (x, y).
     void start(uint32_t x, uint32_t y, uint32_t index) {
         const uint64_t pixel = (uint64_t(y) << 32) | x;
-        index_ = index;
+        reversed_index_ = sobol::reverse_bits(index);
         dimension_ = 0;
         if (type_ == SamplerType::independent) rng_.reseed(hash_words(seed_, pixel, index), 0x5a4a5a4a);
         else pixel_key_ = hash_words(seed_, pixel, 0x50b01u);
@@ -28,7 +28,7 @@ public:
     float next_1d() {
         if (type_ == SamplerType::independent) return rng_.next_float();
         const Keys k = next_keys();
-        return sobol::to_unit_float(sobol::nested_uniform_scramble(sobol::sobol_dim0(k.index), k.scramble_x));
+        return sobol::to_unit_float(sobol::scrambled_dim0(k.index, k.scramble_x));
     }
     /// The next two dimensions of the current sample, in [0, 1)^2; with the
     /// Sobol sampler they are a scrambled (0,2)-sequence over the pixel's samples.
@@ -38,8 +38,8 @@ public:
             return {a, rng_.next_float()};
         }
         const Keys k = next_keys();
-        return {sobol::to_unit_float(sobol::nested_uniform_scramble(sobol::sobol_dim0(k.index), k.scramble_x)),
-                sobol::to_unit_float(sobol::nested_uniform_scramble(sobol::sobol_dim1(k.index), k.scramble_y))};
+        return {sobol::to_unit_float(sobol::scrambled_dim0(k.index, k.scramble_x)),
+                sobol::to_unit_float(sobol::scrambled_dim1(k.index, k.scramble_y))};
     }
     SamplerType type() const { return type_; }
 
@@ -52,17 +52,19 @@ private:
     /// of samples stratified, since the top k bits of a Sobol point depend only
     /// on the low k index bits) and two independent scrambling seeds.
     Keys next_keys() {
-        const uint64_t h1 = mix64(pixel_key_ ^ (uint64_t(dimension_) * 0x9e3779b97f4a7c15ull));
-        const uint64_t h2 = mix64(h1 ^ 0xd1b54a32d192ed03ull);
+        const uint64_t h = mix64(pixel_key_ ^ (uint64_t(dimension_) * 0x9e3779b97f4a7c15ull));
         ++dimension_;
-        return {sobol::nested_uniform_scramble(index_, uint32_t(h1)), uint32_t(h1 >> 32), uint32_t(h2)};
+        const uint32_t lo = uint32_t(h), hi = uint32_t(h >> 32);
+        // The third seed needs no full-strength hash: the LK permutation mixes it in.
+        const uint32_t index = sobol::reverse_bits(sobol::laine_karras_permutation(reversed_index_, lo));
+        return {index, hi, (lo ^ hi) * 0x9e3779b9u + 0x7f4a7c15u};
     }
 
     uint64_t seed_;
     SamplerType type_;
     Pcg32 rng_;
     uint64_t pixel_key_ = 0;
-    uint32_t index_ = 0, dimension_ = 0;
+    uint32_t reversed_index_ = 0, dimension_ = 0;  ///< sample index, bit-reversed
 };
 
 }  // namespace sahara
