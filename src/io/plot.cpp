@@ -136,6 +136,15 @@ struct Frame2 {
     double py(double v) const { return bottom - (std::log10(v) - y_lo) / (y_hi - y_lo) * (bottom - top); }
 };
 
+/// Label of tick m * 10^e: decades always; 2 and 5 too when the axis spans one decade.
+std::string tick_label(int e, int m, int decades) {
+    if (m == 1) return decade_label(e);
+    if (decades > 1 || (m != 2 && m != 5)) return {};
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", m * std::pow(10.0, e));
+    return buf;
+}
+
 void draw_axes(Raster& r, const LogLogPlot& plot, const Frame2& f) {
     const Rgb black(0.0f), grid(0.85f), minor_grid(0.94f);
     for (int e = f.x_lo; e <= f.x_hi; ++e)
@@ -143,14 +152,16 @@ void draw_axes(Raster& r, const LogLogPlot& plot, const Frame2& f) {
             const double x = f.px(m * std::pow(10.0, e));
             r.line(x, f.top, x, f.bottom, m == 1 ? grid : minor_grid);
             r.line(x, f.bottom, x, f.bottom + (m == 1 ? 8 : 4), black);
-            if (m == 1) r.text(int(x) - text_width(decade_label(e)) / 2, f.bottom + 14, decade_label(e), black);
+            const std::string label = tick_label(e, m, f.x_hi - f.x_lo);
+            if (!label.empty()) r.text(int(x) - text_width(label) / 2, f.bottom + 14, label, black);
         }
     for (int e = f.y_lo; e <= f.y_hi; ++e)
         for (int m = 1; m <= (e < f.y_hi ? 9 : 1); ++m) {
             const double y = f.py(m * std::pow(10.0, e));
             r.line(f.left, y, f.right, y, m == 1 ? grid : minor_grid);
             r.line(f.left - (m == 1 ? 8 : 4), y, f.left, y, black);
-            if (m == 1) r.text(f.left - 12 - text_width(decade_label(e)), int(y) - 7, decade_label(e), black);
+            const std::string label = tick_label(e, m, f.y_hi - f.y_lo);
+            if (!label.empty()) r.text(f.left - 12 - text_width(label), int(y) - 7, label, black);
         }
     r.line(f.left, f.top, f.left, f.bottom, black, 2);
     r.line(f.left, f.bottom, f.right, f.bottom, black, 2);
@@ -162,8 +173,9 @@ void draw_axes(Raster& r, const LogLogPlot& plot, const Frame2& f) {
 void draw_legend(Raster& r, const LogLogPlot& plot, const Frame2& f) {
     int w = 0;
     for (const PlotSeries& s : plot.series) w = std::max(w, text_width(s.label));
-    const int row = 22, x1 = f.right - 10, x0 = x1 - w - 60, y0 = f.top + 10;
-    const int y1 = y0 + row * int(plot.series.size()) + 8;
+    // Bottom left: convergence curves fall from the top left to the bottom right.
+    const int row = 22, x0 = f.left + 12, x1 = x0 + w + 60, y1 = f.bottom - 12;
+    const int y0 = y1 - row * int(plot.series.size()) - 8;
     r.fill_rect(x0, y0, x1, y1, Rgb(1.0f));
     r.line(x0, y0, x1, y0, Rgb(0.0f)); r.line(x0, y1, x1, y1, Rgb(0.0f));
     r.line(x0, y0, x0, y1, Rgb(0.0f)); r.line(x1, y0, x1, y1, Rgb(0.0f));
