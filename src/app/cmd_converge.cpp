@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include <omp.h>
@@ -84,46 +85,73 @@ struct Series {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-/// Renders the doubling series of one configuration within the budget.
-Series measure(const SceneDesc& desc, const ConvergeArgs& a, const std::string& label, int threads) {
-    const Scene scene = build_scene(desc);
-    Film film(desc.render.width, desc.render.height);
-    Series s;
-    s.label = label;
+/// A configuration being measured.
+struct Run {
+    std::unique_ptr<Scene> scene;  ///< on the heap: a Scene must not move after build (its accelerator points to it)
+    std::unique_ptr<Film> film;
+    Series series;
     double elapsed = 0;
     int done = 0;
+    bool finished = false;
+};
+
+/// Renders the doubling series of every configuration within the budget. The
+/// configurations take turns, one doubling each, so that a change in machine
+/// load over the run affects them alike (equal-time comparisons stay fair).
+std::vector<Series> measure_all(const std::vector<SceneDesc>& descs, const std::vector<ConvergeConfig>& configs,
+                                const ConvergeArgs& a, int threads) {
+    std::vector<Run> runs;
+    for (size_t i = 0; i < descs.size(); ++i) {
+        Run r{std::unique_ptr<Scene>(new Scene(build_scene(descs[i]))), std::make_unique<Film>(descs[i].render.width, descs[i].render.height), {}};
+        r.series.label = configs[i].label;
+        runs.push_back(std::move(r));
+    }
     const bool tty = Progress::stderr_is_tty();
-    for (int next = 1;; next = done * 2) {
-        const auto t0 = Clock::now();
-        render_pass(scene, film, done, next, threads, nullptr);
-        elapsed += seconds_since(t0);
-        done = next;
-        s.points.push_back({done, elapsed, film.to_rgb(), {}});
-        if (tty) std::fprintf(stderr, "\r  %-12s %7d spp  %8.2f s", label.c_str(), done, elapsed);
-        // The next doubling costs about as much as everything so far.
-        if (2 * elapsed > a.budget_s || done * 2 > a.max_spp) break;
+    for (bool any = true; any;) {
+        any = false;
+        for (Run& r : runs) {
+            if (r.finished) continue;
+            any = true;
+            const int next = std::max(1, r.done * 2);
+            const auto t0 = Clock::now();
+            render_pass(*r.scene, *r.film, r.done, next, threads, nullptr);
+            r.elapsed += seconds_since(t0);
+            r.done = next;
+            r.series.points.push_back({r.done, r.elapsed, r.film->to_rgb(), {}});
+            // The next doubling costs about as much as everything so far.
+            r.finished = 2 * r.elapsed > a.budget_s || r.done * 2 > a.max_spp;
+            if (tty) std::fprintf(stderr, "\r  %-12s %7d spp  %8.2f s   ", r.series.label.c_str(), r.done, r.elapsed);
+        }
     }
     if (tty) std::fprintf(stderr, "\n");
-    else std::fprintf(stderr, "  %-12s %7d spp  %8.2f s\n", label.c_str(), done, elapsed);
-    if (film.nonfinite_samples() > 0)
-        log_warning(label + ": " + std::to_string(film.nonfinite_samples()) + " non-finite samples were discarded");
-    return s;
+    std::vector<Series> all;
+    for (Run& r : runs) {
+        if (r.film->nonfinite_samples() > 0)
+            log_warning(r.series.label + ": " + std::to_string(r.film->nonfinite_samples()) +
+                        " non-finite samples were discarded");
+        all.push_back(std::move(r.series));
+    }
+    return all;
 }
 
 /// Renders a reference at 16x the largest measured spp, with another seed so its
 /// noise is independent of the measured images; capped at 8x the budget.
-std::vector<float> render_reference(SceneDesc desc, const ConvergeArgs& a, const Series& basis, int threads) {
+std::vector<float> render_reference(SceneDesc desc, const ConvergeArgs& a, const std::vector<Series>& all,
+                                    int threads) {
+    const Series& basis = all[0];
     const Point& last = basis.points.back();
     const double per_spp = last.seconds / last.spp;
-    int spp = 16 * last.spp;
-    const int cap = std::max(last.spp * 2, int(8 * a.budget_s / per_spp));
+    int largest = 0;
+    for (const Series& s : all) largest = std::max(largest, s.points.back().spp);
+    int spp = 16 * largest;
+    const int cap = std::max(largest * 2, int(8 * a.budget_s / per_spp));
     if (spp > cap) spp = cap;
     desc.render.seed = desc.render.seed * 0x9e3779b97f4a7c15ull + 0x7261726566ull;
     std::fprintf(stderr, "sahara converge: no --reference given: rendering one at %d spp (%s settings, another seed, "
                          "about %.0f s)\n", spp, basis.label.c_str(), per_spp * spp);
-    if (spp < 16 * last.spp)
+    if (spp < 16 * largest)
         log_warning("reference capped at " + std::to_string(spp) + " spp (< 16x the largest measured " +
-                    std::to_string(last.spp) + "): its own noise inflates the smallest errors");
+                    std::to_string(largest) + "): its own noise inflates the smallest errors");
     const Scene scene = build_scene(desc);
     Film film(desc.render.width, desc.render.height);
     for (int done = 0; done < spp;) {
@@ -232,11 +260,10 @@ int run(const ConvergeArgs& a) {
         c.overrides.apply(d.render);
         descs.push_back(std::move(d));
     }
-    std::vector<Series> all;
-    for (size_t i = 0; i < configs.size(); ++i) all.push_back(measure(descs[i], a, configs[i].label, threads));
+    std::vector<Series> all = measure_all(descs, configs, a, threads);
     const std::vector<float> reference = a.reference
                                              ? load_reference(*a.reference, base.render.width, base.render.height)
-                                             : render_reference(descs[0], a, all[0], threads);
+                                             : render_reference(descs[0], a, all, threads);
     for (Series& s : all) {
         std::vector<double> x, y;
         for (Point& p : s.points) {
