@@ -47,7 +47,7 @@ TEST_CASE("plot: axes, labels and series land in the image") {
     CHECK(decade_label(3) == "1000");
     CHECK(decade_label(-5) == "1E-5");
     LogLogPlot p;
-    p.title = "t";
+    p.title = "test plot";
     p.series.push_back({"a", {0.1, 1, 10}, {1, 0.3, 0.1}, {1, 0, 0}, false});
     const Raster r = draw_loglog_plot(p, 400, 300);
     int red = 0;
