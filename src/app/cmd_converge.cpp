@@ -178,6 +178,18 @@ std::vector<float> load_reference(const std::string& file, int width, int height
     return rgb;
 }
 
+/// A CSV field: quoted (with doubled quotes) when it holds a comma or a quote.
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) {
+        if (c == '"') q.push_back('"');
+        q.push_back(c);
+    }
+    q.push_back('"');
+    return q;
+}
+
 void write_csv(const std::string& file, const std::vector<Series>& all) {
     std::ofstream out(file);
     if (!out) throw input_error(file, "", "cannot write");
@@ -185,9 +197,9 @@ void write_csv(const std::string& file, const std::vector<Series>& all) {
     char line[256];
     for (const Series& s : all)
         for (const Point& p : s.points) {
-            std::snprintf(line, sizeof line, "%s,%d,%.6g,%.6g,%.6g,%.6g\n", s.label.c_str(), p.spp, p.seconds,
+            std::snprintf(line, sizeof line, ",%d,%.6g,%.6g,%.6g,%.6g\n", p.spp, p.seconds,
                           p.error.rmse, p.error.relmse, 1.0 / (p.error.relmse * p.seconds));
-            out << line;
+            out << csv_field(s.label) << line;
         }
     if (!out) throw input_error(file, "", "write failed");
 }
