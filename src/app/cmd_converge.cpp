@@ -247,7 +247,10 @@ void print_summary(const std::vector<Series>& all) {
     double t = INFINITY;
     for (const Series& s : all) t = std::min(t, s.points.back().seconds);
     std::printf("\nfitted slope of log RMSE against log seconds (ideal Monte Carlo: -0.50):\n");
-    for (const Series& s : all) std::printf("  %-14s %6.3f\n", s.label.c_str(), s.slope);
+    for (const Series& s : all) {
+        if (s.points.size() < 2) std::printf("  %-14s n/a (one point: raise --budget)\n", s.label.c_str());
+        else std::printf("  %-14s %6.3f\n", s.label.c_str(), s.slope);
+    }
     std::printf("equal-time comparison at %.3f s (log-log interpolation):\n", t);
     double base = 0;
     for (const Series& s : all) {
