@@ -16,6 +16,7 @@ const char* const kRenderUsage =
     "  --max-depth D        rays per path, camera ray included\n"
     "  --seed S             random seed (same seed + settings = same image)\n"
     "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
+    "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
     "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
@@ -60,6 +61,12 @@ IntegratorType parse_integrator_name(const std::string& flag, const std::string&
     throw UsageError(flag + ": expected path|whitted|albedo|normals|depth|bvh-cost, got '" + v + "'");
 }
 
+SamplerType parse_sampler_name(const std::string& flag, const std::string& v) {
+    if (v == "sobol") return SamplerType::sobol;
+    if (v == "independent") return SamplerType::independent;
+    throw UsageError(flag + ": expected sobol|independent, got '" + v + "'");
+}
+
 namespace {
 
 const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
@@ -79,6 +86,7 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
     else if (a == "--integrator") o.integrator = parse_integrator_name(a, flag_value(args, i));
     else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
     else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
+    else if (a == "--sampler") o.sampler = parse_sampler_name(a, flag_value(args, i));
     else return false;
     return true;
 }
@@ -94,6 +102,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (target_error) r.target_error = *target_error;
     if (exposure) r.exposure = *exposure;
     if (tonemap) r.tonemap = *tonemap;
+    if (sampler) r.sampler = *sampler;
 }
 
 RenderArgs parse_render_args(const std::vector<std::string>& args) {
