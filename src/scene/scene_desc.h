@@ -129,7 +129,7 @@ struct LightDesc {
 };
 
 enum class IntegratorType : uint8_t { path, whitted, albedo, normals, depth, bvh_cost };
-enum class Tonemap : uint8_t { clamp, reinhard, aces };
+enum class Tonemap : uint8_t { clamp, reinhard, aces, filmic };
 
 struct RenderSettings {
     int width = 640, height = 480;
