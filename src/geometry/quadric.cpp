@@ -98,7 +98,7 @@ QuadricHit Quadric::intersect(const Ray& ray) const {
     d = d * inv_len;  // unit: parameters below are object-frame distances
     // Move the origin to the ray point nearest the object so that the
     // coefficients stay small and b² - 4ac does not cancel for distant rays.
-    const double shift = dot(reference_point(*this) - o, d);
+    const double shift = dot(solve_origin - o, d);
     o = o + d * shift;
     const auto& k = coeffs;
     const double a = d.x * (k[0] * d.x + k[3] * d.y + k[4] * d.z) + d.y * (k[1] * d.y + k[5] * d.z) + k[2] * d.z * d.z;
@@ -229,6 +229,7 @@ Bounds3 padded_bounds(const Vec3d& lo, const Vec3d& hi) {
 
 void Quadric::finalize() {
     object_from_world = affine_inverse(world_from_object);
+    solve_origin = reference_point(*this);
     const auto& m = world_from_object.m;
     if (form == QuadricForm::ellipsoid) {
         // The image of the unit sphere under M extends sqrt(sum_j M_ij²) along world axis i.

@@ -56,6 +56,7 @@ struct Quadric {
     bool cap_bottom = false, cap_top = false;
     Mat4 world_from_object, object_from_world;
     Bounds3 world_bounds;  ///< cached by finalize()
+    Vec3d solve_origin;    ///< object-frame point rays are re-based to before solving (finalize())
     uint32_t material = 0;
 
     /// World-space bounds of the clipped surface (and caps).
@@ -72,7 +73,7 @@ struct Quadric {
     double eval(const Vec3d& p) const;
     /// Gradient of f at an object-frame point.
     Vec3d gradient(const Vec3d& p) const;
-    /// Computes object_from_world and world_bounds from the other fields.
+    /// Computes object_from_world, world_bounds and solve_origin from the other fields.
     void finalize();
 };
 
