@@ -431,22 +431,34 @@ TEST_CASE("quadric: factories reject bad parameters") {
     CHECK_THROWS_AS(make_ellipsoid({0, 0, 0}, {1, 1, 1}, Mat4::scale({1, 0, 1})), InputError);
 }
 
-TEST_CASE("quadric: every form agrees with brute-force root finding") {
-    // 100k rays per form (4 instances of sizes 1e-2..1e3, offsets up to 1e2 x size),
-    // against a sign-change scan of the long-double implicit function.
+namespace {
+
+/// 100k rays per form (4 instances of sizes 1e-2..1e3, offsets up to 1e2 x size)
+/// against a sign-change scan of the long-double implicit function.
+void check_against_brute_force(QuadricForm form) {
     const int per_instance = kSanitized ? 2500 : 25000;
-    for (QuadricForm form : {QuadricForm::ellipsoid, QuadricForm::cylinder, QuadricForm::cone,
-                             QuadricForm::paraboloid, QuadricForm::hyperboloid, QuadricForm::general}) {
-        const std::string name = form_name(form);
-        CAPTURE(name);
-        const FormStats st = run_brute_force(form, 1000 + uint64_t(form), 4, per_instance);
-        INFO("rays ", st.rays, " hits ", st.hits, " ill-conditioned ", st.explained);
-        CHECK(st.hits > st.rays / 10);
-        CHECK(st.unexplained == 0);
-        CHECK(st.off_surface == 0);
-        CHECK(st.bad_normal == 0);
-        CHECK(st.explained <= st.rays / 200);
-    }
+    const FormStats st = run_brute_force(form, 1000 + uint64_t(form), 4, per_instance);
+    INFO("rays ", st.rays, " hits ", st.hits, " ill-conditioned ", st.explained);
+    CHECK(st.hits > st.rays / 10);
+    CHECK(st.unexplained == 0);
+    CHECK(st.off_surface == 0);
+    CHECK(st.bad_normal == 0);
+    CHECK(st.explained <= st.rays / 200);
+}
+
+}  // namespace
+
+TEST_CASE("quadric: ellipsoid agrees with brute-force root finding") { check_against_brute_force(QuadricForm::ellipsoid); }
+TEST_CASE("quadric: cylinder agrees with brute-force root finding") { check_against_brute_force(QuadricForm::cylinder); }
+TEST_CASE("quadric: cone agrees with brute-force root finding") { check_against_brute_force(QuadricForm::cone); }
+TEST_CASE("quadric: paraboloid agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::paraboloid);
+}
+TEST_CASE("quadric: hyperboloid agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::hyperboloid);
+}
+TEST_CASE("quadric: general quadric agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::general);
 }
 
 TEST_CASE("quadric: rays spawned from a hit towards either side never re-hit at t ~ 0") {
