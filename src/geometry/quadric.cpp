@@ -18,6 +18,26 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// cylinder or cone hits the side or the cap, never slips between the two.
 constexpr double kCapSlack = 1e-9;
 
+/// Inverse of an affine transform (upper 3x3 by cofactors, translation undone).
+Mat4 invert_affine(const Mat4& m) {
+    const auto& a = m.m;
+    const double det = m.determinant3();
+    const double inv = 1.0 / det;
+    Mat4 r;
+    r.m[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) * inv;
+    r.m[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) * inv;
+    r.m[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) * inv;
+    r.m[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) * inv;
+    r.m[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) * inv;
+    r.m[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) * inv;
+    r.m[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) * inv;
+    r.m[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) * inv;
+    r.m[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) * inv;
+    for (int i = 0; i < 3; ++i)
+        r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
+    return r;
+}
+
 Vec3d point_to(const Mat4& m, const Vec3d& p) {
     return {m.m[0][0] * p.x + m.m[0][1] * p.y + m.m[0][2] * p.z + m.m[0][3],
             m.m[1][0] * p.x + m.m[1][1] * p.y + m.m[1][2] * p.z + m.m[1][3],
@@ -175,25 +195,6 @@ Vec3 Quadric::normal(const Vec3& p_world) const {
     return world_from_object.apply_normal(Vec3(g / length(g)));
 }
 
-Mat4 affine_inverse(const Mat4& m) {
-    const auto& a = m.m;
-    const double det = m.determinant3();
-    const double inv = 1.0 / det;
-    Mat4 r;
-    r.m[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) * inv;
-    r.m[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) * inv;
-    r.m[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) * inv;
-    r.m[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) * inv;
-    r.m[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) * inv;
-    r.m[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) * inv;
-    r.m[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) * inv;
-    r.m[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) * inv;
-    r.m[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) * inv;
-    for (int i = 0; i < 3; ++i)
-        r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
-    return r;
-}
-
 namespace {
 
 /// Object-frame box around the clipped surface (finite for every form).
@@ -228,7 +229,7 @@ Bounds3 padded_bounds(const Vec3d& lo, const Vec3d& hi) {
 }  // namespace
 
 void Quadric::finalize() {
-    object_from_world = affine_inverse(world_from_object);
+    object_from_world = invert_affine(world_from_object);
     solve_origin = reference_point(*this);
     const auto& m = world_from_object.m;
     if (form == QuadricForm::ellipsoid) {

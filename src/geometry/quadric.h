@@ -102,7 +102,4 @@ Quadric make_hyperboloid(const Vec3& center, const Vec3& axis, float radius, flo
 Quadric make_general_quadric(const std::array<double, 10>& coeffs, const Bounds3& box,
                              const Mat4& world_from_object = {});
 
-/// Inverse of an affine transform (upper 3x3 inverted, translation undone).
-Mat4 affine_inverse(const Mat4& m);
-
 }  // namespace sahara
