@@ -563,3 +563,31 @@ TEST_CASE("quadric: closed shapes have no holes (every ray from inside hits)") {
         CHECK(escapes == 0);
     }
 }
+
+TEST_CASE("quadric: placing a canonical shape by world_from_object equals placing it by parameters") {
+    // How a parsed QuadricDesc maps onto the factories: origin 0, axis +z, and
+    // the desc's world_from_local as world_from_object.
+    Pcg32 rng(4000);
+    const Mat4 rot = Mat4::rotate_euler({30, -50, 110});
+    const Vec3 base(1.5f, -2, 0.25f), axis = rot.apply_vector({0, 0, 1});
+    const Mat4 frame = Mat4::translate(Vec3d(base)) * rot;
+    const Quadric pairs[][2] = {
+        {make_cylinder(base, axis, 0.7f, 1.3f, true), make_cylinder({0, 0, 0}, {0, 0, 1}, 0.7f, 1.3f, true, frame)},
+        {make_cone(base, axis, 25, 1.1f, true), make_cone({0, 0, 0}, {0, 0, 1}, 25, 1.1f, true, frame)},
+        {make_paraboloid(base, axis, 0.8f, 0.9f), make_paraboloid({0, 0, 0}, {0, 0, 1}, 0.8f, 0.9f, frame)},
+        {make_hyperboloid(base, axis, 1, 0.4f, 2), make_hyperboloid({0, 0, 0}, {0, 0, 1}, 1, 0.4f, 2, frame)},
+    };
+    int mismatches = 0, hits = 0;
+    for (const auto& pair : pairs) {
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3 org = base + random_unit(rng) * 4.0f;
+            const Vec3 target = base + Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * 2.0f;
+            const Ray ray = make_ray(org, target - org);
+            const QuadricHit a = pair[0].intersect(ray), b = pair[1].intersect(ray);
+            hits += a.hit();
+            mismatches += a.hit() != b.hit() || (a.hit() && (std::abs(a.t - b.t) > 1e-5f || a.part != b.part));
+        }
+    }
+    CHECK(hits > 1000);
+    CHECK(mismatches == 0);
+}
