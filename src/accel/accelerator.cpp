@@ -30,7 +30,7 @@ struct PrimitiveList {
 PrimitiveList collect_primitives(const Scene& scene) {
     PrimitiveList list;
     const TriangleSoup& soup = scene.triangles;
-    const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size();
+    const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
     list.boxes.reserve(n);
     list.centers.reserve(n);
     list.ids.reserve(n);
@@ -43,6 +43,8 @@ PrimitiveList collect_primitives(const Scene& scene) {
         list.add(scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
                  make_prim_id(PrimKind::sphere, i));
     for (uint32_t i = 0; i < scene.boxes.size(); ++i) list.add(scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+    for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
+        list.add(scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
 }
 
@@ -71,7 +73,7 @@ Bvh single_leaf_bvh(const PrimitiveList& prims) {
 }  // namespace
 
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
-    : spheres_(scene.spheres) {
+    : spheres_(scene.spheres), quadrics_(scene.quadrics) {
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
@@ -100,7 +102,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 
 size_t Accelerator::bytes() const {
     return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
-           spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3);
+           spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) + quadrics_.size() * sizeof(Quadric);
 }
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in `hit`.
@@ -130,6 +132,15 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
             case PrimKind::box:
                 if (!intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t)) continue;
                 break;
+            case PrimKind::quadric: {
+                Ray r = ray;
+                r.tmax = tmax;
+                const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
+                if (!qh.hit()) continue;
+                t = qh.t;
+                u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
+                break;
+            }
             case PrimKind::plane:
                 continue;  // unbounded: never in the tree
         }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "geometry/hit.h"
+#include "geometry/quadric.h"
 #include "geometry/sphere.h"
 #include "scene/scene_desc.h"
 
@@ -67,6 +68,7 @@ public:
     TriangleSoup triangles;
     std::vector<Plane> planes;
     std::vector<Box> boxes;
+    std::vector<Quadric> quadrics;
     // appearance (kept as plain data for now)
     std::vector<MaterialDesc> materials;
     std::vector<TextureDesc> textures;
@@ -84,6 +86,9 @@ private:
     std::unique_ptr<Accelerator> accel_;
     Bounds3 bounds_;
 };
+
+/// The runtime quadric for a parsed quadric object.
+Quadric make_quadric(const QuadricDesc& desc);
 
 /// Builds the runtime scene from plain data (merges meshes, builds the BVH).
 Scene build_scene(const SceneDesc& desc);
