@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "accel/accelerator.h"
@@ -186,6 +187,8 @@ Scene build_scene(const SceneDesc& desc) {
             soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
     }
     scene.build_accelerator();
+    const char* force = std::getenv("SAHARA_FORCE_ALL_FEATURES");
+    scene.prepare_lighting(force != nullptr && force[0] == '1');
     return scene;
 }
 
