@@ -101,10 +101,10 @@ namespace {
 /// A floor, a rough metal ball, and two sphere lights of very different sizes.
 SceneDesc area_light_scene() {
     SceneDesc d = floor_scene(Rgb(0.7f));
-    d.materials.push_back(emissive({400, 300, 200}));  // 2: small and bright
+    d.materials.push_back(emissive({40, 30, 20}));  // 2: small and bright
     d.materials.push_back(emissive({0.5f, 0.6f, 0.8f}));  // 3: large and dim
     d.materials.push_back(metal({0.9f, 0.8f, 0.6f}, 0.4f));  // 4
-    d.spheres.push_back({{1, 0, 1.5f}, 0.05f, 2, {0, 0, 0}});
+    d.spheres.push_back({{1, 0, 1.5f}, 0.15f, 2, {0, 0, 0}});
     d.spheres.push_back({{-3, 2, 3}, 2.0f, 3, {0, 0, 0}});
     d.spheres.push_back({{0, 1, 0.6f}, 0.6f, 4, {0, 0, 0}});
     return d;
@@ -123,19 +123,21 @@ TEST_CASE("MIS, BSDF sampling only and light sampling only agree with area light
         CAPTURE(t.x);
         CAPTURE(t.y);
         const Ray ray = ray_to(t, eye);
-        auto stats = [&](LightStrategy st, int n) {
-            return sample_stats(n, 3, [&](Sampler& s) { return path_trace_with(scene, ray, s, 6, st); });
+        auto stats = [&](LightStrategy st, int n) {  // independent streams per strategy
+            return sample_stats(n, 3 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 6, st); });
         };
         const Stat mis = stats(LightStrategy::mis, scaled(8000));
-        const Stat bsdf = stats(LightStrategy::bsdf_only, scaled(40000));
+        const Stat bsdf = stats(LightStrategy::bsdf_only, scaled(80000));
         const Stat light = stats(LightStrategy::light_only, scaled(8000));
         CHECK(agree(mis, bsdf, 4));
         CHECK(agree(mis, light, 4));
         CHECK(mis.mean.x > 0);
-        mis_better += luminance(mis.se) * 2.2f < luminance(bsdf.se);  // at 5x fewer samples
+        // Standard deviation per sample (bsdf had 10x the samples): MIS at least twice as good.
+        const float ratio = luminance(bsdf.se) * std::sqrt(10.0f) / luminance(mis.se);
+        mis_better += ratio > 2.0f;
     }
     // The small bright light makes BSDF sampling alone very noisy on diffuse surfaces.
-    CHECK(mis_better >= 3);
+    CHECK(mis_better >= 4);
 }
 
 TEST_CASE("a sphere light is sampled by solid angle: the cone pdf matches the hit pdf") {
@@ -182,7 +184,7 @@ TEST_CASE("an emissive triangle is an area light (needs triangles in the acceler
     }
     const Ray ray = ray_to({0.1f, 0.1f, 0}, {0, -3, 2});
     auto stats = [&](LightStrategy st, int n) {
-        return sample_stats(n, 9, [&](Sampler& s) { return path_trace_with(scene, ray, s, 3, st); });
+        return sample_stats(n, 9 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 3, st); });
     };
     const Stat mis = stats(LightStrategy::mis, scaled(8000));
     CHECK(agree(mis, stats(LightStrategy::bsdf_only, scaled(16000)), 4));
@@ -253,7 +255,7 @@ TEST_CASE("envmap lighting: MIS agrees with BSDF sampling") {
     for (const Vec3& t : {Vec3(0, 0, 0), Vec3(2, 1, 0)}) {
         const Ray ray = ray_to(t, {0, -3, 2});
         auto stats = [&](LightStrategy st, int n) {
-            return sample_stats(n, 13, [&](Sampler& s) { return path_trace_with(scene, ray, s, 4, st); });
+            return sample_stats(n, 13 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 4, st); });
         };
         const Stat mis = stats(LightStrategy::mis, scaled(8000));
         const Stat bsdf = stats(LightStrategy::bsdf_only, scaled(30000));
