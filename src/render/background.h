@@ -14,7 +14,8 @@ inline Vec2 envmap_uv(const Vec3& up, const Vec3& dir) {
     const Frame f(normalize(up));
     const Vec3 l = f.to_local(normalize(dir));
     const float phi = std::atan2(l.y, l.x);
-    const float theta = std::acos(std::clamp(l.z, -1.0f, 1.0f));
+    // atan2 rather than acos: accurate near the poles, where acos(z) loses theta.
+    const float theta = std::atan2(std::sqrt(l.x * l.x + l.y * l.y), l.z);
     return {phi * (0.5f * kInvPi) + 0.5f, theta * kInvPi};
 }
 
