@@ -136,13 +136,19 @@ TEST_CASE("checkerboard albedo is evaluated at the hit point") {
     m.albedo.odd = Rgb(0.2f);
     m.albedo.checker_scale = 1.0f;
     d.materials.push_back(m);
-    d.planes.push_back({{0, 0, 0.5f}, {0, 0, 1}, 1});  // z = 0.5: away from a cell boundary
+    d.planes.push_back({{0, 0, 0}, {0, 0, 1}, 1});  // z = 0 is a cell boundary: hits must not straddle it
     d.render.integrator = IntegratorType::albedo;
     const Scene scene = build_scene(d);
     CHECK(scene.features.has_textures);
     Sampler s(0);
     CHECK(estimate_radiance(scene, Ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x == doctest::Approx(0.8f));
     CHECK(estimate_radiance(scene, Ray{{1.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x == doctest::Approx(0.2f));
+    for (int i = 0; i < 200; ++i) {  // from many directions, the same cell
+        const Vec3 target(0.1f + 0.004f * float(i), 0.7f - 0.003f * float(i), 0.0f);
+        const Vec3 eye(std::sin(float(i)) * 7.0f, std::cos(float(i)) * 7.0f, 0.5f + 0.037f * float(i));
+        const Ray ray{eye, normalize(target - eye), 0, kInfinity, 0};
+        CHECK(estimate_radiance(scene, ray, s, 4).x == doctest::Approx(0.8f));
+    }
     // Under a white sky a checkered floor reflects its albedo.
     d.render.integrator = IntegratorType::path;
     const Scene lit = build_scene(d);
