@@ -28,97 +28,123 @@ float hit_weight(float bsdf_pdf, float light_pdf) {
     else return 1.0f;
 }
 
+/// The Lambertian-only kernels' BSDF: no dispatch, no frame until sampling.
+struct LambertShading {
+    Rgb albedo;
+    Vec3 ns, ng;
+    bool is_delta() const { return false; }
+};
+
+inline Rgb eval_shading(const LambertShading& b, const Vec3&, const Vec3& wi, float* pdf) {
+    const float cos = dot(wi, b.ns);
+    if (dot(wi, b.ng) <= 0 || cos <= 0) {
+        *pdf = 0;
+        return Rgb(0.0f);
+    }
+    *pdf = cos * kInvPi;
+    return b.albedo * (cos * kInvPi);
+}
+inline Rgb eval_shading(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) { return eval_bsdf(b, wo, wi, pdf); }
+
+inline bool sample_shading(const LambertShading& b, const Vec3&, Sampler& sampler, BsdfSample& bs) {
+    const Vec3 local = sample_cosine_hemisphere(sampler.next_2d());
+    bs.wi = Frame(b.ns).to_world(local);
+    bs.weight = b.albedo;
+    bs.pdf = local.z * kInvPi;
+    return dot(bs.wi, b.ng) > 0;  // below the geometric surface: absorbed
+}
+inline bool sample_shading(const Bsdf& b, const Vec3& wo, Sampler& sampler, BsdfSample& bs) {
+    const Vec2 u = sampler.next_2d();
+    return sample_bsdf(b, wo, u, sampler.next_1d(), bs);
+}
+
+template <bool kLambertOnly>
+auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+    if constexpr (kLambertOnly) return LambertShading{eval_color(m.albedo, textures, si.p, si.uv), si.ns, si.ng};
+    else return make_bsdf(m, si, textures);
+}
+
 /// Next-event estimation at a non-delta vertex: one emitter, one shadow ray.
-template <Strategy S, bool kLambertOnly>
-Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Bsdf& bsdf, const Vec3& wo, float time,
+template <Strategy S, class Shading>
+Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading& bsdf, const Vec3& wo, float time,
                  float u_select, Vec2 u) {
     LightSample ls;
     if (!sample_light(scene, si.p, time, u_select, u, ls)) return Rgb(0.0f);
     float bsdf_pdf = 0;
-    Rgb f_cos;
-    if constexpr (kLambertOnly) {
-        const float cos = dot(ls.wi, si.ns);
-        if (dot(ls.wi, si.ng) <= 0 || cos <= 0) return Rgb(0.0f);
-        f_cos = bsdf.albedo * (cos * kInvPi);
-        bsdf_pdf = cos * kInvPi;
-    } else {
-        f_cos = eval_bsdf(bsdf, wo, ls.wi, &bsdf_pdf);
-    }
+    const Rgb f_cos = eval_shading(bsdf, wo, ls.wi, &bsdf_pdf);
     if (max_component(f_cos) <= 0 || max_component(ls.li) <= 0) return Rgb(0.0f);
     if (scene.occluded(shadow_ray(si.p, si.ng, ls, time))) return Rgb(0.0f);
     const float w = (S == Strategy::mis && !ls.delta) ? power_heuristic(ls.pdf, bsdf_pdf) : 1.0f;
     return f_cos * ls.li * (w / ls.pdf);
 }
 
-/// Lambertian BSDF without the general dispatch (the lambertian-only kernels).
-Bsdf lambert_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
-    Bsdf b;
-    b.kind = BsdfKind::lambertian;
-    b.albedo = eval_color(m.albedo, textures, si.p, si.uv);
-    b.ng = si.ng;
-    return b;
+/// Where the previous scattering event was, for MIS weights of emission found next.
+struct PrevVertex {
+    Vec3 p;
+    float pdf = 0;
+    bool delta = true;  // emitters seen by the camera or through a mirror count fully
+};
+
+/// Emission of an emissive surface hit by the path, MIS-weighted against light sampling.
+template <Strategy S>
+Rgb hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const SurfaceInteraction& si,
+                 const MaterialDesc& mat, const PrevVertex& prev) {
+    if (!si.front_face) return Rgb(0.0f);
+    float w = 1;
+    if constexpr (S == Strategy::mis || S == Strategy::light_only) {
+        const uint32_t e = emitter_of_hit(scene, hit);
+        if (!prev.delta && e != kNoEmitter)
+            w = hit_weight<S>(prev.pdf, area_light_pdf(scene, e, prev.p, si.p, si.ng, ray.time));
+    }
+    return eval_color(mat.radiance, scene.textures, si.p, si.uv) * w;
+}
+
+/// The background seen by a path that leaves the scene, MIS-weighted against envmap sampling.
+template <Strategy S>
+Rgb escaped(const Scene& scene, const Ray& ray, const PrevVertex& prev) {
+    float w = 1;
+    if constexpr (S == Strategy::mis || S == Strategy::light_only)
+        if (!prev.delta && scene.envmap_emitter != kNoEmitter)
+            w = hit_weight<S>(prev.pdf, envmap_light_pdf(scene, ray.dir));
+    return eval_background(scene.background, ray.dir) * w;
 }
 
 /// One path. D rays at most, camera ray included; a shadow ray counts as the
 /// next ray, so direct light is gathered only below max_depth.
 template <Strategy S, bool kLambertOnly>
 Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
-    constexpr bool kNee = S != Strategy::none;
-    ray.dir = normalize(ray.dir);  // BSDFs work with unit directions; spawned rays keep them unit
+    // The plain Lambertian kernel is chosen only for scenes without any emission.
+    constexpr bool kEmission = !(S == Strategy::none && kLambertOnly);
     Rgb radiance(0.0f), beta(1.0f);
-    float eta_scale = 1;      // undoes the 1/eta^2 of refraction for Russian roulette
-    bool prev_delta = true;   // emitters seen by the camera or through a mirror count fully
-    float prev_pdf = 0;
-    Vec3 prev_p;
+    float eta_scale = 1;  // undoes the 1/eta^2 of refraction for Russian roulette
+    PrevVertex prev;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
         if (!scene.intersect(ray, hit)) {
-            float w = 1;
-            if constexpr (S == Strategy::mis || S == Strategy::light_only)
-                if (!prev_delta && scene.envmap_emitter != kNoEmitter)
-                    w = hit_weight<S>(prev_pdf, envmap_light_pdf(scene, ray.dir));
-            radiance += beta * eval_background(scene.background, ray.dir) * w;
+            radiance += beta * escaped<S>(scene, ray, prev);
             break;
         }
         const SurfaceInteraction si = scene.interact(ray, hit);
         const MaterialDesc& mat = scene.materials[si.material];
         if (mat.type == MaterialType::emissive) {
-            if (!si.front_face) break;
-            float w = 1;
-            if constexpr (S == Strategy::mis || S == Strategy::light_only) {
-                const uint32_t e = emitter_of_hit(scene, hit);
-                if (!prev_delta && e != kNoEmitter)
-                    w = hit_weight<S>(prev_pdf, area_light_pdf(scene, e, prev_p, si.p, si.ng, ray.time));
-            }
-            radiance += beta * eval_color(mat.radiance, scene.textures, si.p, si.uv) * w;
+            if constexpr (kEmission) radiance += beta * hit_emission<S>(scene, ray, hit, si, mat, prev);
             break;
         }
-        radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
+        if constexpr (kEmission) radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if (depth == max_depth) break;
 
         const Vec3 wo = -ray.dir;
-        const Bsdf bsdf = kLambertOnly ? lambert_bsdf(mat, si, scene.textures) : make_bsdf(mat, si, scene.textures);
-        if constexpr (kNee) {
+        const auto bsdf = make_shading<kLambertOnly>(mat, si, scene.textures);
+        if constexpr (S != Strategy::none) {
             const float u_select = sampler.next_1d();
             const Vec2 u_light = sampler.next_2d();
-            if (!bsdf.is_delta())
-                radiance += beta * direct_light<S, kLambertOnly>(scene, si, bsdf, wo, ray.time, u_select, u_light);
+            if (!bsdf.is_delta()) radiance += beta * direct_light<S>(scene, si, bsdf, wo, ray.time, u_select, u_light);
         }
         BsdfSample bs;
-        const Vec2 u_dir = sampler.next_2d();
-        if constexpr (kLambertOnly) {
-            bs.wi = Frame(si.ns).to_world(sample_cosine_hemisphere(u_dir));
-            if (dot(bs.wi, si.ng) <= 0) break;  // below the geometric surface: absorbed
-            bs.weight = bsdf.albedo;
-            bs.pdf = dot(bs.wi, si.ns) * kInvPi;
-        } else {
-            if (!sample_bsdf(bsdf, wo, u_dir, sampler.next_1d(), bs)) break;
-        }
+        if (!sample_shading(bsdf, wo, sampler, bs)) break;
         beta *= bs.weight;
         eta_scale *= bs.eta_scale;
-        prev_delta = bs.delta;
-        prev_pdf = bs.pdf;
-        prev_p = si.p;
+        prev = PrevVertex{si.p, bs.pdf, bs.delta};
         if (depth >= kRouletteStartDepth) {
             const float survive = std::min(1.0f, max_component(beta) * eta_scale);
             if (sampler.next_1d() >= survive) break;
@@ -135,7 +161,8 @@ enum class PathKernel : uint8_t { plain_lambert, plain, delta_lambert, delta, mi
 PathKernel choose_kernel(const SceneFeatures& f) {
     if (f.has_area_lights || f.has_envmap) return f.lambertian_only ? PathKernel::mis_lambert : PathKernel::mis;
     if (f.has_lights) return f.lambertian_only ? PathKernel::delta_lambert : PathKernel::delta;
-    return f.lambertian_only ? PathKernel::plain_lambert : PathKernel::plain;
+    // The plain Lambertian kernel skips emission altogether.
+    return f.lambertian_only && !f.has_emitters ? PathKernel::plain_lambert : PathKernel::plain;
 }
 
 }  // namespace

@@ -5,8 +5,9 @@
 
 namespace sahara {
 
-/// Radiance along `ray` with the scene's integrator (scene.render.integrator)
-/// and at most `max_depth` rays per path, the camera ray included.
+/// Radiance along `ray` (unit direction, as the camera makes them) with the
+/// scene's integrator (scene.render.integrator) and at most `max_depth` rays
+/// per path, the camera ray included.
 Rgb estimate_radiance(const Scene& scene, Ray ray, Sampler& sampler, int max_depth);
 
 /// Unidirectional path tracing: BSDF sampling, next-event estimation of lights
