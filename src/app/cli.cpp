@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cmd_info.h"
 #include "app/commands.h"
 #include "base/error.h"
 
@@ -18,6 +19,7 @@ const char* const kUsage =
     "\n"
     "commands:\n"
     "  render [SCENE.json]   render a scene (or the built-in default scene) to an image\n"
+    "  info [SCENE|MODEL]    what a scene holds: objects, triangles, materials, memory\n"
     "  bvh MESH              build the BVH and print its statistics\n"
     "  bench MESH            trace fixed ray sets and compare with Embree\n"
     "  trace MESH            trace rays from a file and write the hits\n"
@@ -44,6 +46,7 @@ int run_cli(int argc, char** argv) {
     }
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     if (cmd == "render") return run_render_command(rest);
+    if (cmd == "info") return run_info_command(rest);
     std::fprintf(stderr, "sahara: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
 }

@@ -17,6 +17,16 @@ const char* const kRenderUsage =
     "  --seed S             random seed (same seed + settings = same image)\n"
     "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
     "  --threads N          worker threads (default: all)\n"
+    "  --time SECONDS       stop after this long, keeping the samples done\n"
+    "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
+    "                       (--spp is then the per-pixel maximum)\n"
+    "  --reference REF.exr  also report the true error against this image\n"
+    "  --checkpoint SECONDS write the partial image this often (non-EXR outputs also get\n"
+    "                       OUT.partial.exr, resumable)\n"
+    "  --resume FILE.exr    continue the render stored in FILE (same scene, seed, settings)\n"
+    "  --preview            show the image in a window while it renders (Esc: stop and save,\n"
+    "                       S: save a snapshot)\n"
+    "  --preview-dump FILE  write the preview window's last frame to FILE (for tests)\n"
     "  --stats              print statistics at the end\n"
     "  --quiet              no progress and no summary line\n"
     "  -h, --help           this text\n";
@@ -67,6 +77,8 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
     else if (a == "--max-depth") o.max_depth = int(parse_int_value(a, flag_value(args, i), 0, 100000));
     else if (a == "--seed") o.seed = uint64_t(parse_int_value(a, flag_value(args, i), 0, (1LL << 62)));
     else if (a == "--integrator") o.integrator = parse_integrator_name(a, flag_value(args, i));
+    else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
+    else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
     else return false;
     return true;
 }
@@ -93,6 +105,11 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
         else if (a == "--threads") r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
         else if (a == "--quiet" || a == "-q") r.quiet = true;
         else if (a == "--stats") r.stats = true;
+        else if (a == "--checkpoint") r.checkpoint_s = parse_real_value(a, flag_value(args, i), 0.1, 1e9);
+        else if (a == "--resume") r.resume = flag_value(args, i);
+        else if (a == "--reference") r.reference = flag_value(args, i);
+        else if (a == "--preview") r.preview = true;
+        else if (a == "--preview-dump") r.preview_dump = flag_value(args, i);
         else if (parse_override_flag(args, i, r.overrides)) continue;
         else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
         else if (r.scene) throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");

@@ -39,6 +39,19 @@ public:
     std::vector<float> to_rgb() const;
     uint64_t nonfinite_samples() const { return nonfinite_.load(); }
 
+    /// Exact accumulator state of pixel (x, y), for checkpoints and --resume.
+    const Vec3d& sum(int x, int y) const { return sum_[size_t(y) * size_t(width_) + size_t(x)]; }
+    double sum_sq(int x, int y) const { return sum_sq_[size_t(y) * size_t(width_) + size_t(x)]; }
+    /// Replaces pixel (x, y)'s accumulator state (restoring a checkpoint).
+    void set_pixel_state(int x, int y, const Vec3d& sum, double sum_sq, uint32_t count) {
+        const size_t i = size_t(y) * size_t(width_) + size_t(x);
+        sum_[i] = sum;
+        sum_sq_[i] = sum_sq;
+        count_[i] = count;
+    }
+    /// Adds to the discarded-sample count (restoring a checkpoint).
+    void add_nonfinite(uint64_t n) { nonfinite_.fetch_add(n); }
+
 private:
     int width_, height_;
     std::vector<Vec3d> sum_;  // double: sums of millions of samples stay exact enough

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "accel/accelerator.h"
+#include "base/counters.h"
 
 namespace sahara {
 
@@ -43,12 +44,14 @@ bool intersect_planes(const std::vector<Plane>& planes, Ray& ray, Hit& hit) {
 }  // namespace
 
 bool Scene::intersect(Ray& ray, Hit& hit) const {
+    count_ray(RayKind::closest_hit);
     bool found = accel_ ? accel_->intersect(ray, hit) : false;
     found |= intersect_planes(planes, ray, hit);
     return found;
 }
 
 bool Scene::occluded(const Ray& ray) const {
+    count_ray(RayKind::shadow);
     if (accel_ && accel_->occluded(ray)) return true;
     Ray r = ray;
     Hit h;
