@@ -59,6 +59,54 @@ std::vector<float> envmap_weights(const Image& img, double* mean_radiance) {
     return w;
 }
 
+/// Point and directional lights: the power a point light emits in all
+/// directions; the part of a directional light's flux that crosses the scene.
+void collect_lights(const Scene& s, float disk, std::vector<Emitter>& emitters, std::vector<float>& power) {
+    for (uint32_t i = 0; i < s.lights.size(); ++i) {
+        const LightDesc& l = s.lights[i];
+        const bool point = l.type == LightDesc::Type::point;
+        const float p = point ? 4.0f * kPiF * average(l.intensity) : disk * average(l.irradiance);
+        if (!(p > 0)) continue;
+        emitters.push_back({point ? Emitter::Kind::point : Emitter::Kind::directional, i});
+        power.push_back(p);
+    }
+}
+
+/// Adds area emitter i if its material emits; a Lambertian emitter of area A
+/// and radiance L emits pi * A * L.
+void add_area_emitter(std::vector<uint32_t>& map, size_t count, Emitter::Kind kind, uint32_t i, float area,
+                      const MaterialDesc& m, std::vector<Emitter>& emitters, std::vector<float>& power) {
+    if (!is_sampled_emitter(m) || !(area > 0)) return;
+    if (map.empty()) map.assign(count, kNoEmitter);
+    map[i] = uint32_t(emitters.size());
+    emitters.push_back({kind, i});
+    power.push_back(kPiF * area * mean_color(m.radiance));
+}
+
+void collect_features(const Scene& s, SceneFeatures& f) {
+    for (const MaterialDesc& m : s.materials) {
+        f.has_emitters |= (m.type == MaterialType::emissive && mean_color(m.radiance) > 0) ||
+                          (m.type == MaterialType::lambertian && max_component(m.emission) > 0);
+        f.has_metal |= m.type == MaterialType::metal;
+        f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
+        f.has_dielectric |= m.type == MaterialType::dielectric;
+        f.has_textures |= m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
+    }
+    f.lambertian_only = !f.has_metal && !f.has_dielectric;
+    const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
+    for (const Sphere& sp : s.spheres) f.has_motion |= shutter && sp.velocity != Vec3(0.0f);
+    f.has_lens = s.camera.aperture > 0;
+}
+
+void force_all(SceneFeatures& f) {
+    f.has_lights = f.has_emitters = f.has_area_lights = f.has_envmap = true;
+    f.has_delta_lights_only = false;
+    f.has_motion = f.has_lens = f.has_textures = true;
+    f.has_metal = f.has_rough_metal = f.has_dielectric = true;
+    f.lambertian_only = false;
+    f.forced_all = true;
+}
+
 }  // namespace
 
 void Scene::prepare_lighting(bool force_all_features) {
@@ -68,79 +116,44 @@ void Scene::prepare_lighting(bool force_all_features) {
     box_emitter.clear();
     envmap_emitter = kNoEmitter;
     scene_radius = bounding_radius(*this);
-    std::vector<float> power;
     const float disk = kPiF * scene_radius * scene_radius;  // cross-section of the scene
+    std::vector<float> power;
 
-    // Lights: power a point light emits in all directions; the part of a
-    // directional light's or envmap's flux that crosses the scene.
-    for (uint32_t i = 0; i < lights.size(); ++i) {
-        const LightDesc& l = lights[i];
-        const bool point = l.type == LightDesc::Type::point;
-        const float p = point ? 4.0f * kPiF * average(l.intensity) : disk * average(l.irradiance);
-        if (!(p > 0)) continue;
-        emitters.push_back({point ? Emitter::Kind::point : Emitter::Kind::directional, i});
-        power.push_back(p);
-    }
+    collect_lights(*this, disk, emitters, power);
     const size_t delta_count = emitters.size();
-    // Area lights: a Lambertian emitter of area A and radiance L emits pi * A * L.
-    auto add_area = [&](std::vector<uint32_t>& map, size_t count, Emitter::Kind kind, uint32_t i, float area,
-                        const MaterialDesc& m) {
-        if (!is_sampled_emitter(m) || !(area > 0)) return;
-        if (map.empty()) map.assign(count, kNoEmitter);
-        map[i] = uint32_t(emitters.size());
-        emitters.push_back({kind, i});
-        power.push_back(kPiF * area * mean_color(m.radiance));
-    };
     for (uint32_t i = 0; i < spheres.size(); ++i)
-        add_area(sphere_emitter, spheres.size(), Emitter::Kind::sphere, i,
-                 4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material]);
+        add_area_emitter(sphere_emitter, spheres.size(), Emitter::Kind::sphere, i,
+                         4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material], emitters,
+                         power);
     for (uint32_t i = 0; i < triangles.size(); ++i)
-        add_area(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i, triangle_area(triangles, i),
-                 materials[triangles.material[i]]);
+        add_area_emitter(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i, triangle_area(triangles, i),
+                         materials[triangles.material[i]], emitters, power);
     for (uint32_t i = 0; i < boxes.size(); ++i)
-        add_area(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
-                 materials[boxes[i].material]);
+        add_area_emitter(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
+                         materials[boxes[i].material], emitters, power);
     const size_t area_count = emitters.size() - delta_count;
+
     envmap_distribution = Distribution2D();
-    if (background.type == BackgroundDesc::Type::envmap && background.image && background.image->width > 0 &&
-        background.image->height > 0) {
+    const Image* img = background.type == BackgroundDesc::Type::envmap ? background.image.get() : nullptr;
+    if (img && img->width > 0 && img->height > 0 && background.strength > 0) {
         double mean = 0;
-        const std::vector<float> w = envmap_weights(*background.image, &mean);
+        const std::vector<float> w = envmap_weights(*img, &mean);
         if (mean > 0) {
-            envmap_distribution = Distribution2D(w, background.image->width, background.image->height);
+            envmap_distribution = Distribution2D(w, img->width, img->height);
             envmap_emitter = uint32_t(emitters.size());
             emitters.push_back({Emitter::Kind::envmap, 0});
-            power.push_back(4.0f * kPiF * disk * float(mean) * background.strength);
+            power.push_back(4.0f * kPiF * disk * float(mean) * background.strength);  // 4 pi sr over the disk
         }
     }
     emitter_distribution = Distribution1D(std::move(power));
 
-    SceneFeatures& f = features;
-    f = SceneFeatures();
-    f.has_lights = delta_count > 0;
-    f.has_area_lights = area_count > 0;
-    f.has_envmap = envmap_emitter != kNoEmitter;
-    f.has_delta_lights_only = f.has_lights && !f.has_area_lights && !f.has_envmap;
-    for (const MaterialDesc& m : materials) {
-        f.has_emitters |= (m.type == MaterialType::emissive && mean_color(m.radiance) > 0) ||
-                          (m.type == MaterialType::lambertian && max_component(m.emission) > 0);
-        f.has_metal |= m.type == MaterialType::metal;
-        f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
-        f.has_dielectric |= m.type == MaterialType::dielectric;
-        f.has_textures |= m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
-    }
-    f.lambertian_only = !f.has_metal && !f.has_dielectric;
-    const bool shutter = camera.shutter_close > camera.shutter_open;
-    for (const Sphere& s : spheres) f.has_motion |= shutter && s.velocity != Vec3(0.0f);
-    f.has_lens = camera.aperture > 0;
-    if (force_all_features) {
-        f.has_lights = f.has_emitters = f.has_area_lights = f.has_envmap = true;
-        f.has_delta_lights_only = false;
-        f.has_motion = f.has_lens = f.has_textures = true;
-        f.has_metal = f.has_rough_metal = f.has_dielectric = true;
-        f.lambertian_only = false;
-        f.forced_all = true;
-    }
+    features = SceneFeatures();
+    features.has_lights = delta_count > 0;
+    features.has_area_lights = area_count > 0;
+    features.has_envmap = envmap_emitter != kNoEmitter;
+    features.has_delta_lights_only = features.has_lights && !features.has_area_lights && !features.has_envmap;
+    collect_features(*this, features);
+    if (force_all_features) force_all(features);
 }
 
 }  // namespace sahara
