@@ -204,6 +204,10 @@ int run_render_command(const std::vector<std::string>& args) {
         std::fputs(kRenderUsage, stdout);
         return 0;
     }
+    return run_render(a, [&a] { return a.scene ? parse_scene_file(*a.scene) : default_scene(); });
+}
+
+int run_render(const RenderArgs& a, const std::function<SceneDesc()>& load_scene) {
     const std::atomic<bool>& signal_stop = install_stop_signals();
     try {
         set_log_quiet(a.quiet);
@@ -211,7 +215,7 @@ int run_render_command(const std::vector<std::string>& args) {
         if (a.preview_dump) check_output_path(fs::path(*a.preview_dump).replace_extension(".png"));
         PhaseTimes times;
         auto t = Clock::now();
-        SceneDesc desc = a.scene ? parse_scene_file(*a.scene) : default_scene();
+        SceneDesc desc = load_scene();
         a.overrides.apply(desc.render);
         check_integrator(desc.render.integrator);
         times.load = seconds_since(t);
