@@ -63,7 +63,7 @@ struct Stat {
 /// Statistics of n independent samples f(sampler) with streams from (seed, i).
 inline Stat sample_stats(int n, uint64_t seed, const std::function<Rgb(Sampler&)>& f) {
     Vec3d sum(0.0), sum_sq(0.0);
-    Sampler sampler(seed);
+    Sampler sampler(seed, SamplerType::independent);  // standard errors assume independent samples
     for (int i = 0; i < n; ++i) {
         sampler.start(uint32_t(i), 7, uint32_t(i));
         const Vec3d v(f(sampler));
