@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "accel/accelerator.h"
@@ -150,6 +151,10 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
             const Box& b = boxes[idx];
             si.p = ray.at(hit.t);
             si.ng = si.ns = box_normal(b.box, si.p);
+            // Snap onto the face: textures keyed on position (checkers) must not
+            // see the hit wander to either side of it.
+            const int axis = max_dimension(abs(si.ng));
+            si.p[axis] = si.ng[axis] > 0 ? b.box.hi[axis] : b.box.lo[axis];
             si.uv = {0, 0};
             si.material = b.material;
             break;
@@ -167,6 +172,8 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
         case PrimKind::plane: {
             const Plane& pl = planes[idx];
             si.p = ray.at(hit.t);
+            // Project onto the plane (exact for axis-aligned planes), as for boxes.
+            si.p -= pl.normal * dot(si.p - pl.point, pl.normal);
             si.ng = si.ns = pl.normal;
             si.uv = {0, 0};
             si.material = pl.material;
@@ -221,6 +228,8 @@ Scene build_scene(const SceneDesc& desc) {
             soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
     }
     scene.build_accelerator();
+    const char* force = std::getenv("SAHARA_FORCE_ALL_FEATURES");
+    scene.prepare_lighting(force != nullptr && force[0] == '1');
     return scene;
 }
 

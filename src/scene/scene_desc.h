@@ -54,6 +54,10 @@ struct MaterialDesc {
     float roughness = 0.0f;    ///< metal
     float ior = 1.5f;          ///< dielectric
     ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};  ///< emissive (front side)
+    /// Lambertian only: radiance it also emits, from both sides. Not light-sampled
+    /// (found by BSDF sampling only); meant for analytic scenes such as the closed
+    /// glowing sphere whose radiance is emission / (1 - albedo).
+    Rgb emission{0.0f, 0.0f, 0.0f};
     /// Cut-outs: alpha in [0,1] (times the texture's alpha when alpha_texture >= 0).
     float alpha = 1.0f;
     int alpha_texture = -1;
