@@ -201,7 +201,9 @@ uint32_t emitter_of_hit(const Scene& scene, const Hit& hit) {
         case PrimKind::sphere: return scene.sphere_emitter.empty() ? kNoEmitter : scene.sphere_emitter[i];
         case PrimKind::triangle: return scene.triangle_emitter.empty() ? kNoEmitter : scene.triangle_emitter[i];
         case PrimKind::box: return scene.box_emitter.empty() ? kNoEmitter : scene.box_emitter[i];
-        case PrimKind::plane: return kNoEmitter;
+        case PrimKind::plane:    // planes and quadrics are not light-sampled:
+        case PrimKind::quadric:  // found by BSDF sampling alone (MIS weight 1)
+            return kNoEmitter;
     }
     return kNoEmitter;
 }
