@@ -469,6 +469,31 @@ Doc textured_doc(const json& material) {
     return d;
 }
 
+/// A PNG assembled chunk by chunk (valid CRCs): RGBA8 `w` x `h`, IDAT bytes as given.
+std::vector<uint8_t> handmade_png(uint32_t w, uint32_t h, const std::vector<uint8_t>& idat) {
+    std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 13, 10, 26, 10};
+    auto chunk = [&](const char* type, std::vector<uint8_t> data) {
+        for (int k = 3; k >= 0; --k) png.push_back(uint8_t(data.size() >> (8 * k)));
+        data.insert(data.begin(), type, type + 4);
+        uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of type + data, as PNG requires
+        for (uint8_t b : data) {
+            crc ^= b;
+            for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+        }
+        crc = ~crc;
+        png.insert(png.end(), data.begin(), data.end());
+        for (int k = 3; k >= 0; --k) png.push_back(uint8_t(crc >> (8 * k)));
+    };
+    std::vector<uint8_t> ihdr;
+    for (uint32_t v : {w, h})
+        for (int k = 3; k >= 0; --k) ihdr.push_back(uint8_t(v >> (8 * k)));
+    ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});
+    chunk("IHDR", ihdr);
+    chunk("IDAT", idat);
+    chunk("IEND", {});
+    return png;
+}
+
 }  // namespace
 
 TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, sRGB decoding") {
@@ -658,25 +683,15 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
         Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
         d.j["images"] = {{{"uri", "data:image/png;base64," + base64({0x89, 'P', 'N', 'G', 13, 10, 26, 10, 1, 2, 3})}}};
         d.j["textures"] = {{{"source", 0}}};
-        CHECK(load(d).find(f + ": images[0]: cannot decode image") == 0);
+        CHECK(load(d) == f + ": images[0]: cannot decode image: PNG is truncated (chunk 0 header)");
+        // Well-formed chunks around a corrupt zlib stream: the decoder itself fails.
+        const std::vector<uint8_t> bad = handmade_png(4, 4, {0x78, 0x9C, 0xFF, 0xFF, 0xFF, 0x00, 0x11});
+        d.j["images"] = {{{"uri", "data:image/png;base64," + base64(bad)}}};
+        CHECK(load(d).find(f + ": images[0]: cannot decode image: ") == 0);
     }
     {  // an image over 32k pixels per side (a valid PNG header claiming 40000 x 8)
-        std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 13, 10, 26, 10};
-        auto chunk = [&](const char* type, std::vector<uint8_t> data) {
-            for (int k = 3; k >= 0; --k) png.push_back(uint8_t(data.size() >> (8 * k)));
-            data.insert(data.begin(), type, type + 4);
-            uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of type + data, as PNG requires
-            for (uint8_t b : data) {
-                crc ^= b;
-                for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-            }
-            crc = ~crc;
-            png.insert(png.end(), data.begin(), data.end());
-            for (int k = 3; k >= 0; --k) png.push_back(uint8_t(crc >> (8 * k)));
-        };
-        chunk("IHDR", {0, 0, 0x9C, 0x40, 0, 0, 0, 8, 8, 6, 0, 0, 0});
-        chunk("IDAT", {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});
-        chunk("IEND", {});
+        // A well-formed PNG header claiming 40000 x 8 pixels.
+        const std::vector<uint8_t> png = handmade_png(40000, 8, {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});
         Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
         write_bytes(dir / "huge.png", png);
         d.j["images"] = {{{"uri", "huge.png"}}};

@@ -134,8 +134,10 @@ std::vector<double> read_accessor(const Source& src, int index, const std::strin
     if (n != components)
         throw input_error(src.file, name, "has " + std::to_string(n) + " components, " + user + " needs " +
                                               std::to_string(components));
-    // Without a bufferView the count is not backed by data; keep it sane.
-    if (acc.bufferView < 0 && acc.count > (size_t(1) << 26)) throw input_error(src.file, name, "count too large");
+    // Without a bufferView the count is not backed by file data: cap it (16M numbers)
+    // so that a few bytes of JSON cannot demand gigabytes.
+    if (acc.bufferView < 0 && acc.count > (size_t(1) << 24) / size_t(n))
+        throw input_error(src.file, name, "count " + std::to_string(acc.count) + " too large for an accessor without bufferView");
     std::vector<double> out;
     const size_t elem = size_t(csize) * size_t(n);
     if (acc.bufferView >= 0) {

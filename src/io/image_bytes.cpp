@@ -28,6 +28,36 @@ std::string format_hint(const unsigned char* data, size_t size) {
     return "";
 }
 
+uint32_t be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+
+/// CRC-32 (ISO 3309, as the PNG specification defines it) of `n` bytes.
+uint32_t crc32(const unsigned char* p, size_t n) {
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; ++i) {
+        crc ^= p[i];
+        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+}
+
+/// Walks a PNG's chunk list (bounds, CRCs, IHDR first, IEND last). libpng
+/// reports such damage by longjmp through OpenImageIO, which leaks its error
+/// text; catching it here first also gives a clearer message.
+std::string png_structure_error(const unsigned char* data, size_t size) {
+    size_t at = 8;
+    for (int index = 0;; ++index) {
+        if (size - at < 12) return "PNG is truncated (chunk " + std::to_string(index) + " header)";
+        const size_t length = be32(data + at);
+        const std::string type(reinterpret_cast<const char*>(data + at + 4), 4);
+        if (length > size - at - 12) return "PNG chunk " + std::to_string(index) + " is truncated";
+        if (crc32(data + at + 4, length + 4) != be32(data + at + 8 + length))
+            return "PNG chunk " + std::to_string(index) + " has a bad CRC";
+        if (index == 0 && type != "IHDR") return "PNG does not start with IHDR";
+        at += 12 + length;
+        if (type == "IEND") return "";
+    }
+}
+
 /// Expands 1-4 channel float pixels to RGBA (grey, grey+alpha, RGB, RGBA).
 void expand_to_rgba(const std::vector<float>& src, int channels, bool srgb, Image& out) {
     const size_t n = size_t(out.width) * size_t(out.height);
@@ -50,6 +80,9 @@ std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_
                                                 const std::string& file, const std::string& element) {
     const std::string hint = format_hint(data, size);
     if (hint.empty()) throw input_error(file, element, "image data is not PNG, JPEG, GIF or BMP");
+    if (hint == "embedded.png")
+        if (const std::string why = png_structure_error(data, size); !why.empty())
+            throw input_error(file, element, "cannot decode image: " + why);
     OIIO::Filesystem::IOMemReader proxy(data, size);
     auto in = OIIO::ImageInput::open(hint, nullptr, &proxy);
     if (!in) throw input_error(file, element, "cannot decode image: " + OIIO::geterror());
