@@ -158,7 +158,7 @@ private:
         if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
             const auto nrm = read_attribute(it->second, element + ".attributes.NORMAL", 3, n);
             for (size_t i = 0; i < n; ++i) {
-                Vec3 v(float(nrm[3 * i]), float(nrm[3 * i + 1]), float(nrm[3 * i + 2]));
+                const Vec3 v{float(nrm[3 * i]), float(nrm[3 * i + 1]), float(nrm[3 * i + 2])};
                 out.normals.push_back(length_squared(v) > 0.0f ? normalize(v) : v);
             }
         }
