@@ -698,7 +698,8 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
         d.j["textures"] = {{{"source", 0}}};
         const std::string e = load(d);
         CHECK(e.find(f + ": images[0]: ") == 0);
-        CHECK(e.find("40000x8, over 32768 pixels per side") != std::string::npos);
+        CHECK(e.find("huge.png") != std::string::npos);
+        CHECK(e.find("32768") != std::string::npos);
     }
     {  // node cycle
         Doc d;

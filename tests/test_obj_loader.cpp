@@ -268,6 +268,9 @@ TEST_CASE("bad OBJ input throws InputError naming file and element") {
     write(dir / "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
     CHECK(error_of([&] { load_obj(dir / "zero.obj"); }).find("zero.obj: malformed OBJ") != std::string::npos);
 
+    write(dir / "empty.obj", "x\nv 0 0 0\n");
+    CHECK(error_of([&] { load_obj(dir / "empty.obj"); }) == (dir / "empty.obj").string() + ": no faces (is this an OBJ file?)");
+
     write(dir / "junk.png", "this is not a png");
     write(dir / "t.mtl", "newmtl m\nmap_Kd junk.png\n");
     write(dir / "tex.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n");

@@ -359,6 +359,7 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     ObjTextures textures(model, mtl_reader.texture_dir());
     for (const tinyobj::material_t& m : materials) model.materials.push_back(convert_material(m, textures));
     build_obj_meshes(file.string(), attrib, shapes, model);
+    if (model.meshes.empty()) throw input_error(file.string(), "", "no faces (is this an OBJ file?)");
     if (model.materials.empty()) model.materials.push_back(default_material());
 
     for (TriangleMesh& mesh : model.meshes) {

@@ -1,6 +1,11 @@
 #include "scene/scene.h"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
 #include "accel/accelerator.h"
+#include "base/counters.h"
 
 namespace sahara {
 
@@ -38,16 +43,153 @@ bool intersect_planes(const std::vector<Plane>& planes, Ray& ray, Hit& hit) {
 }  // namespace
 
 bool Scene::intersect(Ray& ray, Hit& hit) const {
+    count_ray(RayKind::closest_hit);
     bool found = accel_ ? accel_->intersect(ray, hit) : false;
     found |= intersect_planes(planes, ray, hit);
     return found;
 }
 
 bool Scene::occluded(const Ray& ray) const {
+    count_ray(RayKind::shadow);
     if (accel_ && accel_->occluded(ray)) return true;
     Ray r = ray;
     Hit h;
     return intersect_planes(planes, r, h);
+}
+
+}  // namespace sahara
+
+namespace sahara {
+
+namespace {
+
+Vec2 sphere_uv(const Vec3& n) {
+    // Longitude around z, latitude from +z: the scene format has no fixed up,
+    // so spherical UVs follow the world z axis.
+    const float u = 0.5f + std::atan2(n.y, n.x) * (0.5f * std::numbers::inv_pi_v<float>);
+    const float v = 0.5f + std::asin(std::clamp(n.z, -1.0f, 1.0f)) * std::numbers::inv_pi_v<float>;
+    return {u, v};
+}
+
+void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, SurfaceInteraction& si) {
+    const uint32_t i0 = soup.indices[3 * i], i1 = soup.indices[3 * i + 1], i2 = soup.indices[3 * i + 2];
+    const float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
+    const Vec3 &p0 = soup.positions[i0], &p1 = soup.positions[i1], &p2 = soup.positions[i2];
+    // Barycentric interpolation is more accurate than origin + t * dir far from the origin.
+    si.p = p0 * b0 + p1 * b1 + p2 * b2;
+    si.ng = normalize(cross(p1 - p0, p2 - p0));
+    si.ns = si.ng;
+    if (!soup.normals.empty()) {
+        Vec3 n = soup.normals[i0] * b0 + soup.normals[i1] * b1 + soup.normals[i2] * b2;
+        if (length_squared(n) > 0) si.ns = normalize(n);
+    }
+    if (!soup.uvs.empty()) {
+        const Vec2 &a = soup.uvs[i0], &b = soup.uvs[i1], &c = soup.uvs[i2];
+        si.uv = {a.x * b0 + b.x * b1 + c.x * b2, a.y * b0 + b.y * b1 + c.y * b2};
+    } else {
+        si.uv = {b1, b2};
+    }
+    si.material = soup.material[i];
+}
+
+Vec3 box_normal(const Bounds3& b, const Vec3& p) {
+    // The face whose plane is closest to p, relative to the box size.
+    const Vec3 e = b.extent() * 0.5f, c = b.center(), d = p - c;
+    int axis = 0;
+    float best = -1;
+    for (int k = 0; k < 3; ++k) {
+        float r = e[k] > 0 ? std::abs(d[k]) / e[k] : 1.0f;
+        if (r > best) { best = r; axis = k; }
+    }
+    Vec3 n(0.0f);
+    n[axis] = d[axis] >= 0 ? 1.0f : -1.0f;
+    return n;
+}
+
+}  // namespace
+
+SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
+    SurfaceInteraction si;
+    const uint32_t idx = prim_index(hit.prim);
+    switch (prim_kind(hit.prim)) {
+        case PrimKind::triangle: interact_triangle(triangles, idx, hit, si); break;
+        case PrimKind::sphere: {
+            const Sphere& s = spheres[idx];
+            const Vec3 c = s.center_at(ray.time);
+            // Reproject onto the surface: removes the error of origin + t * dir.
+            const Vec3d d = Vec3d(ray.origin) + Vec3d(ray.dir) * double(hit.t) - Vec3d(c);
+            const Vec3d n = d / length(d);
+            si.p = Vec3(Vec3d(c) + n * double(s.radius));
+            si.ng = si.ns = Vec3(n);
+            si.uv = sphere_uv(Vec3(n));
+            si.material = s.material;
+            break;
+        }
+        case PrimKind::box: {
+            const Box& b = boxes[idx];
+            si.p = ray.at(hit.t);
+            si.ng = si.ns = box_normal(b.box, si.p);
+            si.uv = {0, 0};
+            si.material = b.material;
+            break;
+        }
+        case PrimKind::plane: {
+            const Plane& pl = planes[idx];
+            si.p = ray.at(hit.t);
+            si.ng = si.ns = pl.normal;
+            si.uv = {0, 0};
+            si.material = pl.material;
+            break;
+        }
+    }
+    // Orient both normals against the incoming ray; remember which side was hit.
+    si.front_face = dot(si.ng, ray.dir) < 0;
+    if (!si.front_face) {
+        si.ng = -si.ng;
+        si.ns = -si.ns;
+    }
+    if (dot(si.ns, si.ng) < 0) si.ns = si.ng;
+    return si;
+}
+
+Scene build_scene(const SceneDesc& desc) {
+    Scene scene;
+    scene.source = desc.source;
+    scene.render = desc.render;
+    scene.camera = desc.camera;
+    scene.background = desc.background;
+    scene.materials = desc.materials;
+    if (scene.materials.empty()) scene.materials.push_back(default_material());
+    scene.textures = desc.textures;
+    scene.lights = desc.lights;
+    for (const SphereDesc& s : desc.spheres) scene.spheres.push_back({s.center, s.radius, s.velocity, s.material});
+    for (const PlaneDesc& p : desc.planes) scene.planes.push_back({p.point, normalize(p.normal), p.material});
+    for (const BoxDesc& b : desc.boxes) scene.boxes.push_back({Bounds3{min(b.lo, b.hi), max(b.lo, b.hi)}, b.material});
+
+    bool any_normals = false, any_uvs = false;
+    for (const TriangleMesh& m : desc.meshes) {
+        any_normals |= !m.normals.empty();
+        any_uvs |= !m.uvs.empty();
+    }
+    TriangleSoup& soup = scene.triangles;
+    for (const TriangleMesh& m : desc.meshes) {
+        const uint32_t base = uint32_t(soup.positions.size());
+        soup.positions.insert(soup.positions.end(), m.positions.begin(), m.positions.end());
+        // Meshes without normals get zero normals: interact() falls back to the geometric one.
+        if (any_normals) {
+            if (m.normals.empty()) soup.normals.resize(soup.positions.size(), Vec3(0.0f));
+            else soup.normals.insert(soup.normals.end(), m.normals.begin(), m.normals.end());
+        }
+        if (any_uvs) {
+            if (m.uvs.empty()) soup.uvs.resize(soup.positions.size(), Vec2{0, 0});
+            else soup.uvs.insert(soup.uvs.end(), m.uvs.begin(), m.uvs.end());
+        }
+        for (uint32_t idx : m.indices) soup.indices.push_back(base + idx);
+        for (size_t t = 0; t < m.triangle_count(); ++t)
+            soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
+    }
+    scene.build_accelerator();
+    return scene;
 }
 
 }  // namespace sahara

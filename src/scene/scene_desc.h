@@ -2,12 +2,15 @@
 /// Plain scene data: what the JSON parser, the built-in scenes and the mesh
 /// loaders produce, and what the renderer builds its runtime Scene from.
 /// No behaviour here and no BVH; indices refer into the vectors of SceneDesc.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "math/bounds.h"
+#include "math/transform.h"
 #include "math/vec3.h"
 
 namespace sahara {
@@ -124,6 +127,34 @@ struct TriangleMesh {
     size_t triangle_count() const { return indices.size() / 3; }
 };
 
+/// A bounded quadric surface: the format's ellipsoid, cylinder, cone, paraboloid,
+/// hyperboloid and general `quadric` objects. Every type is reduced to one
+/// canonical form for the renderer: the implicit surface
+///   A x² + B y² + C z² + D xy + E xz + F yz + G x + H y + I z + J = 0
+/// in a local frame, clipped to the axis-aligned box `local_bounds` of that frame,
+/// placed by `world_from_local`. The named forms put their symmetry axis on local
+/// +z with the named point (centre, base, apex, vertex) at the local origin.
+/// The parameters as written in the scene are kept for messages and `sahara info`.
+struct QuadricDesc {
+    enum class Type : uint8_t { ellipsoid, cylinder, cone, paraboloid, hyperboloid, general };
+    Type type = Type::general;
+    // --- parameters as written (before the object's transform) ---
+    Vec3 origin{0, 0, 0};  ///< centre (ellipsoid, hyperboloid), base (cylinder), apex (cone), vertex (paraboloid)
+    Vec3 axis{0, 0, 1};    ///< unit symmetry axis (not used by ellipsoid and general)
+    Vec3 radii{1, 1, 1};   ///< ellipsoid semi-axes along the scene's x, y, z
+    float radius = 1;      ///< cylinder; paraboloid at `height`; hyperboloid at both ends
+    float height = 1;      ///< cylinder, cone, paraboloid: from origin along axis; hyperboloid: total, centred
+    float angle = 45;      ///< cone: half-angle between axis and side, degrees, in (0, 90)
+    float waist = 0.5f;    ///< hyperboloid: radius at the centre, 0 < waist < radius
+    bool capped = false;   ///< cylinder: discs at both ends; cone: disc at the open end
+    // --- canonical form ---
+    std::array<double, 10> coefficients{};  ///< A..J above, in the local frame
+    Bounds3 local_bounds;                   ///< clip box in the local frame
+    Mat4 world_from_local, local_from_world;
+    Bounds3 world_bounds;  ///< bounds of the transformed clip box (conservative)
+    uint32_t material = 0;
+};
+
 struct LightDesc {
     enum class Type : uint8_t { point, directional } type = Type::point;
     Vec3 position{0, 0, 0};
@@ -158,6 +189,7 @@ struct SceneDesc {
     std::vector<PlaneDesc> planes;
     std::vector<BoxDesc> boxes;
     std::vector<TriangleMesh> meshes;
+    std::vector<QuadricDesc> quadrics;  ///< bounded quadrics (ellipsoid, cylinder, cone, ...)
     std::vector<LightDesc> lights;
 };
 

@@ -1,0 +1,238 @@
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "app/commands.h"
+#include "app/preview.h"
+#include "app/render_args.h"
+#include "app/render_file.h"
+#include "app/signals.h"
+#include "base/counters.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "io/image_io.h"
+#include "render/progress.h"
+#include "render/renderer.h"
+#include "render/stats.h"
+#include "scene/scene_parser.h"
+
+namespace sahara {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Integrators that are parsed from scene files but not implemented yet are
+/// refused up front rather than silently replaced by another.
+void check_integrator(IntegratorType t) {
+    if (t == IntegratorType::whitted || t == IntegratorType::bvh_cost)
+        throw InputError("integrator '" + std::string(t == IntegratorType::whitted ? "whitted" : "bvh-cost") +
+                         "' is not supported yet");
+}
+
+/// Wall time of each phase, for --stats.
+struct PhaseTimes {
+    double load = 0, build = 0, render = 0, write = 0;
+};
+
+/// Where a non-EXR output keeps its resumable state.
+fs::path partial_path(const fs::path& output) { return fs::path(output.string() + ".partial.exr"); }
+
+/// Everything one `sahara render` run needs besides the scene.
+struct RenderJob {
+    RenderJob(const RenderArgs& a, const Scene& s, Film& f) : args(a), scene(s), film(f) {}
+    const RenderArgs& args;
+    const Scene& scene;
+    Film& film;
+    double previous_seconds = 0;  ///< render time recorded in a resumed file
+    PhaseTimes times;
+    std::unique_ptr<Preview> preview;
+    int snapshots = 0;
+    Clock::time_point last_checkpoint = Clock::now();
+};
+
+/// Writes a consistent copy of the film while the render runs.
+void write_snapshot(RenderJob& job, RenderSession& session, const fs::path& file) {
+    Film copy(job.film.width(), job.film.height());
+    session.snapshot(copy);
+    RenderResult partial;
+    partial.spp_done = int(min_sample_count(copy));
+    partial.stop = StopReason::interrupted;
+    write_render(file, job.scene, copy, render_metadata(job.scene, copy, partial,
+                                                        job.previous_seconds + session.elapsed_seconds()));
+}
+
+void on_tick(RenderJob& job, RenderSession& session) {
+    if (job.preview) {
+        job.preview->update(session);
+        if (job.preview->take_stop_request()) session.request_stop(StopReason::interrupted);
+        if (job.preview->take_snapshot_request()) {
+            const fs::path out(job.args.output);
+            const fs::path snap = out.parent_path() / (out.stem().string() + ".snapshot-" +
+                                                       std::to_string(++job.snapshots) + out.extension().string());
+            write_snapshot(job, session, snap);
+            log_info("snapshot written to " + snap.string());
+        }
+    }
+    if (job.args.checkpoint_s && seconds_since(job.last_checkpoint) >= *job.args.checkpoint_s) {
+        const fs::path out(job.args.output);
+        write_snapshot(job, session, out);
+        if (out.extension() != ".exr") write_snapshot(job, session, partial_path(out));
+        job.last_checkpoint = Clock::now();
+    }
+}
+
+std::string final_line(const RenderJob& job, const RenderResult& r, double est_error, double true_error) {
+    const Film& f = job.film;
+    char buf[512];
+    std::string spp = std::to_string(r.spp_done);
+    if (r.spp_max != r.spp_done) {
+        std::snprintf(buf, sizeof buf, "%d-%d spp (mean %.1f)", r.spp_done, r.spp_max, r.spp_mean);
+        spp = buf;
+    } else {
+        spp += " spp";
+    }
+    if (r.stop != StopReason::complete && r.stop != StopReason::converged)
+        spp += " (" + std::string(stop_reason_name(r.stop)) + "; " + std::to_string(job.scene.render.spp) + " requested)";
+    std::string error;
+    if (job.scene.render.target_error) {
+        std::snprintf(buf, sizeof buf, ", est. error %.4g (target %.4g%s)", est_error, *job.scene.render.target_error,
+                      r.stop == StopReason::converged ? ", reached" : ", not reached");
+        error = buf;
+    }
+    if (true_error >= 0) {
+        std::snprintf(buf, sizeof buf, ", true error %.4g", true_error);
+        error += buf;
+    }
+    const double rate = r.seconds > 0 ? double(r.samples) / r.seconds / 1e6 : 0.0;
+    std::snprintf(buf, sizeof buf, "sahara: %dx%d, %s%s, %.2f s, %.2f Msamples/s -> %s", f.width(), f.height(),
+                  spp.c_str(), error.c_str(), r.seconds, rate, job.args.output.c_str());
+    return buf;
+}
+
+void print_stats(const RenderJob& job, const RenderResult& r) {
+    const Counters c = counter_totals();
+    StatsReport s;
+    s.add_count("Render", "Camera rays", c.rays[int(RayKind::camera)]);
+    s.add_count("Render", "Closest-hit rays (camera + bounce)", c.rays[int(RayKind::closest_hit)]);
+    s.add_count("Render", "Shadow rays", c.rays[int(RayKind::shadow)]);
+    s.add_count("Render", "Samples taken", r.samples);
+    s.add_count("Render", "Non-finite samples discarded", r.nonfinite);
+    s.add_ratio("Render", "Mean samples per pixel", r.spp_mean, "spp");
+    s.add_count("BVH", "Nodes visited", c.bvh_nodes_visited);
+    s.add_count("BVH", "Leaves visited", c.bvh_leaves_visited);
+    s.add_count("BVH", "Primitive tests", c.bvh_primitive_tests);
+    const SceneMemory m = estimate_scene_memory(job.scene);
+    s.add_bytes("Memory", "Spheres", m.spheres);
+    s.add_bytes("Memory", "Triangles", m.triangles);
+    s.add_bytes("Memory", "Planes and boxes", m.other_geometry);
+    s.add_bytes("Memory", "Textures", m.textures);
+    s.add_bytes("Memory", "BVH (estimate)", m.bvh_estimate);
+    s.add_bytes("Memory", "Film", uint64_t(job.film.width()) * uint64_t(job.film.height()) * 36);
+    s.add_seconds("Time", "Load", job.times.load);
+    s.add_seconds("Time", "Build", job.times.build);
+    s.add_seconds("Time", "Render", job.times.render);
+    s.add_seconds("Time", "Write", job.times.write);
+    s.print(stderr);
+}
+
+/// Renders, writes the output (and the resumable partial file if needed), reports.
+int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
+    const RenderArgs& a = job.args;
+    std::vector<float> reference;
+    if (a.reference) {
+        const auto img = read_image(*a.reference, false);
+        if (img->width != job.film.width() || img->height != job.film.height())
+            throw input_error(*a.reference, "", "reference size differs from the render");
+        for (size_t i = 0; i < img->rgba.size(); i += 4) reference.insert(reference.end(), &img->rgba[i], &img->rgba[i + 3]);
+    }
+    if (a.preview)
+        job.preview = Preview::open(job.film.width(), job.film.height(), job.scene.render.exposure, job.scene.render.tonemap);
+    RenderOptions options;
+    options.threads = a.threads;
+    options.progress = !a.quiet && Progress::stderr_is_tty();
+    options.stop = &signal_stop;
+    options.on_tick = [&job](RenderSession& s) { on_tick(job, s); };
+    reset_counters();
+    const RenderResult result = render_image(job.scene, job.film, options);
+    job.times.render = result.seconds;
+
+    const double est_error = estimated_relative_error(job.film);
+    const double true_error = reference.empty() ? -1.0 : relative_error_to(job.film, reference);
+    ImageMetadata meta = render_metadata(job.scene, job.film, result, job.previous_seconds + result.seconds);
+    if (job.scene.render.target_error) meta.emplace_back("estimated_error", std::to_string(est_error));
+    const auto t_write = Clock::now();
+    const fs::path out(a.output);
+    write_render(out, job.scene, job.film, meta);
+    const bool unfinished = result.stop == StopReason::interrupted || result.stop == StopReason::time_limit;
+    std::error_code ec;
+    if (out.extension() != ".exr") {
+        if (unfinished) write_render(partial_path(out), job.scene, job.film, meta);
+        else if (a.checkpoint_s) fs::remove(partial_path(out), ec);
+    }
+    job.times.write = seconds_since(t_write);
+    const std::string line = final_line(job, result, est_error, true_error);
+    if (job.preview) {
+        job.preview->show_final(job.film, line.substr(8));
+        if (a.preview_dump) job.preview->dump(*a.preview_dump);
+    }
+    if (!a.quiet) {
+        std::fprintf(stderr, "%s\n", line.c_str());
+        if (unfinished)
+            std::fprintf(stderr, "sahara: resume with --resume %s\n",
+                         (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());
+    }
+    if (result.nonfinite > 0) log_warning(std::to_string(result.nonfinite) + " non-finite samples were discarded");
+    if (a.stats) print_stats(job, result);
+    return signal_stop.load() ? kExitInterrupted : 0;
+}
+
+}  // namespace
+
+int run_render_command(const std::vector<std::string>& args) {
+    RenderArgs a;
+    try {
+        a = parse_render_args(args);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "sahara render: %s\n\n%s", e.what(), kRenderUsage);
+        return 2;
+    }
+    if (a.help) {
+        std::fputs(kRenderUsage, stdout);
+        return 0;
+    }
+    return run_render(a, [&a] { return a.scene ? parse_scene_file(*a.scene) : default_scene(); });
+}
+
+int run_render(const RenderArgs& a, const std::function<SceneDesc()>& load_scene) {
+    const std::atomic<bool>& signal_stop = install_stop_signals();
+    try {
+        set_log_quiet(a.quiet);
+        check_output_path(a.output);
+        if (a.preview_dump) check_output_path(fs::path(*a.preview_dump).replace_extension(".png"));
+        PhaseTimes times;
+        auto t = Clock::now();
+        SceneDesc desc = load_scene();
+        a.overrides.apply(desc.render);
+        check_integrator(desc.render.integrator);
+        times.load = seconds_since(t);
+        t = Clock::now();
+        const Scene scene = build_scene(desc);
+        times.build = seconds_since(t);
+        Film film(scene.render.width, scene.render.height);
+        RenderJob job(a, scene, film);
+        job.times = times;
+        if (a.resume) job.previous_seconds = resume_film(*a.resume, scene, film);
+        return run_job(job, signal_stop);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "sahara: error: %s\n", e.what());
+        return 2;
+    }
+}
+
+}  // namespace sahara

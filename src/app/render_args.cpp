@@ -1,0 +1,121 @@
+#include "app/render_args.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace sahara {
+
+const char* const kRenderUsage =
+    "usage: sahara render [SCENE.json] [-o OUT.png|.exr|.hdr|.pfm] [options]\n"
+    "\n"
+    "Renders SCENE (or the built-in default scene) to an image.\n"
+    "\n"
+    "  -o, --output FILE    output image (default sahara.png); the extension picks the format\n"
+    "  --spp N              samples per pixel\n"
+    "  --width W, --height H  image size in pixels\n"
+    "  --max-depth D        rays per path, camera ray included\n"
+    "  --seed S             random seed (same seed + settings = same image)\n"
+    "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
+    "  --threads N          worker threads (default: all)\n"
+    "  --time SECONDS       stop after this long, keeping the samples done\n"
+    "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
+    "                       (--spp is then the per-pixel maximum)\n"
+    "  --reference REF.exr  also report the true error against this image\n"
+    "  --checkpoint SECONDS write the partial image this often (non-EXR outputs also get\n"
+    "                       OUT.partial.exr, resumable)\n"
+    "  --resume FILE.exr    continue the render stored in FILE (same scene, seed, settings)\n"
+    "  --preview            show the image in a window while it renders (Esc: stop and save,\n"
+    "                       S: save a snapshot)\n"
+    "  --preview-dump FILE  write the preview window's last frame to FILE (for tests)\n"
+    "  --stats              print statistics at the end\n"
+    "  --quiet              no progress and no summary line\n"
+    "  -h, --help           this text\n";
+
+long long parse_int_value(const std::string& flag, const std::string& value, long long lo, long long hi) {
+    char* end = nullptr;
+    errno = 0;
+    long long v = std::strtoll(value.c_str(), &end, 10);
+    if (value.empty() || *end != '\0' || errno == ERANGE || v < lo || v > hi)
+        throw UsageError(flag + ": expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) +
+                         ", got '" + value + "'");
+    return v;
+}
+
+double parse_real_value(const std::string& flag, const std::string& value, double lo, double hi) {
+    char* end = nullptr;
+    double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
+        throw UsageError(flag + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], got '" + value + "'");
+    return v;
+}
+
+IntegratorType parse_integrator_name(const std::string& flag, const std::string& v) {
+    if (v == "path") return IntegratorType::path;
+    if (v == "whitted") return IntegratorType::whitted;
+    if (v == "albedo") return IntegratorType::albedo;
+    if (v == "normals") return IntegratorType::normals;
+    if (v == "depth") return IntegratorType::depth;
+    if (v == "bvh-cost") return IntegratorType::bvh_cost;
+    throw UsageError(flag + ": expected path|whitted|albedo|normals|depth|bvh-cost, got '" + v + "'");
+}
+
+namespace {
+
+const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
+    if (i + 1 >= args.size()) throw UsageError(args[i] + ": missing value");
+    return args[++i];
+}
+
+}  // namespace
+
+bool parse_override_flag(const std::vector<std::string>& args, size_t& i, RenderOverrides& o) {
+    const std::string& a = args[i];
+    if (a == "--spp") o.spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
+    else if (a == "--width") o.width = int(parse_int_value(a, flag_value(args, i), 1, 32768));
+    else if (a == "--height") o.height = int(parse_int_value(a, flag_value(args, i), 1, 32768));
+    else if (a == "--max-depth") o.max_depth = int(parse_int_value(a, flag_value(args, i), 0, 100000));
+    else if (a == "--seed") o.seed = uint64_t(parse_int_value(a, flag_value(args, i), 0, (1LL << 62)));
+    else if (a == "--integrator") o.integrator = parse_integrator_name(a, flag_value(args, i));
+    else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
+    else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
+    else return false;
+    return true;
+}
+
+void RenderOverrides::apply(RenderSettings& r) const {
+    if (width) r.width = *width;
+    if (height) r.height = *height;
+    if (spp) r.spp = *spp;
+    if (max_depth) r.max_depth = *max_depth;
+    if (seed) r.seed = *seed;
+    if (integrator) r.integrator = *integrator;
+    if (time_limit_s) r.time_limit_s = *time_limit_s;
+    if (target_error) r.target_error = *target_error;
+    if (exposure) r.exposure = *exposure;
+    if (tonemap) r.tonemap = *tonemap;
+}
+
+RenderArgs parse_render_args(const std::vector<std::string>& args) {
+    RenderArgs r;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "-h" || a == "--help") r.help = true;
+        else if (a == "-o" || a == "--output") r.output = flag_value(args, i);
+        else if (a == "--threads") r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
+        else if (a == "--quiet" || a == "-q") r.quiet = true;
+        else if (a == "--stats") r.stats = true;
+        else if (a == "--checkpoint") r.checkpoint_s = parse_real_value(a, flag_value(args, i), 0.1, 1e9);
+        else if (a == "--resume") r.resume = flag_value(args, i);
+        else if (a == "--reference") r.reference = flag_value(args, i);
+        else if (a == "--preview") r.preview = true;
+        else if (a == "--preview-dump") r.preview_dump = flag_value(args, i);
+        else if (parse_override_flag(args, i, r.overrides)) continue;
+        else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
+        else if (r.scene) throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
+        else r.scene = a;
+    }
+    return r;
+}
+
+}  // namespace sahara

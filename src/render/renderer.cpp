@@ -1,0 +1,325 @@
+#include "render/renderer.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <thread>
+
+#include "base/counters.h"
+#include "render/camera.h"
+#include "render/integrator.h"
+#include "render/progress.h"
+#include "render/sampler.h"
+
+namespace sahara {
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// Largest progressive pass: bigger passes amortise nothing more and make the preview stale.
+constexpr int kMaxPassSpp = 64;
+/// Added to mean^2 in the relative error (the relMSE convention).
+constexpr double kRelErrorEpsilon = 0.01;
+
+double luminance_d(const Vec3d& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+/// Takes samples [begin, end) of pixel (x, y), in index order.
+void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x, int y,
+                  uint32_t begin, uint32_t end) {
+    for (uint32_t s = begin; s < end; ++s) {
+        sampler.start(uint32_t(x), uint32_t(y), s);
+        const Vec2 jitter = sampler.next_2d();
+        const Vec2 lens = sampler.next_2d();
+        const float time_u = sampler.next_1d();
+        const Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y, lens, time_u);
+        count_ray(RayKind::camera);
+        film.add_sample(x, y, estimate_radiance(scene, ray, sampler, scene.render.max_depth));
+    }
+    if (end > begin) film.add_count(x, y, end - begin);
+}
+
+std::vector<TileRect> make_tiles(int w, int h) {
+    std::vector<TileRect> tiles;
+    for (int y0 = 0; y0 < h; y0 += kTileSize)
+        for (int x0 = 0; x0 < w; x0 += kTileSize)
+            tiles.push_back({x0, y0, std::min(x0 + kTileSize, w), std::min(y0 + kTileSize, h)});
+    return tiles;
+}
+
+}  // namespace
+
+void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_end, int threads, Progress* progress) {
+    const Camera camera(scene.camera, film.width(), film.height());
+    const std::vector<TileRect> tiles = make_tiles(film.width(), film.height());
+#pragma omp parallel num_threads(threads)
+    {
+#pragma omp for schedule(dynamic, 1) nowait
+        for (size_t t = 0; t < tiles.size(); ++t) {
+            Sampler sampler(scene.render.seed);
+            const TileRect& r = tiles[t];
+            for (int y = r.y0; y < r.y1; ++y)
+                for (int x = r.x0; x < r.x1; ++x)
+                    render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin), uint32_t(sample_end));
+            const uint64_t n = uint64_t(r.x1 - r.x0) * uint64_t(r.y1 - r.y0) * uint64_t(sample_end - sample_begin);
+            if (progress) progress->advance(n, n);
+        }
+        flush_thread_counters();
+    }
+}
+
+RenderSession::RenderSession(const Scene& scene, Film& film, RenderOptions options)
+    : scene_(scene), film_(film), options_(std::move(options)),
+      threads_(options_.threads > 0 ? options_.threads : omp_get_max_threads()),
+      tiles_(make_tiles(film.width(), film.height())), tile_locks_(tiles_.size()), tile_generation_(tiles_.size()) {}
+
+RenderSession::~RenderSession() = default;
+
+void RenderSession::request_stop(StopReason reason) {
+    int expected = int(StopReason::complete);
+    stop_reason_.compare_exchange_strong(expected, int(reason));
+    stop_.store(true);
+}
+
+double RenderSession::elapsed_seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+double RenderSession::eta_seconds() const {
+    const double t = elapsed_seconds();
+    const uint64_t done = samples_.load();
+    double eta = done > 0 ? t * double(samples_planned_ - std::min(done, samples_planned_)) / double(done) : -1.0;
+    if (scene_.render.time_limit_s) {
+        const double left = std::max(0.0, *scene_.render.time_limit_s - t);
+        eta = eta < 0 ? left : std::min(eta, left);
+    }
+    return eta;
+}
+
+uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* targets, uint32_t uniform_target) {
+    const Camera camera(scene_.camera, film_.width(), film_.height());
+    Sampler sampler(scene_.render.seed);
+    const TileRect& r = tiles_[tile];
+    uint64_t taken = 0;
+    std::lock_guard lock(tile_locks_[tile]);
+    for (int y = r.y0; y < r.y1 && !stop_.load(std::memory_order_relaxed); ++y)
+        for (int x = r.x0; x < r.x1 && !stop_.load(std::memory_order_relaxed); ++x) {
+            const uint32_t begin = film_.count(x, y);
+            const uint32_t end = targets ? (*targets)[size_t(y) * size_t(film_.width()) + size_t(x)] : uniform_target;
+            if (end <= begin) continue;
+            render_pixel(scene_, camera, film_, sampler, x, y, begin, end);
+            taken += end - begin;
+        }
+    tile_generation_[tile].fetch_add(1, std::memory_order_release);
+    return taken;
+}
+
+void RenderSession::run_pass(const std::vector<uint32_t>* targets, uint32_t uniform_target) {
+#pragma omp parallel num_threads(threads_)
+    {
+#pragma omp for schedule(dynamic, 1) nowait
+        for (size_t t = 0; t < tiles_.size(); ++t) {
+            if (stop_.load(std::memory_order_relaxed)) continue;
+            const uint64_t n = render_tile(t, targets, uniform_target);
+            samples_.fetch_add(n, std::memory_order_relaxed);
+            progress_->advance(n, n);
+        }
+        flush_thread_counters();
+    }
+}
+
+/// One round of adaptive sampling: pixels whose (3x3-smoothed) estimated error
+/// exceeds the target get more samples, as many as the 1/sqrt(n) law says they
+/// need, at most doubling per round. Returns false when no pixel needs more.
+bool RenderSession::adaptive_round() {
+    const int w = film_.width(), h = film_.height();
+    const double target = *scene_.render.target_error;
+    const uint32_t cap = uint32_t(scene_.render.spp);
+    const std::vector<float> err = relative_error_map(film_);
+    std::vector<uint32_t> targets(err.size());
+    bool any = false;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            // Smoothing spreads demand to neighbours whose own estimate is luckily low.
+            double e2 = 0;
+            int n = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int xx = x + dx, yy = y + dy;
+                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                    const double e = err[size_t(yy) * size_t(w) + size_t(xx)];
+                    e2 += e * e;
+                    ++n;
+                }
+            const double e = std::sqrt(e2 / n);
+            const uint32_t count = film_.count(x, y);
+            uint32_t want = count;
+            if (e > target && count < cap) {
+                const double needed = std::ceil(double(count) * (e / target) * (e / target)) - double(count);
+                const uint32_t more = uint32_t(std::clamp(needed, 4.0, double(std::max(count, 4u))));
+                want = std::min(cap, count + more);
+                any = true;
+            }
+            targets[size_t(y) * size_t(w) + size_t(x)] = want;
+        }
+    if (!any) return false;
+    pass_target_.store(0);
+    run_pass(&targets, 0);
+    return true;
+}
+
+void RenderSession::render_all() {
+    const int spp = scene_.render.spp;
+    const bool adaptive = scene_.render.target_error.has_value();
+    int done = int(min_sample_count(film_));
+    spp_complete_.store(done);
+    const int uniform_end = adaptive ? std::min(spp, std::max(done, kAdaptiveMinSpp)) : spp;
+    // Progressive passes of doubling size: an early pass gives a full preview,
+    // and later passes amortise the per-pass overhead.
+    int pass = std::clamp(done, 1, kMaxPassSpp);
+    while (done < uniform_end && !stop_.load()) {
+        const int end = std::min(uniform_end, done + pass);
+        pass_target_.store(end);
+        run_pass(nullptr, uint32_t(end));
+        if (stop_.load()) break;
+        done = end;
+        spp_complete_.store(done);
+        pass = std::min(pass * 2, kMaxPassSpp);
+    }
+    if (adaptive && !stop_.load()) {
+        while (!stop_.load() && adaptive_round()) spp_complete_.store(int(min_sample_count(film_)));
+        if (!stop_.load()) request_stop(StopReason::converged);
+    }
+}
+
+RenderResult RenderSession::run() {
+    const uint64_t pixels = uint64_t(film_.width()) * uint64_t(film_.height());
+    uint64_t already = 0;
+    for (int y = 0; y < film_.height(); ++y)
+        for (int x = 0; x < film_.width(); ++x) already += film_.count(x, y);
+    const uint64_t full = pixels * uint64_t(scene_.render.spp);
+    samples_planned_ = std::max<uint64_t>(1, full - std::min(full, already));
+    progress_ = std::make_unique<Progress>(samples_planned_, "samples", options_.progress);
+    start_ = Clock::now();
+
+    std::mutex m;
+    std::condition_variable cv;
+    bool finished = false;
+    std::exception_ptr error;
+    std::thread worker([&] {
+        try {
+            render_all();
+        } catch (...) {
+            error = std::current_exception();
+        }
+        std::lock_guard lock(m);
+        finished = true;
+        cv.notify_all();
+    });
+    // The calling thread supervises: stop requests, the time limit, on_tick.
+    const auto tick = std::chrono::duration<double>(options_.tick_seconds);
+    for (;;) {
+        {
+            std::unique_lock lock(m);
+            if (cv.wait_for(lock, tick, [&] { return finished; })) break;
+        }
+        if (options_.stop && options_.stop->load()) request_stop(StopReason::interrupted);
+        if (scene_.render.time_limit_s && elapsed_seconds() >= *scene_.render.time_limit_s)
+            request_stop(StopReason::time_limit);
+        if (options_.on_tick) options_.on_tick(*this);
+    }
+    worker.join();
+    progress_->finish();
+    if (error) std::rethrow_exception(error);
+
+    RenderResult r;
+    r.seconds = elapsed_seconds();
+    r.samples = samples_.load();
+    r.spp_done = int(min_sample_count(film_));
+    uint64_t total = 0;
+    for (int y = 0; y < film_.height(); ++y)
+        for (int x = 0; x < film_.width(); ++x) {
+            r.spp_max = std::max(r.spp_max, int(film_.count(x, y)));
+            total += film_.count(x, y);
+        }
+    r.spp_mean = double(total) / double(std::max<uint64_t>(pixels, 1));
+    r.nonfinite = film_.nonfinite_samples();
+    r.stop = StopReason(stop_reason_.load());
+    spp_complete_.store(r.spp_done);
+    return r;
+}
+
+void RenderSession::visit_changed_tiles(std::vector<uint64_t>& seen, bool wait,
+                                        const std::function<void(const TileRect&)>& fn) {
+    seen.resize(tiles_.size(), ~uint64_t(0));
+    for (size_t t = 0; t < tiles_.size(); ++t) {
+        const uint64_t gen = tile_generation_[t].load(std::memory_order_acquire);
+        if (gen == seen[t]) continue;
+        std::unique_lock lock(tile_locks_[t], std::defer_lock);
+        if (wait) lock.lock();
+        else if (!lock.try_lock()) continue;
+        seen[t] = tile_generation_[t].load(std::memory_order_relaxed);
+        fn(tiles_[t]);
+    }
+}
+
+void RenderSession::snapshot(Film& out) {
+    for (size_t t = 0; t < tiles_.size(); ++t) {
+        std::lock_guard lock(tile_locks_[t]);
+        const TileRect& r = tiles_[t];
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x)
+                out.set_pixel_state(x, y, film_.sum(x, y), film_.sum_sq(x, y), film_.count(x, y));
+    }
+    out.add_nonfinite(film_.nonfinite_samples() - out.nonfinite_samples());
+}
+
+RenderResult render_image(const Scene& scene, Film& film, const RenderOptions& options) {
+    RenderSession session(scene, film, options);
+    return session.run();
+}
+
+std::vector<float> relative_error_map(const Film& film) {
+    std::vector<float> err(size_t(film.width()) * size_t(film.height()), 0.0f);
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) {
+            const uint32_t n = film.count(x, y);
+            if (n < 2) continue;
+            const double mean = luminance_d(film.sum(x, y)) / double(n);
+            const double var_of_mean = film.luminance_variance(x, y) / double(n);
+            err[size_t(y) * size_t(film.width()) + size_t(x)] =
+                float(std::sqrt(var_of_mean / (mean * mean + kRelErrorEpsilon)));
+        }
+    return err;
+}
+
+double estimated_relative_error(const Film& film) {
+    const std::vector<float> err = relative_error_map(film);
+    double sum = 0;
+    for (float e : err) sum += double(e) * double(e);
+    return err.empty() ? 0.0 : std::sqrt(sum / double(err.size()));
+}
+
+double relative_error_to(const Film& film, const std::vector<float>& reference_rgb) {
+    double sum = 0;
+    const size_t n = size_t(film.width()) * size_t(film.height());
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) {
+            const size_t i = size_t(y) * size_t(film.width()) + size_t(x);
+            const float* r = &reference_rgb[i * 3];
+            const double ref = luminance_d(Vec3d(double(r[0]), double(r[1]), double(r[2])));
+            const double d = luminance_d(Vec3d(film.mean(x, y))) - ref;
+            sum += d * d / (ref * ref + kRelErrorEpsilon);
+        }
+    return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+uint32_t min_sample_count(const Film& film) {
+    uint32_t m = ~0u;
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) m = std::min(m, film.count(x, y));
+    return film.width() > 0 && film.height() > 0 ? m : 0;
+}
+
+}  // namespace sahara
