@@ -14,6 +14,7 @@
 #include "io/image_bytes.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "render/texture.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
@@ -559,14 +560,16 @@ TEST_CASE("KHR_texture_transform is rewritten for sahara's v-up uvs") {
     const TextureDesc& t = m.textures[0];
     // For a few glTF uvs: the texel row/column glTF addresses must equal sahara's lookup.
     for (const auto& [u, vg] : std::vector<std::pair<float, float>>{{0.1f, 0.2f}, {0.7f, 0.9f}, {0.5f, 0.0f}}) {
-        // glTF (spec matrix): t = offset + [cos sin; -sin cos] * (scale * uv), row = t.y * height.
+        // glTF: t = offset + R * (scale * uv) with the spec's column-major GLSL
+        // mat3(cos, sin, 0, -sin, cos, 0, ...), i.e. R = [cos -sin; sin cos]; row = t.y * height.
         const float su = scl[0] * u, sv = scl[1] * vg;
-        const float tu = off[0] + std::cos(rot) * su + std::sin(rot) * sv;
-        const float tv = off[1] - std::sin(rot) * su + std::cos(rot) * sv;
-        // sahara: uv = (u, 1 - vg); uv' = offset + R_ccw(rotation) * (scale * uv); row = (1 - uv'.y) * height.
+        const float tu = off[0] + std::cos(rot) * su - std::sin(rot) * sv;
+        const float tv = off[1] + std::sin(rot) * su + std::cos(rot) * sv;
+        // sahara (scene_desc.h, render/texture.cpp): uv = (u, 1 - vg);
+        // uv' = offset + [cos sin; -sin cos] * (scale * uv); row = (1 - uv'.y) * height.
         const float xu = t.uv_scale.x * u, xv = t.uv_scale.y * (1 - vg);
-        const float pu = t.uv_offset.x + std::cos(t.uv_rotation) * xu - std::sin(t.uv_rotation) * xv;
-        const float pv = t.uv_offset.y + std::sin(t.uv_rotation) * xu + std::cos(t.uv_rotation) * xv;
+        const float pu = t.uv_offset.x + std::cos(t.uv_rotation) * xu + std::sin(t.uv_rotation) * xv;
+        const float pv = t.uv_offset.y - std::sin(t.uv_rotation) * xu + std::cos(t.uv_rotation) * xv;
         CHECK(pu == doctest::Approx(tu).epsilon(1e-5));
         CHECK(1 - pv == doctest::Approx(tv).epsilon(1e-5));
     }
@@ -715,4 +718,50 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
         e.node({{"mesh", e.mesh(7)}});
         CHECK(load(e) == f + ": meshes[0].primitives[0].attributes.POSITION: accessor 7 does not exist");
     }
+}
+
+TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/texture.h") {
+    // tiny_png: top row red, (0,128,0); bottom row blue, white. uv 0.25/0.75 hit texel centres.
+    const fs::path dir = scratch("texels");
+    const std::vector<uint8_t> png = tiny_png(dir);
+    const Rgb red(1, 0, 0), blue(0, 0, 1), green(0, srgb_to_linear_value(128 / 255.0f), 0);
+    auto sample = [](const LoadedModel& m, size_t vertex) {
+        const TriangleMesh& mesh = m.meshes.at(0);
+        return sample_texture_rgb(m.textures.at(0), mesh.uvs.at(vertex));
+    };
+    auto near = [](Rgb a, Rgb b) { return length(a - b) < 1e-4f; };
+
+    // glTF: v = 0 is the top row, so uv (0.25, 0.25) is the top-left texel (red).
+    for (const json& ktt : {json(nullptr), json{{"offset", {0.5, 0}}}, json{{"rotation", std::numbers::pi / 2}}}) {
+        CAPTURE(ktt.dump());
+        Doc d;
+        const int uv = d.accessor(std::vector<float>{0.25f, 0.25f, 0.75f, 0.25f, 0.25f, 0.75f}, 5126, "VEC2", 3);
+        d.node({{"mesh", d.mesh(d.positions(kTriangle), -1, 4, {{"TEXCOORD_0", uv}})}});
+        d.j["meshes"][0]["primitives"][0]["material"] = 0;
+        json info = {{"index", 0}};
+        if (!ktt.is_null()) info["extensions"] = {{"KHR_texture_transform", ktt}};
+        d.j["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", info}}}}};
+        d.j["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
+        d.j["textures"] = {{{"source", 0}}};
+        const LoadedModel m = load_gltf(d.write(dir / "t.gltf"));
+        if (ktt.is_null()) {
+            CHECK(near(sample(m, 0), red));
+            CHECK(near(sample(m, 1), green));  // (0.75, 0.25): top right
+            CHECK(near(sample(m, 2), blue));   // (0.25, 0.75): bottom left
+        } else if (ktt.contains("offset")) {
+            CHECK(near(sample(m, 0), green));  // u + 0.5
+        } else {
+            // glTF rotation pi/2: t = [cos -sin; sin cos] p = (-0.25, 0.25) -> wraps to (0.75, 0.25): top right.
+            CHECK(near(sample(m, 0), green));
+        }
+    }
+
+    // OBJ: v = 0 is the bottom row, so vt 0.25 0.25 is the bottom-left texel (blue).
+    write_text(dir / "t.mtl", "newmtl m\nmap_Kd tiny.png\n");
+    write_text(dir / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
+                              "usemtl m\nf 1/1 2/2 3/3\n");
+    const LoadedModel obj = load_obj(dir / "t.obj");
+    CHECK(near(sample(obj, 0), blue));
+    CHECK(near(sample(obj, 1), green));  // (0.75, 0.75): top right
+    CHECK(near(sample(obj, 2), red));    // (0.25, 0.75): top left
 }

@@ -36,15 +36,17 @@ Vec2 pair(const tinygltf::Value& v, const char* key, Vec2 fallback) {
     return {float(a.Get(0).GetNumberAsDouble()), float(a.Get(1).GetNumberAsDouble())};
 }
 
-/// KHR_texture_transform maps glTF uvs t = o + R_g(a) S p with R_g(a) = [cos sin; -sin cos]
-/// (clockwise in a v-up plane). sahara's uvs are F(p) = (u, 1 - v), so the same lookup in
-/// sahara space is F(T(F(uv))) = offset' + R(a) S uv with R the counter-clockwise rotation
-/// and offset' = (o.x + s.y sin a, 1 - o.y - s.y cos a).
+/// KHR_texture_transform maps glTF uvs t = o + R(a) S p, where the spec's GLSL
+/// mat3(cos, sin, 0, -sin, cos, 0, ...) is column-major: R(a) = [cos -sin; sin cos].
+/// sahara's uvs are F(p) = (u, 1 - v), so the same lookup in sahara space is
+/// F(T(F(uv))) = offset' + D R(a) D S uv with D = diag(1, -1), where D R(a) D =
+/// [cos sin; -sin cos] is TextureDesc's rotate(a), and
+/// offset' = F(o + R(a) S (0, 1)) = (o.x - s.y sin a, 1 - o.y - s.y cos a).
 void set_transform(TextureDesc& t, Vec2 offset, float rotation, Vec2 scale) {
     const float s = std::sin(rotation), c = std::cos(rotation);
     t.uv_scale = scale;
     t.uv_rotation = rotation;
-    t.uv_offset = {offset.x + scale.y * s, 1.0f - offset.y - scale.y * c};
+    t.uv_offset = {offset.x - scale.y * s, 1.0f - offset.y - scale.y * c};
 }
 
 Rgb rgb_of(const std::vector<double>& v, Rgb fallback) {

@@ -32,8 +32,8 @@ struct TextureDesc {
     std::string path;  ///< for messages and `sahara info`
     std::shared_ptr<const Image> image;
     WrapMode wrap_u = WrapMode::repeat, wrap_v = WrapMode::repeat;
-    /// uv' = [offset] + rotate(rotation) * (scale * uv), where rotate(a) is the
-    /// counter-clockwise rotation [cos a, -sin a; sin a, cos a] of the v-up uv plane.
+    /// uv' = [offset] + rotate(rotation) * (scale * uv), rotate(a) = [cos a, sin a; -sin a, cos a]
+    /// as render/texture.cpp applies it (glTF's transform, expressed in these v-up uvs).
     Vec2 uv_offset{0, 0}, uv_scale{1, 1};
     float uv_rotation = 0;
     int texcoord = 0;  ///< which UV set (only set 0 is stored on meshes today)
