@@ -765,3 +765,23 @@ TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/t
     CHECK(near(sample(obj, 1), green));  // (0.75, 0.75): top right
     CHECK(near(sample(obj, 2), red));    // (0.25, 0.75): top left
 }
+
+TEST_CASE("glTF: the material's TEXCOORD set, normalized byte normals, u8 and u32 indices") {
+    const fs::path dir = scratch("sets");
+    Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}});
+    d.j["images"] = {{{"uri", "data:image/png;base64," + base64(tiny_png(dir))}}};
+    d.j["textures"] = {{{"source", 0}}};
+    auto& attrs = d.j["meshes"][0]["primitives"][0]["attributes"];
+    attrs["TEXCOORD_1"] = d.accessor(std::vector<uint8_t>{0, 0, 51, 0, 0, 255, 0, 0}, 5121, "VEC2", 3, true);
+    // Signed normalized bytes: -127 maps to -1 exactly, 127 to 1.
+    attrs["NORMAL"] = d.accessor(std::vector<int8_t>{0, 0, 127, 0, 0, 127, 0, -127, 0, 0}, 5120, "VEC3", 3, true);
+    d.j["meshes"][0]["primitives"][0]["indices"] = d.accessor(std::vector<uint32_t>{2, 1, 0}, 5125, "SCALAR", 3);
+    const LoadedModel m = load_gltf(d.write(dir / "sets.gltf"));
+    const TriangleMesh& mesh = m.meshes.at(0);
+    REQUIRE(mesh.uvs.size() == 3);
+    CHECK(mesh.uvs[1].x == doctest::Approx(0.2f));  // 51/255 from TEXCOORD_1 (TEXCOORD_0 has 1 there)
+    CHECK(mesh.uvs[2].y == 0.0f);  // v_gltf = 1 -> 0
+    CHECK(mesh.uvs[1].y == 1.0f);  // v_gltf = 0 -> 1
+    CHECK(mesh.normals[2] == Vec3(0, -1, 0));
+    CHECK(mesh.indices == std::vector<uint32_t>{2, 1, 0});
+}

@@ -1,5 +1,7 @@
 #include <doctest/doctest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -287,4 +289,31 @@ TEST_CASE("ear clipping handles collinear and repeated vertices") {
     for (size_t t = 0; t < tris.size(); t += 3)
         a += 0.5 * double(cross(poly[tris[t + 1]] - poly[tris[t]], poly[tris[t + 2]] - poly[tris[t]]).z);
     CHECK(a == doctest::Approx(4.0));
+}
+
+TEST_CASE("OBJ map_d grey masks become alpha; map_Ke textures emission") {
+    const fs::path dir = scratch("alpha");
+    // A 2x1 single-channel mask: 0 (cut) and 255 (kept).
+    const uint8_t px[2] = {0, 255};
+    auto out = OIIO::ImageOutput::create((dir / "mask.png").string());
+    REQUIRE(out);
+    REQUIRE(out->open((dir / "mask.png").string(), OIIO::ImageSpec(2, 1, 1, OIIO::TypeDesc::UINT8)));
+    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px));
+    out->close();
+    write(dir / "m.mtl", "newmtl leaf\nKd 0.2 0.8 0.2\nd 1\nmap_d mask.png\n"
+                         "newmtl lamp\nKe 2 2 2\nmap_Ke mask.png\n");
+    write(dir / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\nusemtl lamp\nf 3 2 1\n");
+    const LoadedModel m = load_obj(dir / "m.obj");
+    REQUIRE(m.materials.size() == 2);
+    const MaterialDesc& leaf = m.materials[0];
+    REQUIRE(leaf.alpha_texture >= 0);
+    const Image& mask = *m.textures.at(size_t(leaf.alpha_texture)).image;
+    CHECK(mask.rgba[3] == 0.0f);  // alpha taken from the grey value, not decoded as sRGB
+    CHECK(mask.rgba[7] == 1.0f);
+    CHECK(leaf.type == MaterialType::lambertian);
+    const MaterialDesc& lamp = m.materials[1];
+    CHECK(lamp.type == MaterialType::emissive);
+    CHECK(lamp.radiance.kind == ColorSource::Kind::texture);
+    CHECK(lamp.radiance.color == Rgb(2, 2, 2));
+    CHECK(m.textures.size() == 2);  // the same file as alpha (linear) and as colour (sRGB)
 }
