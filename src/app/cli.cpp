@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cmd_converge.h"
 #include "app/cmd_info.h"
 #include "app/commands.h"
 #include "base/error.h"
@@ -20,6 +21,7 @@ const char* const kUsage =
     "commands:\n"
     "  render [SCENE.json]   render a scene (or the built-in default scene) to an image\n"
     "  view MODEL            render a downloaded model (.obj, .gltf, .glb) with no scene file\n"
+    "  converge [SCENE]      measure error against run time at doubling spp; CSV + log-log plot\n"
     "  info [SCENE|MODEL]    what a scene holds: objects, triangles, materials, memory\n"
     "  bvh MESH              build the BVH and print its statistics\n"
     "  bench MESH            trace fixed ray sets and compare with Embree\n"
@@ -49,6 +51,10 @@ int run_cli(int argc, char** argv) {
     if (cmd == "render") return run_render_command(rest);
     if (cmd == "info") return run_info_command(rest);
     if (cmd == "view") return run_view_command(rest);
+    if (cmd == "converge") return run_converge_command(rest);
+    if (cmd == "bvh") return run_bvh_command(argc - 1, argv + 1);
+    if (cmd == "bench") return run_bench_command(argc - 1, argv + 1);
+    if (cmd == "trace") return run_trace_command(argc - 1, argv + 1);
     std::fprintf(stderr, "sahara: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
 }

@@ -1,5 +1,7 @@
 #include "app/render_args.h"
 
+#include "render/tonemap.h"
+
 #include <cmath>
 #include <cstdlib>
 
@@ -16,6 +18,9 @@ const char* const kRenderUsage =
     "  --max-depth D        rays per path, camera ray included\n"
     "  --seed S             random seed (same seed + settings = same image)\n"
     "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
+    "  --exposure STOPS     exposure for 8-bit outputs (EXR stays linear)\n"
+    "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
+    "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
     "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
@@ -60,6 +65,12 @@ IntegratorType parse_integrator_name(const std::string& flag, const std::string&
     throw UsageError(flag + ": expected path|whitted|albedo|normals|depth|bvh-cost, got '" + v + "'");
 }
 
+SamplerType parse_sampler_name(const std::string& flag, const std::string& v) {
+    if (v == "sobol") return SamplerType::sobol;
+    if (v == "independent") return SamplerType::independent;
+    throw UsageError(flag + ": expected sobol|independent, got '" + v + "'");
+}
+
 namespace {
 
 const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
@@ -79,6 +90,14 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
     else if (a == "--integrator") o.integrator = parse_integrator_name(a, flag_value(args, i));
     else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
     else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
+    else if (a == "--sampler") o.sampler = parse_sampler_name(a, flag_value(args, i));
+    else if (a == "--exposure") o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
+    else if (a == "--tonemap") {
+        const std::string& v = flag_value(args, i);
+        const std::optional<Tonemap> t = tonemap_from_name(v);
+        if (!t) throw UsageError(a + ": expected clamp|reinhard|aces|filmic, got '" + v + "'");
+        o.tonemap = *t;
+    }
     else return false;
     return true;
 }
@@ -94,6 +113,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (target_error) r.target_error = *target_error;
     if (exposure) r.exposure = *exposure;
     if (tonemap) r.tonemap = *tonemap;
+    if (sampler) r.sampler = *sampler;
 }
 
 RenderArgs parse_render_args(const std::vector<std::string>& args) {

@@ -23,6 +23,7 @@ struct RenderOverrides {
     std::optional<double> time_limit_s, target_error;
     std::optional<float> exposure;
     std::optional<Tonemap> tonemap;
+    std::optional<SamplerType> sampler;
 
     void apply(RenderSettings& r) const;
 };
@@ -37,6 +38,7 @@ struct RenderArgs {
     std::optional<double> checkpoint_s;      ///< --checkpoint: write the partial image this often
     std::optional<std::string> resume;       ///< --resume: continue the render stored in this EXR
     std::optional<std::string> reference;    ///< --reference: report the true error against this image
+    bool auto_exposure = false;              ///< pick the exposure from the image (sahara view)
     bool preview = false;                    ///< --preview: live window
     std::optional<std::string> preview_dump; ///< --preview-dump: write the window's last frame here
     RenderOverrides overrides;
@@ -53,6 +55,7 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
 long long parse_int_value(const std::string& flag, const std::string& value, long long lo, long long hi);
 double parse_real_value(const std::string& flag, const std::string& value, double lo, double hi);
 IntegratorType parse_integrator_name(const std::string& flag, const std::string& value);
+SamplerType parse_sampler_name(const std::string& flag, const std::string& value);
 
 extern const char* const kRenderUsage;
 

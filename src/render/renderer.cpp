@@ -59,7 +59,7 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
     {
 #pragma omp for schedule(dynamic, 1) nowait
         for (size_t t = 0; t < tiles.size(); ++t) {
-            Sampler sampler(scene.render.seed);
+            Sampler sampler(scene.render.seed, scene.render.sampler);
             const TileRect& r = tiles[t];
             for (int y = r.y0; y < r.y1; ++y)
                 for (int x = r.x0; x < r.x1; ++x)
@@ -99,7 +99,7 @@ double RenderSession::eta_seconds() const {
 
 uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* targets, uint32_t uniform_target) {
     const Camera camera(scene_.camera, film_.width(), film_.height());
-    Sampler sampler(scene_.render.seed);
+    Sampler sampler(scene_.render.seed, scene_.render.sampler);
     const TileRect& r = tiles_[tile];
     uint64_t taken = 0;
     std::lock_guard lock(tile_locks_[tile]);

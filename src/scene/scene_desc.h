@@ -164,7 +164,10 @@ struct LightDesc {
 };
 
 enum class IntegratorType : uint8_t { path, whitted, albedo, normals, depth, bvh_cost };
-enum class Tonemap : uint8_t { clamp, reinhard, aces };
+enum class Tonemap : uint8_t { clamp, reinhard, aces, filmic };
+/// Where the per-sample random numbers come from: Owen-scrambled Sobol
+/// (low discrepancy, the default) or independent uniform random numbers.
+enum class SamplerType : uint8_t { sobol, independent };
 
 struct RenderSettings {
     int width = 640, height = 480;
@@ -176,6 +179,7 @@ struct RenderSettings {
     std::optional<double> target_error;
     float exposure = 0.0f;  ///< stops
     Tonemap tonemap = Tonemap::clamp;
+    SamplerType sampler = SamplerType::sobol;  ///< command line only (--sampler)
 };
 
 struct SceneDesc {
