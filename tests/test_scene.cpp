@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include "math/rng.h"
+#include "render/camera.h"
 #include "scene/scene.h"
 #include "scene/scene_parser.h"
 
@@ -40,4 +41,22 @@ TEST_CASE("scene: quadrics sit in the BVH beside spheres and give the quadric's 
         }
     }
     CHECK(quadric_hits > 2000);
+}
+
+#include "render/bvh_cost.h"
+
+TEST_CASE("bvh-cost: the heat map shows more work where there is geometry, and a legend") {
+    SceneDesc d = default_scene();
+    const Scene scene = build_scene(d);
+    const BvhCostImage img = render_bvh_cost(scene, 64, 48, 1);
+    CHECK(img.width == 64);
+    CHECK(img.height > 48);  // legend strip below the picture
+    CHECK(img.max_cost > 0);
+    // The sphere in the centre costs more than the empty sky at the top.
+    const Camera cam(scene.camera, 64, 48);
+    const double centre = bvh_ray_cost(scene, cam.generate_ray(32.5f, 24.5f, {0.5f, 0.5f}, 0));
+    const double sky = bvh_ray_cost(scene, cam.generate_ray(32.5f, 0.5f, {0.5f, 0.5f}, 0));
+    CHECK(centre > sky);
+    CHECK(heat_color(0.0f).z > heat_color(0.0f).x);  // cold is blue
+    CHECK(heat_color(1.0f).x > heat_color(1.0f).z);  // hot is red
 }
