@@ -46,7 +46,12 @@ TEST_CASE("scene: quadrics sit in the BVH beside spheres and give the quadric's 
 #include "render/bvh_cost.h"
 
 TEST_CASE("bvh-cost: the heat map shows more work where there is geometry, and a legend") {
+    // A 10 x 10 wall of small spheres filling the lower half of the view.
     SceneDesc d = default_scene();
+    d.spheres.clear();
+    for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j)
+            d.spheres.push_back({{float(i) - 4.5f, 10, float(j) - 9.0f}, 0.45f, 1, {0, 0, 0}});
     const Scene scene = build_scene(d);
     const BvhCostImage img = render_bvh_cost(scene, 64, 48, 1);
     CHECK(img.width == 64);
@@ -54,7 +59,7 @@ TEST_CASE("bvh-cost: the heat map shows more work where there is geometry, and a
     CHECK(img.max_cost > 0);
     // The sphere in the centre costs more than the empty sky at the top.
     const Camera cam(scene.camera, 64, 48);
-    const double centre = bvh_ray_cost(scene, cam.generate_ray(32.5f, 24.5f, {0.5f, 0.5f}, 0));
+    const double centre = bvh_ray_cost(scene, cam.generate_ray(32.5f, 40.5f, {0.5f, 0.5f}, 0));
     const double sky = bvh_ray_cost(scene, cam.generate_ray(32.5f, 0.5f, {0.5f, 0.5f}, 0));
     CHECK(centre > sky);
     CHECK(heat_color(0.0f).z > heat_color(0.0f).x);  // cold is blue
