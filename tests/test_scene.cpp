@@ -65,3 +65,28 @@ TEST_CASE("bvh-cost: the heat map shows more work where there is geometry, and a
     CHECK(heat_color(0.0f).z > heat_color(0.0f).x);  // cold is blue
     CHECK(heat_color(1.0f).x > heat_color(1.0f).z);  // hot is red
 }
+
+#include <filesystem>
+
+#include "render/renderer.h"
+
+TEST_CASE("every shipped scene parses and renders at 1 spp without NaN or Inf samples") {
+    int scenes = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(SAHARA_SOURCE_DIR) + "/scenes")) {
+        if (entry.path().extension() != ".json") continue;
+        CAPTURE(entry.path().string());
+        SceneDesc d = parse_scene_file(entry.path());
+        d.render.width = 64;
+        d.render.height = 48;
+        d.render.spp = 1;
+        const Scene scene = build_scene(d);
+        Film film(64, 48);
+        RenderOptions options;
+        options.threads = 2;
+        const RenderResult r = render_image(scene, film, options);
+        CHECK(r.spp_done == 1);
+        CHECK(film.nonfinite_samples() == 0);
+        ++scenes;
+    }
+    CHECK(scenes >= 6);
+}
