@@ -1,0 +1,585 @@
+#include "app/mpi_render.h"
+
+#include <stdexcept>
+
+#if SAHARA_HAVE_MPI
+#include <mpi.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <list>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "app/mpi_work.h"
+#include "base/log.h"
+#include "render/progress.h"
+#endif
+
+namespace sahara {
+
+#if SAHARA_HAVE_MPI
+
+using namespace mpi_work;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// Largest progressive pass, as in RenderSession (pass sizes do not change the
+/// image: each pixel takes its samples in index order whatever the split).
+constexpr int kMaxPassSpp = 64;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+int resolve_threads(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+/// Nonblocking point-to-point messages. Sends are MPI_Isend with the buffer
+/// kept alive until complete: two ranks sending each other large (rendezvous)
+/// messages with blocking MPI_Send would deadlock.
+class Mailbox {
+public:
+    void send(int dest, int tag, std::vector<char> bytes) {
+        auto& s = sends_.emplace_back();
+        s.bytes = std::move(bytes);
+        MPI_Isend(s.bytes.data(), int(s.bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &s.request);
+        bytes_sent_ += s.bytes.size();
+    }
+    /// Completes finished sends; true when none is pending.
+    bool progress() {
+        for (auto it = sends_.begin(); it != sends_.end();) {
+            int done = 0;
+            MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
+            it = done ? sends_.erase(it) : std::next(it);
+        }
+        return sends_.empty();
+    }
+    /// Receives the next message from anyone, if there is one.
+    bool receive(int& source, int& tag, std::vector<char>& bytes) {
+        int flag = 0;
+        MPI_Status status;
+        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status);
+        if (!flag) return false;
+        int count = 0;
+        MPI_Get_count(&status, MPI_BYTE, &count);
+        bytes.resize(size_t(count));
+        MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        source = status.MPI_SOURCE;
+        tag = status.MPI_TAG;
+        return true;
+    }
+    uint64_t bytes_sent() const { return bytes_sent_; }
+
+private:
+    struct Pending {
+        MPI_Request request = MPI_REQUEST_NULL;
+        std::vector<char> bytes;
+    };
+    std::list<Pending> sends_;  // a list: buffers must not move while in flight
+    uint64_t bytes_sent_ = 0;
+};
+
+/// Polling with a growing sleep: MPI's blocking calls spin and would take a
+/// core from the render threads; a few hundred microseconds of latency is
+/// hidden by the unit each rank holds in reserve.
+class Backoff {
+public:
+    void idle() {
+        std::this_thread::sleep_for(std::chrono::microseconds(us_));
+        us_ = std::min(us_ * 2, 2000);
+    }
+    void busy() { us_ = 50; }
+
+private:
+    int us_ = 50;
+};
+
+template <class T> std::vector<char> bytes_of(const T& v) {
+    Writer w;
+    w.put(v);
+    return std::move(w.bytes);
+}
+
+}  // namespace
+
+// --- rank 0 -----------------------------------------------------------------
+
+/// A unit waiting to be handed out: a tile and its target (uniform, or the
+/// current adaptive round's per-pixel targets).
+struct Unit {
+    uint32_t tile = 0;
+    uint32_t uniform_target = 0;
+    bool adaptive = false;
+};
+
+struct DistributedRender::Impl {
+    Impl(const MpiSession& m, const Scene& s, Film& f, DistributedOptions o)
+        : mpi(m), scene(s), film(f), options(std::move(o)), threads(resolve_threads(options.threads)),
+          camera(s.camera, f.width(), f.height()) {
+        for (int y0 = 0; y0 < f.height(); y0 += kTileSize)
+            for (int x0 = 0; x0 < f.width(); x0 += kTileSize)
+                tiles.push_back({x0, y0, std::min(x0 + kTileSize, f.width()), std::min(y0 + kTileSize, f.height())});
+        busy.assign(tiles.size(), 0);
+        peers.resize(size_t(mpi.size()));
+    }
+
+    struct Peer {
+        uint32_t slots = 0;                 ///< units it may hold (its threads + 1)
+        std::map<uint32_t, Unit> holding;   ///< tile -> unit sent and not returned
+        bool stop_sent = false, done = false, left = false;
+        WorkerReport report;
+    };
+
+    // -- scheduler; everything below `m` is guarded by it --
+    uint32_t target_of(const Unit& u, int x, int y) const {
+        return u.adaptive ? round_targets[size_t(y) * size_t(film.width()) + size_t(x)] : u.uniform_target;
+    }
+    bool needs_work(const Unit& u) const {
+        const TileRect& r = tiles[u.tile];
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x)
+                if (film.count(x, y) < target_of(u, x, y)) return true;
+        return false;
+    }
+    /// The first pending unit whose tile is free (units of a tile go out one at
+    /// a time, in order); units with nothing left to do are dropped.
+    std::optional<Unit> take_locked() {
+        if (closed) return std::nullopt;
+        for (auto it = pending.begin(); it != pending.end();) {
+            if (busy[it->tile]) {
+                ++it;
+                continue;
+            }
+            const Unit u = *it;
+            it = pending.erase(it);
+            if (!needs_work(u)) continue;
+            busy[u.tile] = 1;
+            ++in_flight;
+            return u;
+        }
+        return std::nullopt;
+    }
+    TileWork make_work_locked(const Unit& u) const {
+        TileWork w;
+        w.tile = u.tile;
+        w.rect = tiles[u.tile];
+        for (int y = w.rect.y0; y < w.rect.y1; ++y)
+            for (int x = w.rect.x0; x < w.rect.x1; ++x) {
+                w.targets.push_back(target_of(u, x, y));
+                w.state.push_back({film.sum(x, y), film.sum_sq(x, y), film.count(x, y), 0});
+            }
+        return w;
+    }
+    /// Stores a returned unit; a unit cut short (a stopped rank) goes back in the queue.
+    void apply_locked(const TileWork& w, const Unit& u) {
+        const TileRect& r = tiles[u.tile];
+        const int tw = r.x1 - r.x0;
+        for (int y = r.y0; y < r.y1; ++y)
+            for (int x = r.x0; x < r.x1; ++x) {
+                const PixelState& p = w.state[size_t(y - r.y0) * size_t(tw) + size_t(x - r.x0)];
+                film.set_pixel_state(x, y, p.sum, p.sum_sq, p.count);
+            }
+        film.add_nonfinite(w.nonfinite);
+        samples.fetch_add(w.samples, std::memory_order_relaxed);
+        progress->advance(w.samples, w.samples);
+        release_locked(u);
+    }
+    void release_locked(const Unit& u) {
+        busy[u.tile] = 0;
+        --in_flight;
+        if (!closed && needs_work(u)) pending.push_front(u);
+    }
+    void close() {
+        {
+            std::lock_guard lock(m);
+            closed = true;
+        }
+        cv.notify_all();
+    }
+
+    void enqueue_uniform_passes();
+    bool enqueue_adaptive_round();
+    void local_threads();
+    void top_up(int rank);
+    void handle(int source, int tag, const std::vector<char>& bytes);
+    void begin_stop(StopReason reason);
+    bool coordinate_step(Backoff& backoff);
+    RenderResult result() const;
+
+    const MpiSession& mpi;
+    const Scene& scene;
+    Film& film;
+    DistributedOptions options;
+    int threads;
+    Camera camera;
+    std::vector<TileRect> tiles;
+
+    std::mutex m;
+    std::condition_variable cv;
+    std::list<Unit> pending;
+    std::vector<char> busy;
+    size_t in_flight = 0;
+    bool closed = false;
+    std::vector<uint32_t> round_targets;  ///< the current adaptive round's per-pixel targets
+
+    std::atomic<bool> local_stop{false};
+    std::atomic<uint64_t> samples{0};
+    std::unique_ptr<Progress> progress;
+    Clock::time_point start, stop_time;
+    bool stopping = false, adaptive_phase = false;
+    StopReason reason = StopReason::complete;
+    std::vector<Peer> peers;
+    Mailbox mail;
+    int lost = 0;
+};
+
+void DistributedRender::Impl::enqueue_uniform_passes() {
+    const int spp = scene.render.spp;
+    int done = int(min_sample_count(film));
+    const int uniform_end = scene.render.target_error ? std::min(spp, std::max(done, kAdaptiveMinSpp)) : spp;
+    int pass = std::clamp(done, 1, kMaxPassSpp);
+    std::lock_guard lock(m);
+    while (done < uniform_end) {
+        const int end = std::min(uniform_end, done + pass);
+        for (uint32_t t = 0; t < tiles.size(); ++t) pending.push_back({t, uint32_t(end), false});
+        done = end;
+        pass = std::min(pass * 2, kMaxPassSpp);
+    }
+}
+
+/// At a barrier (no unit pending or in flight): the next adaptive round, as
+/// RenderSession::adaptive_round computes it from the whole film.
+bool DistributedRender::Impl::enqueue_adaptive_round() {
+    std::lock_guard lock(m);
+    if (!adaptive_sample_targets(film, *scene.render.target_error, uint32_t(scene.render.spp), round_targets))
+        return false;
+    for (uint32_t t = 0; t < tiles.size(); ++t) pending.push_back({t, 0, true});
+    return true;
+}
+
+/// Rank 0's own render threads take units from the same queue as the other ranks.
+void DistributedRender::Impl::local_threads() {
+#pragma omp parallel num_threads(threads)
+    {
+        for (;;) {
+            std::unique_lock lock(m);
+            std::optional<Unit> u;
+            while (!closed && !(u = take_locked())) cv.wait(lock);
+            if (!u) break;
+            TileWork w = make_work_locked(*u);
+            lock.unlock();
+            render_work(scene, camera, w, local_stop);
+            lock.lock();
+            apply_locked(w, *u);
+            lock.unlock();
+            cv.notify_all();
+        }
+        flush_thread_counters();
+    }
+}
+
+void DistributedRender::Impl::top_up(int rank) {
+    Peer& p = peers[size_t(rank)];
+    while (!p.left && p.holding.size() < p.slots) {
+        std::unique_lock lock(m);
+        const std::optional<Unit> u = take_locked();
+        if (!u) return;
+        TileWork w = make_work_locked(*u);
+        lock.unlock();
+        p.holding[u->tile] = *u;
+        mail.send(rank, kTagWork, encode_work(w));
+    }
+}
+
+void DistributedRender::Impl::handle(int source, int tag, const std::vector<char>& bytes) {
+    Peer& p = peers[size_t(source)];
+    if (tag == kTagHello) {
+        p.slots = Reader(bytes).get<uint32_t>() + 1;
+    } else if (tag == kTagResult) {
+        const uint32_t tile = peek_tile(bytes);
+        const auto it = p.holding.find(tile);
+        if (it == p.holding.end()) throw std::runtime_error("sahara: rank 0 got a tile it never sent");
+        TileWork w;
+        w.rect = tiles.at(tile);
+        decode_result(bytes, w);
+        const Unit u = it->second;
+        p.holding.erase(it);
+        {
+            std::lock_guard lock(m);
+            apply_locked(w, u);
+        }
+        cv.notify_all();
+    } else if (tag == kTagLeave) {
+        if (!stopping && !(options.stop && options.stop->load()))
+            log_warning("rank " + std::to_string(source) + " was stopped; the other ranks take over its tiles");
+        p.left = true;
+        if (!p.stop_sent) mail.send(source, kTagStop, {});
+        p.stop_sent = true;
+    } else if (tag == kTagDone) {
+        p.report = Reader(bytes).get<WorkerReport>();
+        p.done = true;
+        {
+            std::lock_guard lock(m);
+            for (const auto& [tile, u] : p.holding) release_locked(u);
+        }
+        p.holding.clear();
+        cv.notify_all();
+    }
+}
+
+void DistributedRender::Impl::begin_stop(StopReason why) {
+    if (stopping) return;
+    stopping = true;
+    reason = why;
+    stop_time = Clock::now();
+    if (why != StopReason::complete && why != StopReason::converged) local_stop.store(true);
+    close();
+    for (int r = 1; r < mpi.size(); ++r)
+        if (!peers[size_t(r)].stop_sent) {
+            mail.send(r, kTagStop, {});
+            peers[size_t(r)].stop_sent = true;
+        }
+}
+
+/// One round of the coordinating loop; false when the render is over.
+bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
+    if (!stopping) {
+        if (options.stop && options.stop->load()) begin_stop(StopReason::interrupted);
+        else if (scene.render.time_limit_s && seconds_between(start, Clock::now()) >= *scene.render.time_limit_s)
+            begin_stop(StopReason::time_limit);
+    }
+    int source = 0, tag = 0;
+    std::vector<char> bytes;
+    bool progressed = false;
+    while (mail.receive(source, tag, bytes)) {
+        handle(source, tag, bytes);
+        progressed = true;
+    }
+    const bool sends_done = mail.progress();
+    if (!stopping) {
+        bool barrier;
+        {
+            std::lock_guard lock(m);
+            barrier = pending.empty() && in_flight == 0;
+        }
+        if (barrier) {
+            adaptive_phase = adaptive_phase || scene.render.target_error.has_value();
+            if (!adaptive_phase || !enqueue_adaptive_round())
+                begin_stop(adaptive_phase ? StopReason::converged : StopReason::complete);
+            cv.notify_all();
+        }
+        for (int r = 1; r < mpi.size(); ++r) top_up(r);
+    } else {
+        bool all_done = true;
+        for (int r = 1; r < mpi.size(); ++r) all_done = all_done && peers[size_t(r)].done;
+        if (all_done && sends_done) return false;
+        if (seconds_between(stop_time, Clock::now()) > options.stop_grace_seconds) {
+            for (int r = 1; r < mpi.size(); ++r)
+                if (!peers[size_t(r)].done) {
+                    log_warning("rank " + std::to_string(r) + " did not answer; its " +
+                                std::to_string(peers[size_t(r)].holding.size()) +
+                                " tiles in flight keep their last state");
+                    ++lost;
+                }
+            return false;
+        }
+    }
+    if (progressed) backoff.busy();
+    else backoff.idle();
+    return true;
+}
+
+RenderResult DistributedRender::Impl::result() const {
+    RenderResult r;
+    r.seconds = seconds_between(start, Clock::now());
+    r.samples = samples.load();
+    r.spp_done = int(min_sample_count(film));
+    uint64_t total = 0;
+    for (int y = 0; y < film.height(); ++y)
+        for (int x = 0; x < film.width(); ++x) {
+            r.spp_max = std::max(r.spp_max, int(film.count(x, y)));
+            total += film.count(x, y);
+        }
+    r.spp_mean = double(total) / double(std::max<uint64_t>(uint64_t(film.width()) * uint64_t(film.height()), 1));
+    r.nonfinite = film.nonfinite_samples();
+    r.stop = reason;
+    return r;
+}
+
+DistributedRender::DistributedRender(const MpiSession& mpi, const Scene& scene, Film& film, DistributedOptions options)
+    : impl_(std::make_unique<Impl>(mpi, scene, film, std::move(options))) {}
+
+DistributedRender::~DistributedRender() = default;
+
+RenderResult DistributedRender::run() {
+    Impl& s = *impl_;
+    uint64_t already = 0;
+    for (int y = 0; y < s.film.height(); ++y)
+        for (int x = 0; x < s.film.width(); ++x) already += s.film.count(x, y);
+    const uint64_t full = uint64_t(s.film.width()) * uint64_t(s.film.height()) * uint64_t(s.scene.render.spp);
+    s.progress = std::make_unique<Progress>(std::max<uint64_t>(1, full - std::min(full, already)), "samples",
+                                            s.options.progress);
+    s.start = Clock::now();
+    s.enqueue_uniform_passes();
+    std::thread workers([&s] { s.local_threads(); });
+    Backoff backoff;
+    auto next_tick = Clock::now();
+    try {
+        while (s.coordinate_step(backoff)) {
+            if (s.options.on_tick && Clock::now() >= next_tick) {
+                s.options.on_tick(*this);
+                next_tick = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(s.options.tick_seconds));
+            }
+        }
+    } catch (...) {
+        s.local_stop.store(true);
+        s.close();
+        workers.join();
+        throw;
+    }
+    workers.join();
+    s.progress->finish();
+    for (int r = 1; r < s.mpi.size(); ++r) {
+        t_counters += s.peers[size_t(r)].report.counters;
+        flush_thread_counters();
+    }
+    return s.result();
+}
+
+void DistributedRender::snapshot(Film& out) {
+    std::lock_guard lock(impl_->m);
+    const Film& f = impl_->film;
+    for (int y = 0; y < f.height(); ++y)
+        for (int x = 0; x < f.width(); ++x) out.set_pixel_state(x, y, f.sum(x, y), f.sum_sq(x, y), f.count(x, y));
+    out.add_nonfinite(f.nonfinite_samples() - out.nonfinite_samples());
+}
+
+double DistributedRender::elapsed_seconds() const { return seconds_between(impl_->start, Clock::now()); }
+
+int DistributedRender::lost_ranks() const { return impl_->lost; }
+
+// --- ranks > 0 --------------------------------------------------------------
+
+namespace {
+
+/// A worker rank: the main thread talks MPI, the render threads take units
+/// from `todo` and put results in `done`.
+struct Worker {
+    std::mutex m;
+    std::condition_variable cv;
+    std::deque<TileWork> todo, done;
+    bool quit = false;
+    std::atomic<bool> stop{false};
+    WorkerReport report;
+
+    void render_threads(const Scene& scene, int threads) {
+        const Camera camera(scene.camera, scene.render.width, scene.render.height);
+#pragma omp parallel num_threads(threads)
+        {
+            double waited = 0, rendered = 0;
+            uint64_t units = 0;
+            for (;;) {
+                std::unique_lock lock(m);
+                const auto t0 = Clock::now();
+                cv.wait(lock, [&] { return quit || !todo.empty(); });
+                if (!quit) waited += seconds_between(t0, Clock::now());
+                if (todo.empty()) break;
+                TileWork w = std::move(todo.front());
+                todo.pop_front();
+                lock.unlock();
+                const auto t1 = Clock::now();
+                render_work(scene, camera, w, stop);
+                w.seconds = seconds_between(t1, Clock::now());
+                rendered += w.seconds;
+                ++units;
+                lock.lock();
+                done.push_back(std::move(w));
+            }
+            flush_thread_counters();
+            std::lock_guard lock(m);
+            report.wait_seconds += waited;
+            report.render_seconds += rendered;
+            report.units += units;
+        }
+    }
+};
+
+}  // namespace
+
+void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int threads_arg,
+                              const std::atomic<bool>& signal_stop) {
+    (void)mpi;
+    const int threads = resolve_threads(threads_arg);
+    Worker w;
+    w.report.threads = uint32_t(threads);
+    Mailbox mail;
+    mail.send(0, kTagHello, bytes_of(uint32_t(threads)));
+    std::thread renderers([&] { w.render_threads(scene, threads); });
+    Backoff backoff;
+    bool told_leaving = false, stopped = false;
+    for (;;) {
+        int source = 0, tag = 0;
+        std::vector<char> bytes;
+        bool progressed = false;
+        while (mail.receive(source, tag, bytes)) {
+            progressed = true;
+            std::lock_guard lock(w.m);
+            if (tag == kTagWork) w.todo.push_back(decode_work(bytes));
+            else if (tag == kTagStop) stopped = w.quit = true;
+            w.cv.notify_all();
+        }
+        if (stopped) w.stop.store(true);  // rank 0 stopped the job (or finished it)
+        if (signal_stop.load() && !told_leaving) {
+            // Cut the tiles in hand short and let rank 0 give the rest to others.
+            w.stop.store(true);
+            mail.send(0, kTagLeave, {});
+            told_leaving = true;
+        }
+        std::deque<TileWork> finished;
+        bool idle;
+        {
+            std::lock_guard lock(w.m);
+            finished.swap(w.done);
+            idle = w.quit && w.todo.empty();
+        }
+        for (const TileWork& t : finished) mail.send(0, kTagResult, encode_result(t));
+        if (!finished.empty()) progressed = true;
+        if (idle && renderers.joinable()) {
+            renderers.join();  // the threads hold no unit once quit and todo is empty
+            for (const TileWork& t : w.done) mail.send(0, kTagResult, encode_result(t));
+            w.done.clear();
+            w.report.counters = counter_totals();
+            mail.send(0, kTagDone, bytes_of(w.report));
+        }
+        if (!renderers.joinable() && mail.progress()) break;
+        mail.progress();
+        if (progressed) backoff.busy();
+        else backoff.idle();
+    }
+}
+
+#else  // !SAHARA_HAVE_MPI
+
+struct DistributedRender::Impl {};
+
+DistributedRender::DistributedRender(const MpiSession&, const Scene&, Film&, DistributedOptions) {
+    throw std::logic_error("sahara was built without MPI");
+}
+DistributedRender::~DistributedRender() = default;
+RenderResult DistributedRender::run() { return {}; }
+void DistributedRender::snapshot(Film&) {}
+double DistributedRender::elapsed_seconds() const { return 0; }
+int DistributedRender::lost_ranks() const { return 0; }
+
+void serve_distributed_render(const MpiSession&, const Scene&, int, const std::atomic<bool>&) {
+    throw std::logic_error("sahara was built without MPI");
+}
+
+#endif
+
+}  // namespace sahara
