@@ -377,7 +377,9 @@ bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
         bool all_done = true;
         for (int r = 1; r < mpi.size(); ++r) all_done = all_done && peers[size_t(r)].done;
         if (all_done && sends_done) return false;
-        if (seconds_between(stop_time, Clock::now()) > options.stop_grace_seconds) {
+        const double grace =
+            reason == StopReason::interrupted ? options.signal_grace_seconds : options.stop_grace_seconds;
+        if (seconds_between(stop_time, Clock::now()) > grace) {
             for (int r = 1; r < mpi.size(); ++r)
                 if (!peers[size_t(r)].done) {
                     log_warning("rank " + std::to_string(r) + " did not answer; its " +

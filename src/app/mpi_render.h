@@ -28,8 +28,12 @@ struct DistributedOptions {
     /// Called on rank 0's coordinating thread about every tick_seconds (checkpoints).
     std::function<void(DistributedRender&)> on_tick = nullptr;
     double tick_seconds = 0.1;
-    /// After a stop, how long rank 0 waits for the tiles in flight on other ranks.
+    /// After the end or a time limit, how long rank 0 waits for the other ranks' tiles in flight.
     double stop_grace_seconds = 10;
+    /// The same after a signal: under mpirun it usually means the job is being
+    /// killed (Ctrl-C, or a rank died), and mpirun sends SIGKILL one second
+    /// after SIGTERM (odls_base_sigkill_timeout), so rank 0 writes soon.
+    double signal_grace_seconds = 0.3;
 };
 
 /// Rank 0's side of a distributed render. The other ranks run serve_distributed_render.

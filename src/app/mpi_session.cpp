@@ -5,6 +5,8 @@
 #include <exception>
 #include <string>
 
+#include <unistd.h>
+
 #include "base/log.h"
 
 #if SAHARA_HAVE_MPI
@@ -40,6 +42,14 @@ MpiSession::MpiSession() {
     initialised_ = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    if (const char* dir = std::getenv("SAHARA_MPI_PID_DIR")) {
+        // Debugging and tests: which process is which rank (to stop one on purpose).
+        const std::string file = std::string(dir) + "/rank-" + std::to_string(rank_) + ".pid";
+        if (FILE* f = std::fopen(file.c_str(), "w")) {
+            std::fprintf(f, "%d\n", int(::getpid()));
+            std::fclose(f);
+        }
+    }
     const char* tasks = std::getenv("SLURM_NTASKS");
     if (size_ == 1 && tasks && std::atoi(tasks) > 1)
         log_warning("Slurm started " + std::string(tasks) +
