@@ -117,6 +117,7 @@ RenderResult render_distributed(RenderJob& job, const RenderOptions& local) {
     DistributedRender render(*job.mpi, job.scene, job.film, options);
     const RenderResult r = render.run();
     if (render.lost_ranks() > 0) job.mpi->abort_at_exit(kExitInterrupted);
+    if (job.args.stats) std::fprintf(stderr, "Ranks (%d):\n%s", job.mpi->size(), render.rank_report().c_str());
     return r;
 }
 

@@ -1,5 +1,6 @@
 #include "app/mpi_render.h"
 
+#include <cstdio>
 #include <stdexcept>
 
 #if SAHARA_HAVE_MPI
@@ -30,9 +31,11 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-/// Largest progressive pass, as in RenderSession (pass sizes do not change the
-/// image: each pixel takes its samples in index order whatever the split).
-constexpr int kMaxPassSpp = 64;
+/// Samples per pixel of one unit (one pass over a tile). RenderSession starts
+/// with 1-spp passes for a quick preview; here every unit is a full pass, so a
+/// 16x16 tile carries 16k samples against ~10 KB of state each way. Pass sizes
+/// do not change the image: each pixel takes its samples in index order.
+constexpr int kPassSpp = 64;
 
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
@@ -88,9 +91,10 @@ private:
 /// hidden by the unit each rank holds in reserve.
 class Backoff {
 public:
-    void idle() {
+    /// `sending`: messages are still going out; poll soon so MPI can move them on.
+    void idle(bool sending) {
         std::this_thread::sleep_for(std::chrono::microseconds(us_));
-        us_ = std::min(us_ * 2, 2000);
+        us_ = std::min(us_ * 2, sending ? 100 : 2000);
     }
     void busy() { us_ = 50; }
 
@@ -128,7 +132,7 @@ struct DistributedRender::Impl {
     }
 
     struct Peer {
-        uint32_t slots = 0;                 ///< units it may hold (its threads + 1)
+        uint32_t slots = 0;                 ///< units it may hold (2 per thread + 1)
         std::map<uint32_t, Unit> holding;   ///< tile -> unit sent and not returned
         bool stop_sent = false, done = false, left = false;
         WorkerReport report;
@@ -235,19 +239,20 @@ struct DistributedRender::Impl {
     std::vector<Peer> peers;
     Mailbox mail;
     int lost = 0;
+    WorkerReport local_report;      ///< rank 0's own render threads
+    double coordinator_seconds = 0;  ///< rank 0's time handling messages (decode, apply, encode)
+    uint64_t messages = 0;
 };
 
 void DistributedRender::Impl::enqueue_uniform_passes() {
     const int spp = scene.render.spp;
     int done = int(min_sample_count(film));
     const int uniform_end = scene.render.target_error ? std::min(spp, std::max(done, kAdaptiveMinSpp)) : spp;
-    int pass = std::clamp(done, 1, kMaxPassSpp);
     std::lock_guard lock(m);
     while (done < uniform_end) {
-        const int end = std::min(uniform_end, done + pass);
+        const int end = std::min(uniform_end, done + kPassSpp);
         for (uint32_t t = 0; t < tiles.size(); ++t) pending.push_back({t, uint32_t(end), false});
         done = end;
-        pass = std::min(pass * 2, kMaxPassSpp);
     }
 }
 
@@ -265,20 +270,31 @@ bool DistributedRender::Impl::enqueue_adaptive_round() {
 void DistributedRender::Impl::local_threads() {
 #pragma omp parallel num_threads(threads)
     {
+        double waited = 0, rendered = 0;
+        uint64_t units = 0;
         for (;;) {
             std::unique_lock lock(m);
             std::optional<Unit> u;
+            const auto t0 = Clock::now();
             while (!closed && !(u = take_locked())) cv.wait(lock);
             if (!u) break;
+            waited += seconds_between(t0, Clock::now());
             TileWork w = make_work_locked(*u);
             lock.unlock();
+            const auto t1 = Clock::now();
             render_work(scene, camera, w, local_stop);
+            rendered += seconds_between(t1, Clock::now());
+            ++units;
             lock.lock();
             apply_locked(w, *u);
             lock.unlock();
             cv.notify_all();
         }
         flush_thread_counters();
+        std::lock_guard lock(m);
+        local_report.units += units;
+        local_report.render_seconds += rendered;
+        local_report.wait_seconds += waited;
     }
 }
 
@@ -298,7 +314,9 @@ void DistributedRender::Impl::top_up(int rank) {
 void DistributedRender::Impl::handle(int source, int tag, const std::vector<char>& bytes) {
     Peer& p = peers[size_t(source)];
     if (tag == kTagHello) {
-        p.slots = Reader(bytes).get<uint32_t>() + 1;
+        // Two units per thread plus one: the spare hides the round trip to rank 0,
+        // even when rank 0's coordinating thread waits for a core.
+        p.slots = 2 * Reader(bytes).get<uint32_t>() + 1;
     } else if (tag == kTagResult) {
         const uint32_t tile = peek_tile(bytes);
         const auto it = p.holding.find(tile);
@@ -355,9 +373,11 @@ bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
     int source = 0, tag = 0;
     std::vector<char> bytes;
     bool progressed = false;
+    const auto t0 = Clock::now();
     while (mail.receive(source, tag, bytes)) {
         handle(source, tag, bytes);
         progressed = true;
+        ++messages;
     }
     const bool sends_done = mail.progress();
     if (!stopping) {
@@ -373,7 +393,9 @@ bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
             cv.notify_all();
         }
         for (int r = 1; r < mpi.size(); ++r) top_up(r);
-    } else {
+    }
+    if (progressed) coordinator_seconds += seconds_between(t0, Clock::now());
+    if (stopping) {
         bool all_done = true;
         for (int r = 1; r < mpi.size(); ++r) all_done = all_done && peers[size_t(r)].done;
         if (all_done && sends_done) return false;
@@ -391,7 +413,7 @@ bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
         }
     }
     if (progressed) backoff.busy();
-    else backoff.idle();
+    else backoff.idle(!sends_done);
     return true;
 }
 
@@ -464,6 +486,27 @@ void DistributedRender::snapshot(Film& out) {
 double DistributedRender::elapsed_seconds() const { return seconds_between(impl_->start, Clock::now()); }
 
 int DistributedRender::lost_ranks() const { return impl_->lost; }
+
+std::string DistributedRender::rank_report() const {
+    const Impl& s = *impl_;
+    std::string out;
+    char line[256];
+    const auto add = [&](int rank, const WorkerReport& r, int threads) {
+        const double per_unit = r.units ? 1e3 / double(r.units) : 0.0;
+        std::snprintf(line, sizeof line,
+                      "rank %d: %d threads, %llu units, render %.3f s (%.2f ms/unit), waiting for units %.3f s "
+                      "(%.3f ms/unit)\n",
+                      rank, threads, static_cast<unsigned long long>(r.units), r.render_seconds,
+                      r.render_seconds * per_unit, r.wait_seconds, r.wait_seconds * per_unit);
+        out += line;
+    };
+    add(0, s.local_report, s.threads);
+    for (int r = 1; r < s.mpi.size(); ++r) add(r, s.peers[size_t(r)].report, int(s.peers[size_t(r)].report.threads));
+    std::snprintf(line, sizeof line, "rank 0 coordinator: %llu messages, %.3f s handling them, %.2f MB sent\n",
+                  static_cast<unsigned long long>(s.messages), s.coordinator_seconds, double(s.mail.bytes_sent()) / 1e6);
+    out += line;
+    return out;
+}
 
 // --- ranks > 0 --------------------------------------------------------------
 
@@ -558,10 +601,10 @@ void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int thr
             w.report.counters = counter_totals();
             mail.send(0, kTagDone, bytes_of(w.report));
         }
-        if (!renderers.joinable() && mail.progress()) break;
-        mail.progress();
+        const bool sends_done = mail.progress();
+        if (!renderers.joinable() && sends_done) break;
         if (progressed) backoff.busy();
-        else backoff.idle();
+        else backoff.idle(!sends_done);
     }
 }
 
@@ -577,6 +620,7 @@ RenderResult DistributedRender::run() { return {}; }
 void DistributedRender::snapshot(Film&) {}
 double DistributedRender::elapsed_seconds() const { return 0; }
 int DistributedRender::lost_ranks() const { return 0; }
+std::string DistributedRender::rank_report() const { return {}; }
 
 void serve_distributed_render(const MpiSession&, const Scene&, int, const std::atomic<bool>&) {
     throw std::logic_error("sahara was built without MPI");

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "app/mpi_session.h"
 #include "render/film.h"
@@ -50,6 +51,8 @@ public:
     double elapsed_seconds() const;
     /// Ranks that did not answer after the stop (their tiles keep their last state).
     int lost_ranks() const;
+    /// Per-rank work and communication figures of the finished render, one line per rank.
+    std::string rank_report() const;
 
 private:
     struct Impl;

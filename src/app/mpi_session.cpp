@@ -37,6 +37,11 @@ MpiSession::MpiSession() {
     if (!launched_by_mpi()) return;
     // Only the thread that initialised MPI calls it (FUNNELED): the render
     // threads never do, they hand tiles to that thread through queues.
+    // A work unit is ~11 KB. Above Open MPI's shared-memory eager limit (4 KB)
+    // a message waits for a rendezvous that completes only when the sender
+    // calls MPI again, i.e. after its polling sleep: units would stall there.
+    // (TCP's eager limit is 64 KB already.) A user's own setting wins.
+    ::setenv("OMPI_MCA_btl_vader_eager_limit", "32768", 0);
     int provided = 0;
     MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
     initialised_ = true;
