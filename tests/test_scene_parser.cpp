@@ -431,7 +431,7 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
         {"{" + cam + R"(, "objects": [], "render": {"seed": -1}})", {"render.seed: expected an integer in [0,"}},
         {"{" + cam + R"(, "objects": [], "render": {"integrator": "raytrace"}})",
          {"render.integrator: expected one of \"path\", \"whitted\"", "got \"raytrace\""}},
-        {"{" + cam + R"(, "objects": [], "render": {"tonemap": "filmic"}})", {"render.tonemap: expected one of \"clamp\""}},
+        {"{" + cam + R"(, "objects": [], "render": {"tonemap": "agx"}})", {"render.tonemap: expected one of \"clamp\""}},
         {"{" + cam + R"(, "objects": [], "render": {"time_limit_s": 0}})", {"render.time_limit_s: expected a number > 0"}},
         {"{" + cam + R"(, "objects": [], "render": {"exposure": 100}})", {"render.exposure: expected a number in [-64, 64]"}},
         {"{" + cam + R"(, "objects": [], "format": "scene/2"})", {"format: expected one of \"scene/1\""}},

@@ -17,6 +17,7 @@
 #include "render/progress.h"
 #include "render/renderer.h"
 #include "render/stats.h"
+#include "render/tonemap.h"
 #include "scene/scene_parser.h"
 
 namespace sahara {
@@ -214,7 +215,12 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     if (job.scene.render.target_error) meta.emplace_back("estimated_error", std::to_string(est_error));
     const auto t_write = Clock::now();
     const fs::path out(a.output);
-    write_render(out, job.scene, job.film, meta);
+    std::optional<float> exposure;
+    if (a.auto_exposure && !a.overrides.exposure) {
+        exposure = auto_exposure_stops(job.film.to_rgb());
+        meta.emplace_back("exposure", std::to_string(*exposure));
+    }
+    const size_t clipped = write_render(out, job.scene, job.film, meta, exposure);
     const bool unfinished = result.stop == StopReason::interrupted || result.stop == StopReason::time_limit;
     std::error_code ec;
     if (out.extension() != ".exr") {
@@ -229,6 +235,11 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     }
     if (!a.quiet) {
         std::fprintf(stderr, "%s\n", line.c_str());
+        if (exposure) std::fprintf(stderr, "sahara: automatic exposure %+.2f stops (set one with --exposure)\n", double(*exposure));
+        if (clipped > 0)
+            std::fprintf(stderr, "sahara: %zu pixels (%.2f%%) clipped by the '%s' tone curve\n", clipped,
+                         100.0 * double(clipped) / (double(job.film.width()) * double(job.film.height())),
+                         std::string(tonemap_name(job.scene.render.tonemap)).c_str());
         if (unfinished)
             std::fprintf(stderr, "sahara: resume with --resume %s\n",
                          (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());

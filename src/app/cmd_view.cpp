@@ -63,6 +63,7 @@ ViewArgs parse_view_args(const std::vector<std::string>& args) {
     if (size.width) v.render.overrides.width = size.width;
     if (size.height) v.render.overrides.height = size.height;
     if (!output_given) v.render.output = "view.png";
+    v.render.auto_exposure = true;
     if (!v.render.help && !v.render.scene) throw UsageError("no MODEL given");
     return v;
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "render/tonemap.h"
+
 namespace sahara {
 
 const char* const kRenderUsage =
@@ -17,6 +19,8 @@ const char* const kRenderUsage =
     "  --max-depth D        rays per path, camera ray included\n"
     "  --seed S             random seed (same seed + settings = same image)\n"
     "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
+    "  --exposure STOPS     exposure for 8-bit outputs (EXR stays linear)\n"
+    "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
@@ -125,6 +129,13 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
     else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
     else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
     else if (a == "--sampler") o.sampler = parse_sampler_name(a, flag_value(args, i));
+    else if (a == "--exposure") o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
+    else if (a == "--tonemap") {
+        const std::string& v = flag_value(args, i);
+        const std::optional<Tonemap> t = tonemap_from_name(v);
+        if (!t) throw UsageError(a + ": expected clamp|reinhard|aces|filmic, got '" + v + "'");
+        o.tonemap = *t;
+    }
     else return false;
     return true;
 }

@@ -39,6 +39,7 @@ struct RenderArgs {
     std::optional<double> checkpoint_s;      ///< --checkpoint: write the partial image this often
     std::optional<std::string> resume;       ///< --resume: continue the render stored in this EXR
     std::optional<std::string> reference;    ///< --reference: report the true error against this image
+    bool auto_exposure = false;              ///< pick the exposure from the image (sahara view)
     bool preview = false;                    ///< --preview: live window
     std::optional<std::string> preview_dump; ///< --preview-dump: write the window's last frame here
     RenderOverrides overrides;

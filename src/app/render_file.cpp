@@ -119,15 +119,17 @@ ImageMetadata render_metadata(const Scene& scene, const Film& film, const Render
     return m;
 }
 
-void write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
-                  const ImageMetadata& metadata) {
+size_t write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
+                    const ImageMetadata& metadata, std::optional<float> exposure) {
     std::vector<float> rgb = film.to_rgb();
     if (!is_hdr_output(file)) {
-        rgb = tonemap_image(rgb, scene.render.exposure, scene.render.tonemap);
+        size_t clipped = 0;
+        rgb = tonemap_image(rgb, exposure.value_or(scene.render.exposure), scene.render.tonemap, &clipped);
         write_image(file, film.width(), film.height(), rgb, metadata);
-        return;
+        return clipped;
     }
     write_image(file, film.width(), film.height(), rgb, metadata, state_channels(film));
+    return 0;
 }
 
 double resume_film(const std::filesystem::path& file, const Scene& scene, Film& film) {

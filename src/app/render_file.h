@@ -4,6 +4,7 @@
 /// bit patterns, and counts) in uint32 channels, so a resumed render continues
 /// bit for bit where the first stopped.
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "io/image_io.h"
@@ -20,10 +21,11 @@ ImageMetadata render_identity(const Scene& scene);
 ImageMetadata render_metadata(const Scene& scene, const Film& film, const RenderResult& result,
                               double total_render_seconds);
 
-/// Writes `film` to `file` (tone-mapped for 8-bit formats; with state channels
-/// for EXR). Atomic (temporary + rename).
-void write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
-                  const ImageMetadata& metadata);
+/// Writes `film` to `file` (tone-mapped for 8-bit formats, with `exposure`
+/// replacing the scene's when given; with state channels for EXR). Atomic
+/// (temporary + rename). Returns how many pixels the tone curve clipped.
+size_t write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
+                    const ImageMetadata& metadata, std::optional<float> exposure = std::nullopt);
 
 /// Loads the state of a sahara EXR into `film` after checking that it was
 /// rendered with the same scene and settings. Returns the render seconds the

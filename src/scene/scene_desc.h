@@ -160,7 +160,7 @@ struct LightDesc {
 };
 
 enum class IntegratorType : uint8_t { path, whitted, albedo, normals, depth, bvh_cost };
-enum class Tonemap : uint8_t { clamp, reinhard, aces };
+enum class Tonemap : uint8_t { clamp, reinhard, aces, filmic };
 /// Where the per-sample random numbers come from: Owen-scrambled Sobol
 /// (low discrepancy, the default) or independent uniform random numbers.
 enum class SamplerType : uint8_t { sobol, independent };

@@ -28,7 +28,7 @@ void parse_render(JsonObject o, RenderSettings& r) {
     if (auto v = o.get_non_null("target_error")) r.target_error = v->number(NumberRange::positive());
     // 2^±64 already saturates or blacks out any image; larger values are typos.
     if (auto v = o.get("exposure")) r.exposure = v->number_f(NumberRange::closed(-64, 64));
-    if (auto v = o.get("tonemap")) r.tonemap = Tonemap(v->one_of({"clamp", "reinhard", "aces"}));
+    if (auto v = o.get("tonemap")) r.tonemap = Tonemap(v->one_of({"clamp", "reinhard", "aces", "filmic"}));
     o.finish();
 }
 
