@@ -4,20 +4,12 @@
 #include <stdexcept>
 
 #if SAHARA_HAVE_MPI
-#include <mpi.h>
-#include <omp.h>
-
-#include <algorithm>
-#include <chrono>
 #include <condition_variable>
-#include <deque>
-#include <list>
 #include <map>
 #include <mutex>
 #include <optional>
-#include <thread>
 
-#include "app/mpi_work.h"
+#include "app/mpi_mailbox.h"
 #include "base/log.h"
 #include "render/progress.h"
 #endif
@@ -27,7 +19,6 @@ namespace sahara {
 #if SAHARA_HAVE_MPI
 
 using namespace mpi_work;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -36,77 +27,6 @@ namespace {
 /// 16x16 tile carries 16k samples against ~10 KB of state each way. Pass sizes
 /// do not change the image: each pixel takes its samples in index order.
 constexpr int kPassSpp = 64;
-
-double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
-int resolve_threads(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
-
-/// Nonblocking point-to-point messages. Sends are MPI_Isend with the buffer
-/// kept alive until complete: two ranks sending each other large (rendezvous)
-/// messages with blocking MPI_Send would deadlock.
-class Mailbox {
-public:
-    void send(int dest, int tag, std::vector<char> bytes) {
-        auto& s = sends_.emplace_back();
-        s.bytes = std::move(bytes);
-        MPI_Isend(s.bytes.data(), int(s.bytes.size()), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &s.request);
-        bytes_sent_ += s.bytes.size();
-    }
-    /// Completes finished sends; true when none is pending.
-    bool progress() {
-        for (auto it = sends_.begin(); it != sends_.end();) {
-            int done = 0;
-            MPI_Test(&it->request, &done, MPI_STATUS_IGNORE);
-            it = done ? sends_.erase(it) : std::next(it);
-        }
-        return sends_.empty();
-    }
-    /// Receives the next message from anyone, if there is one.
-    bool receive(int& source, int& tag, std::vector<char>& bytes) {
-        int flag = 0;
-        MPI_Status status;
-        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status);
-        if (!flag) return false;
-        int count = 0;
-        MPI_Get_count(&status, MPI_BYTE, &count);
-        bytes.resize(size_t(count));
-        MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        source = status.MPI_SOURCE;
-        tag = status.MPI_TAG;
-        return true;
-    }
-    uint64_t bytes_sent() const { return bytes_sent_; }
-
-private:
-    struct Pending {
-        MPI_Request request = MPI_REQUEST_NULL;
-        std::vector<char> bytes;
-    };
-    std::list<Pending> sends_;  // a list: buffers must not move while in flight
-    uint64_t bytes_sent_ = 0;
-};
-
-/// Polling with a growing sleep: MPI's blocking calls spin and would take a
-/// core from the render threads; a few hundred microseconds of latency is
-/// hidden by the unit each rank holds in reserve.
-class Backoff {
-public:
-    /// `sending`: messages are still going out; poll soon so MPI can move them on.
-    void idle(bool sending) {
-        std::this_thread::sleep_for(std::chrono::microseconds(us_));
-        us_ = std::min(us_ * 2, sending ? 100 : 2000);
-    }
-    void busy() { us_ = 50; }
-
-private:
-    int us_ = 50;
-};
-
-template <class T> std::vector<char> bytes_of(const T& v) {
-    Writer w;
-    w.put(v);
-    return std::move(w.bytes);
-}
 
 }  // namespace
 
@@ -508,106 +428,6 @@ std::string DistributedRender::rank_report() const {
     return out;
 }
 
-// --- ranks > 0 --------------------------------------------------------------
-
-namespace {
-
-/// A worker rank: the main thread talks MPI, the render threads take units
-/// from `todo` and put results in `done`.
-struct Worker {
-    std::mutex m;
-    std::condition_variable cv;
-    std::deque<TileWork> todo, done;
-    bool quit = false;
-    std::atomic<bool> stop{false};
-    WorkerReport report;
-
-    void render_threads(const Scene& scene, int threads) {
-        const Camera camera(scene.camera, scene.render.width, scene.render.height);
-#pragma omp parallel num_threads(threads)
-        {
-            double waited = 0, rendered = 0;
-            uint64_t units = 0;
-            for (;;) {
-                std::unique_lock lock(m);
-                const auto t0 = Clock::now();
-                cv.wait(lock, [&] { return quit || !todo.empty(); });
-                if (!quit) waited += seconds_between(t0, Clock::now());
-                if (todo.empty()) break;
-                TileWork w = std::move(todo.front());
-                todo.pop_front();
-                lock.unlock();
-                const auto t1 = Clock::now();
-                render_work(scene, camera, w, stop);
-                w.seconds = seconds_between(t1, Clock::now());
-                rendered += w.seconds;
-                ++units;
-                lock.lock();
-                done.push_back(std::move(w));
-            }
-            flush_thread_counters();
-            std::lock_guard lock(m);
-            report.wait_seconds += waited;
-            report.render_seconds += rendered;
-            report.units += units;
-        }
-    }
-};
-
-}  // namespace
-
-void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int threads_arg,
-                              const std::atomic<bool>& signal_stop) {
-    (void)mpi;
-    const int threads = resolve_threads(threads_arg);
-    Worker w;
-    w.report.threads = uint32_t(threads);
-    Mailbox mail;
-    mail.send(0, kTagHello, bytes_of(uint32_t(threads)));
-    std::thread renderers([&] { w.render_threads(scene, threads); });
-    Backoff backoff;
-    bool told_leaving = false, stopped = false;
-    for (;;) {
-        int source = 0, tag = 0;
-        std::vector<char> bytes;
-        bool progressed = false;
-        while (mail.receive(source, tag, bytes)) {
-            progressed = true;
-            std::lock_guard lock(w.m);
-            if (tag == kTagWork) w.todo.push_back(decode_work(bytes));
-            else if (tag == kTagStop) stopped = w.quit = true;
-            w.cv.notify_all();
-        }
-        if (stopped) w.stop.store(true);  // rank 0 stopped the job (or finished it)
-        if (signal_stop.load() && !told_leaving) {
-            // Cut the tiles in hand short and let rank 0 give the rest to others.
-            w.stop.store(true);
-            mail.send(0, kTagLeave, {});
-            told_leaving = true;
-        }
-        std::deque<TileWork> finished;
-        bool idle;
-        {
-            std::lock_guard lock(w.m);
-            finished.swap(w.done);
-            idle = w.quit && w.todo.empty();
-        }
-        for (const TileWork& t : finished) mail.send(0, kTagResult, encode_result(t));
-        if (!finished.empty()) progressed = true;
-        if (idle && renderers.joinable()) {
-            renderers.join();  // the threads hold no unit once quit and todo is empty
-            for (const TileWork& t : w.done) mail.send(0, kTagResult, encode_result(t));
-            w.done.clear();
-            w.report.counters = counter_totals();
-            mail.send(0, kTagDone, bytes_of(w.report));
-        }
-        const bool sends_done = mail.progress();
-        if (!renderers.joinable() && sends_done) break;
-        if (progressed) backoff.busy();
-        else backoff.idle(!sends_done);
-    }
-}
-
 #else  // !SAHARA_HAVE_MPI
 
 struct DistributedRender::Impl {};
@@ -621,10 +441,6 @@ void DistributedRender::snapshot(Film&) {}
 double DistributedRender::elapsed_seconds() const { return 0; }
 int DistributedRender::lost_ranks() const { return 0; }
 std::string DistributedRender::rank_report() const { return {}; }
-
-void serve_distributed_render(const MpiSession&, const Scene&, int, const std::atomic<bool>&) {
-    throw std::logic_error("sahara was built without MPI");
-}
 
 #endif
 

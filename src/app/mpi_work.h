@@ -58,7 +58,8 @@ struct WorkerReport {
 
 /// Renders `w` from its state to its targets (the image-sized camera), stopping
 /// at the next pixel when `stop` is raised; updates state, samples, nonfinite.
-inline void render_work(const Scene& scene, const Camera& camera, TileWork& w, const std::atomic<bool>& stop) {
+inline void render_work(const Scene& scene, const Camera& camera, TileWork& w,
+                        const std::atomic<bool>& stop) {
     const int tw = w.rect.x1 - w.rect.x0, th = w.rect.y1 - w.rect.y0;
     Film film(tw, th);
     for (int y = 0; y < th; ++y)
