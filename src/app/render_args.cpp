@@ -11,7 +11,8 @@ namespace sahara {
 const char* const kRenderUsage =
     "usage: sahara render [SCENE.json] [-o OUT.png|.exr|.hdr|.pfm] [options]\n"
     "\n"
-    "Renders SCENE (or the built-in default scene) to an image.\n"
+    "Renders SCENE (or the built-in default scene) to an image. Started by mpirun or srun\n"
+    "(MPI builds), the ranks share the image's tiles, or whole frames with --frames.\n"
     "\n"
     "  -o, --output FILE    output image (default sahara.png); the extension picks the format\n"
     "  --spp N              samples per pixel\n"
