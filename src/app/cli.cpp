@@ -52,6 +52,9 @@ int run_cli(int argc, char** argv) {
     if (cmd == "info") return run_info_command(rest);
     if (cmd == "view") return run_view_command(rest);
     if (cmd == "converge") return run_converge_command(rest);
+    if (cmd == "bvh") return run_bvh_command(argc - 1, argv + 1);
+    if (cmd == "bench") return run_bench_command(argc - 1, argv + 1);
+    if (cmd == "trace") return run_trace_command(argc - 1, argv + 1);
     std::fprintf(stderr, "sahara: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
 }

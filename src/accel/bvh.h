@@ -1,0 +1,106 @@
+#pragma once
+/// A binary bounding volume hierarchy as pure data, plus its builders. The
+/// builders see only one bounding box and one centre per primitive, never a
+/// triangle or a sphere; traversal (accel/bvh_traverse.h) hands leaf ranges to
+/// a caller-supplied functor, so the caller owns the primitive tests.
+///
+/// Layout: 32-byte nodes in 64-byte aligned storage, the two children of an
+/// inner node adjacent (nodes[i], nodes[i + 1], i even, so a sibling pair is
+/// one cache line), root at nodes[0], nodes[1] unused padding. A leaf's
+/// primitives are the slots prim_indices[index .. index + count).
+#include <cstddef>
+#include <cstdint>
+#include <new>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "math/bounds.h"
+
+namespace sahara {
+
+/// One node: 24 bytes of bounds + 8 bytes of links = 32 bytes (two per 64-byte cache line).
+struct BvhNode {
+    /// lo.x, hi.x, lo.y, hi.y, lo.z, hi.z: interleaved so the near plane of
+    /// an axis is bounds[2 * axis + (direction < 0)] and the far plane the other one.
+    float bounds[6];
+    uint32_t index;  ///< inner: first child (the second is index + 1); leaf: first primitive slot
+    uint32_t count;  ///< number of primitives; 0 marks an inner node
+
+    bool is_leaf() const { return count != 0; }
+    Bounds3 box() const { return {{bounds[0], bounds[2], bounds[4]}, {bounds[1], bounds[3], bounds[5]}}; }
+    void set_box(const Bounds3& b) {
+        bounds[0] = b.lo.x; bounds[1] = b.hi.x;
+        bounds[2] = b.lo.y; bounds[3] = b.hi.y;
+        bounds[4] = b.lo.z; bounds[5] = b.hi.z;
+    }
+};
+static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");
+
+/// Minimal allocator returning `Align`-byte aligned storage.
+template <class T, size_t Align>
+struct AlignedAllocator {
+    using value_type = T;
+    template <class U>
+    struct rebind {
+        using other = AlignedAllocator<U, Align>;
+    };
+    AlignedAllocator() = default;
+    template <class U>
+    AlignedAllocator(const AlignedAllocator<U, Align>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align))); }
+    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(Align)); }
+    friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
+};
+
+/// The hierarchy. An empty Bvh (no nodes) has no primitives.
+struct Bvh {
+    /// Index of the first sibling pair (nodes[1] is padding).
+    static constexpr uint32_t kFirstPair = 2;
+    std::vector<BvhNode, AlignedAllocator<BvhNode, 64>> nodes;
+    std::vector<uint32_t> prim_indices;  ///< leaf slot -> index of the primitive given to the builder
+
+    bool empty() const { return nodes.empty(); }
+    /// Bytes of nodes (padding included) and slot indices (what traversal reads besides primitive data).
+    size_t bytes() const { return nodes.size() * sizeof(BvhNode) + prim_indices.size() * sizeof(uint32_t); }
+};
+
+enum class BvhBuilder : uint8_t {
+    binned,  ///< binned SAH, parallel over subtrees (fast default)
+    sweep,   ///< exact sweep SAH over all centroid-sorted splits (quality reference)
+};
+
+/// SAH cost model and build limits. The costs are relative: visiting an inner
+/// node (two box tests) costs `traversal`, testing one primitive costs
+/// `intersection`. A node becomes a leaf when that is cheaper than its best split.
+struct BvhBuildParams {
+    float traversal_cost = 1.0f;
+    float intersection_cost = 1.0f;
+    uint32_t max_leaf_size = 16;  ///< larger ranges are always split
+    uint32_t bin_count = 16;      ///< binned builder: centroid bins per axis
+    /// Subtrees with more primitives than this are built as OpenMP tasks.
+    uint32_t parallel_threshold = 4096;
+};
+
+/// Inputs of a build: one box and one centre per primitive (same length).
+struct BvhBuildInput {
+    std::span<const Bounds3> boxes;
+    std::span<const Vec3> centers;
+};
+
+/// Builds a BVH with the chosen builder. Primitives with empty boxes are kept
+/// (they land in some leaf but can never be reached by a ray).
+Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params = {});
+
+/// Traversal stack depth: builders switch to median splits past
+/// kBvhMedianSplitDepth, which bounds the depth of any tree by
+/// kBvhMedianSplitDepth + log2(2^30 primitives) < kBvhMaxDepth.
+inline constexpr int kBvhMaxDepth = 64;
+inline constexpr int kBvhMedianSplitDepth = 32;
+
+/// Parses "binned" / "sweep"; returns false for anything else.
+bool parse_bvh_builder(std::string_view text, BvhBuilder& out);
+/// "binned" or "sweep".
+const char* bvh_builder_name(BvhBuilder builder);
+
+}  // namespace sahara

@@ -1,0 +1,112 @@
+#include "accel/embree_reference.h"
+
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#if SAHARA_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace sahara {
+
+void set_flush_denormals(bool on) {
+    _MM_SET_FLUSH_ZERO_MODE(on ? _MM_FLUSH_ZERO_ON : _MM_FLUSH_ZERO_OFF);
+    _MM_SET_DENORMALS_ZERO_MODE(on ? _MM_DENORMALS_ZERO_ON : _MM_DENORMALS_ZERO_OFF);
+}
+
+#if SAHARA_HAVE_EMBREE
+
+struct EmbreeReference::Impl {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+bool EmbreeReference::available() { return true; }
+
+EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust)
+    : impl_(std::make_unique<Impl>()) {
+    const auto start = std::chrono::steady_clock::now();
+    impl_->device = rtcNewDevice(nullptr);
+    if (!impl_->device) throw std::runtime_error("embree: rtcNewDevice failed");
+    impl_->scene = rtcNewScene(impl_->device);
+    if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), positions.size()));
+    for (size_t i = 0; i < positions.size(); ++i) {
+        v[3 * i] = positions[i].x;
+        v[3 * i + 1] = positions[i].y;
+        v[3 * i + 2] = positions[i].z;
+    }
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(uint32_t), indices.size() / 3));
+    if (!indices.empty()) std::memcpy(idx, indices.data(), indices.size() * sizeof(uint32_t));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(impl_->scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(impl_->scene);
+    if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE) throw std::runtime_error("embree: scene build failed");
+    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+EmbreeReference::~EmbreeReference() = default;
+
+namespace {
+void fill_ray(RTCRay& r, const Ray& ray) {
+    r.org_x = ray.origin.x; r.org_y = ray.origin.y; r.org_z = ray.origin.z;
+    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+    r.tnear = ray.tmin;
+    r.tfar = ray.tmax;
+    r.time = ray.time;
+    r.mask = 0xFFFFFFFFu;
+    r.id = 0;
+    r.flags = 0;
+}
+}  // namespace
+
+bool EmbreeReference::intersect(const Ray& ray, float& t, uint32_t& prim) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    fill_ray(rh.ray, ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    t = rh.ray.tfar;
+    prim = rh.hit.primID;
+    return true;
+}
+
+bool EmbreeReference::occluded(const Ray& ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    fill_ray(r, ray);
+    rtcOccluded1(impl_->scene, &ctx, &r);
+    return r.tfar == -kInfinity;
+}
+
+#else
+
+struct EmbreeReference::Impl {};
+bool EmbreeReference::available() { return false; }
+EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool) {
+    throw std::runtime_error("this sahara was built without Embree");
+}
+EmbreeReference::~EmbreeReference() = default;
+bool EmbreeReference::intersect(const Ray&, float&, uint32_t&) const { return false; }
+bool EmbreeReference::occluded(const Ray&) const { return false; }
+
+#endif
+
+}  // namespace sahara

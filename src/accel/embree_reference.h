@@ -1,0 +1,43 @@
+#pragma once
+/// Embree 3 as a yardstick: the same triangles in an Embree scene, traced with
+/// rtcIntersect1 / rtcOccluded1. Embree types stay inside embree_reference.cpp.
+/// Without Embree (SAHARA_HAVE_EMBREE undefined) available() is false and the
+/// constructor throws std::runtime_error.
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "math/ray.h"
+#include "math/vec3.h"
+
+namespace sahara {
+
+class EmbreeReference {
+public:
+    /// Whether this build has Embree.
+    static bool available();
+    /// Builds an Embree scene over the indexed triangles. `robust` sets
+    /// RTC_SCENE_FLAG_ROBUST (Embree's slower, watertight-leaning mode); the
+    /// default mode is the fast one and can let rays slip through shared edges.
+    EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false);
+    ~EmbreeReference();
+    EmbreeReference(const EmbreeReference&) = delete;
+    EmbreeReference& operator=(const EmbreeReference&) = delete;
+
+    /// Nearest hit in [ray.tmin, ray.tmax]: t and triangle index; false on a miss.
+    bool intersect(const Ray& ray, float& t, uint32_t& prim) const;
+    /// Whether anything blocks the ray.
+    bool occluded(const Ray& ray) const;
+    double build_ms() const { return build_ms_; }
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    double build_ms_ = 0;
+};
+
+/// Sets flush-to-zero and denormals-are-zero for the calling thread (Embree's
+/// recommendation); the bench applies it to sahara and Embree alike.
+void set_flush_denormals(bool on);
+
+}  // namespace sahara

@@ -1,0 +1,123 @@
+/// `sahara trace`: traces a raw ray file against a mesh and writes raw hit
+/// (and optionally occlusion) files, for checking sahara against other tracers.
+#include <unistd.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "accel/accelerator.h"
+#include "app/commands.h"
+#include "app/mesh_input.h"
+#include "app/tool_args.h"
+#include "base/error.h"
+#include "base/pending_file.h"
+
+namespace sahara {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "ray and hit files are little-endian");
+
+constexpr const char* kTraceUsage =
+    "usage: sahara trace MESH --rays IN.rays --hits OUT.hits [--occlusion OUT.occl]\n"
+    "  MESH         a mesh (.obj)\n"
+    "  --rays       raw little-endian float32 x 8 per ray: ox oy oz dx dy dz tmin tmax (32 bytes)\n"
+    "  --hits       written: per ray float32 t and uint32 primitive index (miss: +inf, 0xFFFFFFFF)\n"
+    "  --occlusion  written: one byte per ray, 1 = something blocks (tmin, tmax)\n"
+    "Primitive indices are triangle indices in file order; a polygon v0 v1 .. vk is fan-split\n"
+    "into (v0,v1,v2), (v0,v2,v3), ..., (v0,vk-1,vk). Concave polygons are fan-split the same way\n"
+    "(no ear clipping, so the fan may cover area outside the polygon). Degenerate triangles keep\n"
+    "their index and are never hit. Outputs are written to a temporary file and renamed.\n";
+
+std::vector<Ray> read_ray_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw input_error(path, "", "cannot open ray file");
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.size() % 32 != 0)
+        throw input_error(path, "", "size " + std::to_string(bytes.size()) + " is not a multiple of 32 bytes (8 float32 per ray)");
+    std::vector<Ray> rays(bytes.size() / 32);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        float f[8];
+        std::memcpy(f, bytes.data() + 32 * i, 32);
+        for (float x : f)
+            if (std::isnan(x)) throw input_error(path, "ray " + std::to_string(i), "NaN component");
+        rays[i] = Ray{{f[0], f[1], f[2]}, {f[3], f[4], f[5]}, f[6], f[7]};
+        if (!is_finite(rays[i].origin) || !is_finite(rays[i].dir))
+            throw input_error(path, "ray " + std::to_string(i), "infinite origin or direction");
+    }
+    return rays;
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then rename.
+void write_atomically(const std::string& path, const std::vector<char>& bytes) {
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+    const PendingFile pending(tmp);  // an interrupt removes the temporary
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) throw input_error(path, "", "cannot write output");
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+        out.flush();
+        if (!out) {
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            throw input_error(path, "", "write failed");
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw input_error(path, "", "cannot rename temporary file into place");
+    }
+}
+
+int trace(const ToolArgs& args) {
+    const std::vector<Ray> rays = read_ray_file(args.values.at("--rays"));
+    const Scene scene = scene_from_mesh(read_obj_triangles(args.positional[0]));
+    const Accelerator accel(scene);
+    const bool want_occl = args.values.count("--occlusion") != 0;
+    std::vector<char> hits(rays.size() * 8), occl(want_occl ? rays.size() : 0);
+#pragma omp parallel for schedule(dynamic, 1024)
+    for (size_t i = 0; i < rays.size(); ++i) {
+        Ray r = rays[i];
+        Hit h;
+        float t = kInfinity;
+        uint32_t prim = kNoPrim;
+        if (accel.intersect(r, h)) t = h.t, prim = prim_index(h.prim);
+        std::memcpy(&hits[8 * i], &t, 4);
+        std::memcpy(&hits[8 * i + 4], &prim, 4);
+        if (want_occl) occl[i] = accel.occluded(rays[i]) ? 1 : 0;
+    }
+    write_atomically(args.values.at("--hits"), hits);
+    if (want_occl) write_atomically(args.values.at("--occlusion"), occl);
+    return 0;
+}
+
+}  // namespace
+
+int run_trace_command(int argc, char** argv) {
+    ToolArgs args;
+    const std::string err = parse_tool_args(argc, argv, {"--rays", "--hits", "--occlusion"}, {}, args);
+    if (!err.empty()) return usage_error("trace", err, kTraceUsage);
+    if (args.help) {
+        std::fputs(kTraceUsage, stdout);
+        return 0;
+    }
+    if (args.positional.size() != 1) return usage_error("trace", "expected one mesh file", kTraceUsage);
+    if (!args.values.count("--rays") || !args.values.count("--hits"))
+        return usage_error("trace", "--rays and --hits are required", kTraceUsage);
+    try {
+        return trace(args);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "sahara trace: %s\n", e.what());
+        return 2;
+    }
+}
+
+}  // namespace sahara

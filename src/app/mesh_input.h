@@ -1,0 +1,25 @@
+#pragma once
+/// A small private OBJ reader for the BVH tools (`sahara bvh`, `bench`,
+/// `trace`) and their tests, until they switch to io/model_loader.h.
+///
+/// Primitive order (the `trace` command's primitive indices): triangles in
+/// file order; a polygon v0 v1 ... vk is fan-split into (v0,v1,v2),
+/// (v0,v2,v3), ..., (v0,vk-1,vk). Concave polygons are fan-split the same way,
+/// without ear clipping, so their fan may cover area outside the polygon.
+/// Zero-area triangles are KEPT so that indices stay file-order indices.
+/// Only positions are read (the tools need no normals, UVs or materials).
+#include <filesystem>
+
+#include "scene/scene.h"
+#include "scene/scene_desc.h"
+
+namespace sahara {
+
+/// Reads positions and fan-split triangles of an OBJ file; throws InputError
+/// for a missing or malformed file, an out-of-range index or a non-finite position.
+TriangleMesh read_obj_triangles(const std::filesystem::path& file);
+
+/// A Scene holding only `mesh`'s triangles (no BVH yet; call build_accelerator or build an Accelerator).
+Scene scene_from_mesh(const TriangleMesh& mesh);
+
+}  // namespace sahara

@@ -1,0 +1,128 @@
+#include "app/ray_batch.h"
+
+#include <omp.h>
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace sahara {
+
+size_t RayAnswers::hits() const {
+    size_t n = 0;
+    for (uint32_t p : prim) n += p != kNoPrim;
+    return n;
+}
+
+namespace {
+
+/// Runs `trace_one(i, t, prim)` for every ray index on `threads` threads and times the whole pass.
+double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+template <class TraceOne>
+PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceOne&& trace_one) {
+    out.t.assign(count, kInfinity);
+    out.prim.assign(count, kNoPrim);
+    double cpu = 0;
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads) reduction(+ : cpu)
+    {
+        const double cpu_start = thread_cpu_seconds();
+        set_flush_denormals(ftz);
+        // Chunks of 1024 rays: coherent primary rays stay together, dynamic balances the rest.
+#pragma omp for schedule(dynamic, 1024) nowait
+        for (size_t i = 0; i < count; ++i) trace_one(i, out.t[i], out.prim[i]);
+        set_flush_denormals(false);
+        cpu += thread_cpu_seconds() - cpu_start;
+    }
+    return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
+}
+
+}  // namespace
+
+PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
+                    RayAnswers& out) {
+    return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
+        if (occlusion) {
+            if (accel.occluded(rays[i])) t = 0.0f, prim = 0;
+            return;
+        }
+        Ray r = rays[i];
+        Hit h;
+        if (accel.intersect(r, h)) t = h.t, prim = prim_index(h.prim);
+    });
+}
+
+PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
+                    bool ftz, RayAnswers& out) {
+    return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
+        if (occlusion) {
+            if (embree.occluded(rays[i])) t = 0.0f, prim = 0;
+            return;
+        }
+        float th;
+        uint32_t p;
+        if (embree.intersect(rays[i], th, p)) t = th, prim = p;
+    });
+}
+
+double nearest_hit_double(const Ray& ray, const TriangleMesh& mesh) {
+    const Vec3d o(ray.origin), d(ray.dir);
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < mesh.triangle_count(); ++i) {
+        Vec3d p[3];
+        for (size_t k = 0; k < 3; ++k) p[k] = Vec3d(mesh.positions[mesh.indices[3 * i + k]]);
+        const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0], pv = cross(d, e2);
+        const double det = dot(e1, pv);
+        if (det == 0.0) continue;
+        const Vec3d tv = o - p[0], q = cross(tv, e1);
+        const double u = dot(tv, pv) / det, v = dot(d, q) / det, t = dot(e2, q) / det;
+        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > double(ray.tmin) && t < double(ray.tmax) && t < best) best = t;
+    }
+    return best;
+}
+
+namespace {
+
+/// Whether answer (t, prim) of a pass agrees with the double-precision nearest hit `td`.
+bool agrees_with_double(float t, uint32_t prim, double td, float tol) {
+    if (prim == kNoPrim) return std::isinf(td);
+    if (t == 0.0f) return !std::isinf(td);  // occlusion answer
+    return std::fabs(td - double(t)) <= double(tol);
+}
+
+}  // namespace
+
+Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b, const std::vector<Ray>& rays,
+                              const TriangleMesh& mesh) {
+    // Arbitration is a brute-force loop per ray; beyond this many it is skipped.
+    constexpr size_t kMaxArbitrations = 1000;
+    Disagreements d;
+    size_t arbitrations = 0;
+    for (size_t i = 0; i < a.t.size(); ++i) {
+        const bool ha = a.prim[i] != kNoPrim, hb = b.prim[i] != kNoPrim;
+        if (!ha && !hb) continue;
+        const float diff = std::fabs(a.t[i] - b.t[i]), scale = std::max(std::fabs(a.t[i]), std::fabs(b.t[i]));
+        const Ray& r = rays[i];
+        const float tol = 1e-4f * (std::isinf(scale) ? 0.0f : scale) + 1e-6f * max_component(abs(r.origin)) / length(r.dir);
+        if (ha == hb && a.prim[i] == b.prim[i] && diff <= tol) continue;
+        if (ha == hb && a.prim[i] != b.prim[i] && diff <= 1e-6f * scale) {
+            ++d.ties;
+            continue;
+        }
+        if (arbitrations++ < kMaxArbitrations &&
+            agrees_with_double(a.t[i], a.prim[i], nearest_hit_double(r, mesh), tol + 1e-4f * std::fabs(a.t[i])))
+            ++d.confirmed_for_a;
+        else
+            ++d.total;
+    }
+    return d;
+}
+
+}  // namespace sahara

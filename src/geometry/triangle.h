@@ -1,0 +1,143 @@
+#pragma once
+/// Triangle primitive: the watertight ray/triangle test of Woop, Benthin and
+/// Wald, "Watertight Ray/Triangle Intersection" (JCGT 2013), plus helpers that
+/// turn the barycentrics of an accepted hit into normals and UVs.
+///
+/// Watertight means: a ray through a shared edge or vertex of a closed mesh
+/// hits at least one of the triangles that share it. The test shears the
+/// triangle into a space where the ray is the +z axis through the origin and
+/// evaluates 2-D edge functions there; when an edge function is exactly 0 in
+/// float it is recomputed in double, so neighbouring triangles agree on the
+/// sign of the shared edge.
+#include <cmath>
+#include <cstdint>
+
+#include "math/ray.h"
+#include "math/vec3.h"
+
+namespace sahara {
+
+/// Per-ray constants of the watertight test (computed once per ray).
+struct TriangleRay {
+    float org[3];
+    int kx = 0, ky = 1, kz = 2;  ///< axis permutation: kz = dominant direction axis
+    float sx = 0, sy = 0, sz = 1;  ///< shear constants
+
+    explicit TriangleRay(const Ray& ray) {
+        org[0] = ray.origin.x; org[1] = ray.origin.y; org[2] = ray.origin.z;
+        const Vec3 a = abs(ray.dir);
+        kz = max_dimension(a);
+        kx = kz == 2 ? 0 : kz + 1;
+        ky = kx == 2 ? 0 : kx + 1;
+        // Swapping kx and ky for a negative dominant component preserves the
+        // winding, so the sign of the determinant tells the side that was hit.
+        if (ray.dir[kz] < 0.0f) { int t = kx; kx = ky; ky = t; }
+        sx = ray.dir[kx] / ray.dir[kz];
+        sy = ray.dir[ky] / ray.dir[kz];
+        sz = 1.0f / ray.dir[kz];
+    }
+};
+
+/// The three vertices of one triangle as plain arrays (indexable by a runtime axis).
+struct TriangleVerts {
+    float p[3][3];
+
+    static TriangleVerts of(const Vec3& a, const Vec3& b, const Vec3& c) {
+        return {{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}}};
+    }
+};
+static_assert(sizeof(TriangleVerts) == 36);
+
+/// Result of a successful triangle test.
+struct TriangleHit {
+    float t;     ///< ray parameter
+    float u, v;  ///< barycentric weights of vertices 1 and 2
+};
+
+namespace detail {
+/// Edge function recomputed in double (only when the float result is exactly 0).
+inline float edge_function_double(float ax, float ay, float bx, float by) {
+    return float(double(ax) * double(by) - double(ay) * double(bx));
+}
+}  // namespace detail
+
+/// Watertight test of `ray` (precomputed as `tr`) against one triangle; a hit
+/// needs tmin < t < tmax. Degenerate (zero-area) triangles never hit.
+inline bool intersect_triangle(const TriangleRay& tr, const TriangleVerts& tri, float tmin, float tmax,
+                               TriangleHit& out) {
+    const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
+    // Vertices relative to the ray origin.
+    const float a_x = tri.p[0][kx] - tr.org[kx], a_y = tri.p[0][ky] - tr.org[ky], a_z = tri.p[0][kz] - tr.org[kz];
+    const float b_x = tri.p[1][kx] - tr.org[kx], b_y = tri.p[1][ky] - tr.org[ky], b_z = tri.p[1][kz] - tr.org[kz];
+    const float c_x = tri.p[2][kx] - tr.org[kx], c_y = tri.p[2][ky] - tr.org[ky], c_z = tri.p[2][kz] - tr.org[kz];
+    // Shear so the ray becomes the +z axis.
+    const float ax = a_x - tr.sx * a_z, ay = a_y - tr.sy * a_z;
+    const float bx = b_x - tr.sx * b_z, by = b_y - tr.sy * b_z;
+    const float cx = c_x - tr.sx * c_z, cy = c_y - tr.sy * c_z;
+    // Scaled barycentrics (2-D edge functions).
+    float u = cx * by - cy * bx;
+    float v = ax * cy - ay * cx;
+    float w = bx * ay - by * ax;
+    if (u == 0.0f || v == 0.0f || w == 0.0f) {
+        u = detail::edge_function_double(cx, cy, bx, by);
+        v = detail::edge_function_double(ax, ay, cx, cy);
+        w = detail::edge_function_double(bx, by, ax, ay);
+    }
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+    const float det = u + v + w;
+    if (det == 0.0f) return false;
+    // Scaled hit distance, compared against the interval without a division.
+    const float t_scaled = u * (tr.sz * a_z) + v * (tr.sz * b_z) + w * (tr.sz * c_z);
+    const float abs_det = std::fabs(det);
+    const float t_signed = det < 0.0f ? -t_scaled : t_scaled;
+    if (!(t_signed > tmin * abs_det) || !(t_signed < tmax * abs_det)) return false;
+    const float inv_det = 1.0f / det;
+    out = {t_scaled * inv_det, v * inv_det, w * inv_det};
+    // Rounding of the division can push t onto the interval's boundary.
+    return out.t > tmin && out.t < tmax;
+}
+
+/// Unnormalised geometric normal of the triangle (p0, p1, p2): counter-clockwise is the front.
+inline Vec3 triangle_geometric_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    return cross(p1 - p0, p2 - p0);
+}
+
+/// Unit geometric normal of triangle `i` of any indexed mesh with `positions`
+/// and `indices` (TriangleMesh, TriangleSoup); zero for a degenerate triangle.
+template <class Mesh>
+Vec3 triangle_geometric_normal(const Mesh& mesh, size_t i) {
+    const Vec3 n = triangle_geometric_normal(mesh.positions[mesh.indices[3 * i]], mesh.positions[mesh.indices[3 * i + 1]],
+                                             mesh.positions[mesh.indices[3 * i + 2]]);
+    const float len = length(n);
+    return len > 0.0f ? n / len : Vec3(0.0f);
+}
+
+/// Barycentric interpolation of a per-vertex attribute: (1-u-v) a0 + u a1 + v a2.
+template <class T>
+T barycentric_interpolate(const T& a0, const T& a1, const T& a2, float u, float v) {
+    const float w = 1.0f - u - v;
+    return a0 * w + a1 * u + a2 * v;
+}
+
+/// Interpolated unit shading normal of triangle `i` at barycentrics (u, v);
+/// falls back to the geometric normal when the mesh has no normals or they cancel.
+template <class Mesh>
+Vec3 triangle_shading_normal(const Mesh& mesh, size_t i, float u, float v) {
+    if (mesh.normals.empty()) return triangle_geometric_normal(mesh, i);
+    const uint32_t* id = &mesh.indices[3 * i];
+    const Vec3 n = barycentric_interpolate(mesh.normals[id[0]], mesh.normals[id[1]], mesh.normals[id[2]], u, v);
+    const float len = length(n);
+    return len > 0.0f ? n / len : triangle_geometric_normal(mesh, i);
+}
+
+/// Interpolated UV of triangle `i` at barycentrics (u, v); (u, v) itself when the mesh has no UVs.
+template <class Mesh>
+Vec2 triangle_uv(const Mesh& mesh, size_t i, float u, float v) {
+    if (mesh.uvs.empty()) return Vec2{u, v};
+    const uint32_t* id = &mesh.indices[3 * i];
+    const Vec2 &a = mesh.uvs[id[0]], &b = mesh.uvs[id[1]], &c = mesh.uvs[id[2]];
+    const float w = 1.0f - u - v;
+    return Vec2{a.x * w + b.x * u + c.x * v, a.y * w + b.y * u + c.y * v};
+}
+
+}  // namespace sahara

@@ -1,0 +1,147 @@
+#pragma once
+// Procedural meshes and seeded ray sets shared by test_bvh.cpp and test_triangle.cpp.
+#include <cstdint>
+#include <map>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "math/bounds.h"
+#include "math/ray.h"
+#include "scene/scene_desc.h"
+
+namespace sahara::test {
+
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
+/// Ray counts are divided by this under ASan (roughly its slowdown), to keep tests short.
+inline constexpr int kSanitizerDivisor = kSanitized ? 20 : 1;
+
+/// Closed icosphere: an icosahedron with each triangle split into 4, `level` times,
+/// vertices pushed to the sphere; shared vertices are deduplicated (watertight topology).
+inline TriangleMesh make_icosphere(int level, float radius = 1.0f, Vec3 center = {0, 0, 0}) {
+    const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+    std::vector<Vec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                           {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<uint32_t> idx = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2,
+                                 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5,
+                                 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+    for (Vec3& v : p) v = normalize(v);
+    for (int l = 0; l < level; ++l) {
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+        auto midpoint = [&](uint32_t a, uint32_t b) {
+            auto key = std::minmax(a, b);
+            auto it = mid.find(key);
+            if (it != mid.end()) return it->second;
+            p.push_back(normalize((p[a] + p[b]) * 0.5f));
+            return mid[key] = uint32_t(p.size() - 1);
+        };
+        std::vector<uint32_t> next;
+        for (size_t i = 0; i < idx.size(); i += 3) {
+            const uint32_t a = idx[i], b = idx[i + 1], c = idx[i + 2];
+            const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+        }
+        idx = std::move(next);
+    }
+    TriangleMesh m;
+    m.name = "icosphere";
+    for (const Vec3& v : p) m.positions.push_back(center + v * radius);
+    m.indices = std::move(idx);
+    return m;
+}
+
+/// n x n grid of tiny, separated triangles in the z = 0 plane.
+inline TriangleMesh make_tiny_grid(int n, float cell = 1.0f, float size = 1e-3f) {
+    TriangleMesh m;
+    m.name = "tiny grid";
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const auto base = uint32_t(m.positions.size());
+            const Vec3 o(float(x) * cell, float(y) * cell, 0.0f);
+            m.positions.insert(m.positions.end(), {o, o + Vec3(size, 0, 0), o + Vec3(0, size, 0)});
+            m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+        }
+    return m;
+}
+
+/// Long thin slivers (length 10, width ~1e-4) in random orientations around the origin.
+inline TriangleMesh make_slivers(int n, uint32_t seed = 7) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    TriangleMesh m;
+    m.name = "slivers";
+    for (int i = 0; i < n; ++i) {
+        const Vec3 c(u(rng), u(rng), u(rng));
+        Vec3 d(u(rng), u(rng), u(rng));
+        d = normalize(d) * 5.0f;
+        const Vec3 w = normalize(cross(d, Vec3(u(rng), u(rng), u(rng)))) * 1e-4f;
+        const auto base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), {c - d, c + d, c + w});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    return m;
+}
+
+/// A small icosphere plus zero-area triangles: repeated vertices and collinear vertices.
+inline TriangleMesh make_degenerate_mesh() {
+    TriangleMesh m = make_icosphere(2, 1.0f);
+    m.name = "degenerate";
+    const auto n = uint32_t(m.positions.size());
+    for (uint32_t i = 0; i + 2 < n; i += 3) {
+        m.indices.insert(m.indices.end(), {i, i, i + 1});  // repeated vertex
+        m.indices.insert(m.indices.end(), {i, i, i});      // a point
+    }
+    const auto base = uint32_t(m.positions.size());
+    for (int k = 0; k < 50; ++k) {  // collinear triples through the sphere
+        const float s = float(k) * 0.04f - 1.0f;
+        m.positions.insert(m.positions.end(), {Vec3(s, -2, 0.1f), Vec3(s, 0, 0.1f), Vec3(s, 2, 0.1f)});
+        const auto b = base + uint32_t(3 * k);
+        m.indices.insert(m.indices.end(), {b, b + 1, b + 2});
+    }
+    return m;
+}
+
+inline Bounds3 mesh_bounds(const TriangleMesh& m) {
+    Bounds3 b;
+    for (const Vec3& p : m.positions) b.extend(p);
+    return b;
+}
+
+/// Seeded random rays: origins uniformly in `b` grown by 50% on every side
+/// (so both inside and outside), directions uniform on the sphere, except
+/// every 4th ray which is axis-parallel (+-x, +-y or +-z, with exact zeros).
+inline std::vector<Ray> make_random_rays(const Bounds3& b, int count, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    const Vec3 e = b.extent(), lo = b.lo - e * 0.5f, size = e * 2.0f;
+    std::vector<Ray> rays;
+    rays.reserve(size_t(count));
+    for (int i = 0; i < count; ++i) {
+        Ray r;
+        r.origin = lo + Vec3(u01(rng), u01(rng), u01(rng)) * size;
+        if (i % 4 == 3) {
+            const auto k = int(rng() % 6);
+            r.dir = Vec3(0.0f);
+            r.dir[k / 2] = (k % 2) ? -1.0f : 1.0f;
+        } else {
+            const float z = 1.0f - 2.0f * u01(rng), phi = 6.2831853f * u01(rng);
+            const float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
+            r.dir = Vec3(s * std::cos(phi), s * std::sin(phi), z);
+        }
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+}  // namespace sahara::test

@@ -1,0 +1,542 @@
+#include <doctest/doctest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cstring>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "accel/accelerator.h"
+#include "accel/bvh_pairs.h"
+#include "accel/bvh_stats.h"
+#include "app/mesh_input.h"
+#include "mesh_fixtures.h"
+#include "scene/scene.h"
+
+using namespace sahara;
+using namespace sahara::test;
+
+namespace {
+
+std::vector<std::filesystem::path> shared_obj_files() {
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(SAHARA_ASSETS_DIR "/obj"))
+        if (e.path().extension() == ".obj") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+bool same_t(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b)); }
+
+/// Number of rays on which the tree disagrees with the brute-force loop: hit/miss,
+/// t beyond 1e-6 relative, or a different primitive at a different t; occluded() must match hit/miss.
+int count_disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
+    int bad = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad)
+    for (size_t i = 0; i < rays.size(); ++i) {
+        Ray a = rays[i], b = rays[i];
+        Hit ha, hb;
+        const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
+        const bool occ = acc.occluded(rays[i]);
+        if (fa != fb || occ != fb) ++bad;
+        else if (fa && (!same_t(ha.t, hb.t, 1e-6f) || (ha.prim != hb.prim && ha.t != hb.t))) ++bad;
+        else if (fa && a.tmax != ha.t) ++bad;
+    }
+    return bad;
+}
+
+/// Rays for a brute-force comparison on a mesh of `tris` triangles: 100k, fewer
+/// for big meshes (brute force costs rays x triangles: at most ~1e8 tests per
+/// mesh, but never fewer than 1000 rays), divided under ASan.
+int ray_budget(size_t tris, int max_rays) {
+    const double budget = 1e8 / double(std::max<size_t>(tris, 1));
+    return int(std::clamp(budget, 1000.0, double(max_rays))) / kSanitizerDivisor;
+}
+
+void check_against_brute_force(const TriangleMesh& mesh, BvhBuilder builder, uint32_t seed, int max_rays = 100000) {
+    Scene scene = scene_from_mesh(mesh);
+    AcceleratorOptions opt;
+    opt.builder = builder;
+    const Accelerator acc(scene, opt);
+    const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), ray_budget(mesh.triangle_count(), max_rays), seed);
+    INFO(mesh.name, " builder ", bvh_builder_name(builder), " rays ", rays.size());
+    CHECK(count_disagreements(acc, rays) == 0);
+}
+
+std::vector<Bounds3> triangle_boxes(const TriangleMesh& m) {
+    std::vector<Bounds3> boxes;
+    for (size_t i = 0; i < m.triangle_count(); ++i) {
+        Bounds3 b;
+        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
+        boxes.push_back(b);
+    }
+    return boxes;
+}
+
+Bvh build_for_mesh(const TriangleMesh& m, BvhBuilder builder, const BvhBuildParams& params = {}) {
+    const std::vector<Bounds3> boxes = triangle_boxes(m);
+    std::vector<Vec3> centers;
+    for (const Bounds3& b : boxes) centers.push_back(b.center());
+    return build_bvh({boxes, centers}, builder, params);
+}
+
+std::vector<TriangleMesh> procedural_meshes() {
+    return {make_icosphere(3), make_tiny_grid(30), make_slivers(1000), make_degenerate_mesh()};
+}
+
+}  // namespace
+
+TEST_CASE("both builders produce valid trees") {
+    std::vector<TriangleMesh> meshes = procedural_meshes();
+    for (const auto& f : shared_obj_files()) meshes.push_back(read_obj_triangles(f));
+    for (const TriangleMesh& m : meshes)
+        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep}) {
+            INFO(m.name, " ", bvh_builder_name(builder));
+            const Bvh bvh = build_for_mesh(m, builder);
+            CHECK(validate_bvh(bvh, triangle_boxes(m)) == "");
+            const BvhStats s = compute_bvh_stats(bvh);
+            size_t leaf_prims = 0, leaves = 0;
+            for (size_t k = 0; k < s.leaf_size_histogram.size(); ++k) {
+                leaves += s.leaf_size_histogram[k];
+                leaf_prims += k * s.leaf_size_histogram[k];
+            }
+            CHECK(leaves == s.leaves);
+            CHECK(leaf_prims == m.triangle_count());
+            CHECK(s.nodes == 2 * s.leaves - 1);
+            CHECK(s.sah_cost >= 1.0);  // at least the root leaf-or-traversal term
+        }
+}
+
+TEST_CASE("validator catches a broken tree") {
+    const TriangleMesh m = make_icosphere(2);
+    Bvh bvh = build_for_mesh(m, BvhBuilder::binned);
+    REQUIRE(validate_bvh(bvh, triangle_boxes(m)) == "");
+    Bvh dup = bvh;
+    dup.prim_indices[1] = dup.prim_indices[0];
+    CHECK(validate_bvh(dup, triangle_boxes(m)) != "");
+    Bvh shrunk = bvh;
+    shrunk.nodes[Bvh::kFirstPair].bounds[1] = shrunk.nodes[Bvh::kFirstPair].bounds[0];
+    CHECK(validate_bvh(shrunk, triangle_boxes(m)) != "");
+}
+
+TEST_CASE("SAH leaf creation: a single-leaf cap of 1 gives one primitive per leaf") {
+    BvhBuildParams p;
+    p.max_leaf_size = 1;
+    const TriangleMesh m = make_icosphere(3);
+    const BvhStats s = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned, p));
+    CHECK(s.leaves == m.triangle_count());
+    CHECK(s.leaf_size_histogram.size() == 2);
+    // With a very expensive traversal, SAH prefers bigger leaves.
+    p.max_leaf_size = 16;
+    p.traversal_cost = 8.0f;
+    const BvhStats big = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned, p));
+    CHECK(big.leaves < m.triangle_count() / 2);
+}
+
+TEST_CASE("sweep SAH is at least as good as binned on meshes") {
+    for (const TriangleMesh& m : {make_icosphere(4), make_slivers(3000)}) {
+        const double binned = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned)).sah_cost;
+        const double sweep = compute_bvh_stats(build_for_mesh(m, BvhBuilder::sweep)).sah_cost;
+        INFO(m.name, " binned ", binned, " sweep ", sweep);
+        // Greedy top-down builds are not strictly ordered; the exact sweep should not lose by more than 2%.
+        CHECK(sweep <= binned * 1.02);
+    }
+}
+
+TEST_CASE("BVH agrees with brute force on procedural meshes") {
+    uint32_t seed = 1;
+    for (const TriangleMesh& m : procedural_meshes())
+        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep})
+            check_against_brute_force(m, builder, seed++, builder == BvhBuilder::binned ? 100000 : 25000);
+}
+
+TEST_CASE("BVH agrees with brute force on the shared OBJ meshes") {
+    uint32_t seed = 100;
+    for (const auto& f : shared_obj_files()) check_against_brute_force(read_obj_triangles(f), BvhBuilder::binned, seed++);
+}
+
+TEST_CASE("spheres, boxes and triangles in one tree agree with brute force") {
+    Scene scene = scene_from_mesh(make_icosphere(3, 0.5f, {0, 0, 0}));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+    for (int i = 0; i < 200; ++i) {
+        Sphere s;
+        s.center = Vec3(u(rng), u(rng), u(rng));
+        s.radius = 0.05f + 0.1f * std::fabs(u(rng));
+        if (i % 3 == 0) s.velocity = Vec3(u(rng), 0, 0) * 0.1f;
+        scene.spheres.push_back(s);
+    }
+    for (int i = 0; i < 50; ++i) {
+        const Vec3 c(u(rng), u(rng), u(rng));
+        scene.boxes.push_back(Box{{c - Vec3(0.1f), c + Vec3(0.2f)}, 0});
+    }
+    const Accelerator acc(scene);
+    CHECK(acc.uses_tree());
+    std::vector<Ray> rays = make_random_rays(acc.bounds(), 50000 / kSanitizerDivisor, 11);
+    std::uniform_real_distribution<float> t01(0.0f, 1.0f);
+    for (Ray& r : rays) r.time = t01(rng);
+    CHECK(count_disagreements(acc, rays) == 0);
+    // The moving spheres' bounds cover the whole shutter.
+    Bounds3 all;
+    for (const Sphere& s : scene.spheres) all.extend(s.bounds(0, 1));
+    CHECK(acc.bounds().contains(all));
+}
+
+TEST_CASE("a ray starting inside a box hits it on the way out") {
+    Scene scene;
+    scene.boxes.push_back(Box{{Vec3(-1.0f), Vec3(1.0f)}, 0});
+    const Accelerator acc(scene);
+    Ray r{{0, 0, 0}, {1, 0, 0}};
+    Hit h;
+    REQUIRE(acc.intersect(r, h));
+    CHECK(h.t == doctest::Approx(1.0f));
+    CHECK(prim_kind(h.prim) == PrimKind::box);
+    Ray out{{-3, 0, 0}, {1, 0, 0}};
+    REQUIRE(acc.intersect(out, h));
+    CHECK(h.t == doctest::Approx(2.0f));
+}
+
+TEST_CASE("axis-parallel rays with the origin on a node's slab plane are not lost") {
+    // A grid of unit squares in z = 0: rays along -z start exactly on the x/y
+    // planes shared by neighbouring boxes (0 * inf = NaN in the slab test).
+    TriangleMesh m;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const auto b = uint32_t(m.positions.size());
+            const Vec3 o(float(x), float(y), 0);
+            m.positions.insert(m.positions.end(), {o, o + Vec3(1, 0, 0), o + Vec3(1, 1, 0), o + Vec3(0, 1, 0)});
+            m.indices.insert(m.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+        }
+    Scene scene = scene_from_mesh(m);
+    const Accelerator acc(scene);
+    int missed = 0;
+    for (int y = 0; y <= 16; ++y)
+        for (int x = 0; x <= 16; ++x) {
+            const float px = float(x) * 0.5f, py = float(y) * 0.5f;
+            if (px >= 8 || py >= 8 || px <= 0 || py <= 0) continue;
+            Ray r{{px, py, 1}, {0, 0, -1}};
+            Hit h;
+            if (!acc.intersect(r, h) || !acc.occluded(Ray{{px, py, 1}, {0, 0, -1}})) ++missed;
+        }
+    CHECK(missed == 0);
+}
+
+TEST_CASE("pair-node box test matches the single-node test, including zero directions on slab planes") {
+    std::mt19937 rng(21);
+    std::uniform_int_distribution<int> coord(-2, 2);  // small integers: origins often exactly on planes
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0;
+    for (int i = 0; i < 200000 / kSanitizerDivisor; ++i) {
+        BvhNode child[2];
+        for (BvhNode& c : child) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};  // empty box
+            c.set_box(b);
+            c.index = 0;
+            c.count = 1;
+        }
+        BvhPairNode p{};
+        for (int c = 0; c < 2; ++c) {
+            p.x[c] = child[c].bounds[0]; p.x[c + 2] = child[c].bounds[1];
+            p.y[c] = child[c].bounds[2]; p.y[c + 2] = child[c].bounds[3];
+            p.z[c] = child[c].bounds[4]; p.z[c + 2] = child[c].bounds[5];
+        }
+        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+        const BvhRay r(ray);
+        float t_pair[2], t_single[2];
+        const int mask = intersect_bvh_pair(p, r, t_pair);
+        for (int c = 0; c < 2; ++c) {
+            const bool hit = intersect_bvh_node(child[c], r, t_single[c]);
+            if (hit != bool(mask & (1 << c)) || (hit && t_single[c] != t_pair[c])) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("generic traversal of the canonical tree with a caller-supplied leaf test") {
+    const TriangleMesh m = make_slivers(2000);
+    const Bvh bvh = build_for_mesh(m, BvhBuilder::sweep);
+    Scene scene = scene_from_mesh(m);
+    const Accelerator acc(scene);
+    int bad = 0;
+    for (const Ray& r0 : make_random_rays(mesh_bounds(m), 20000 / kSanitizerDivisor, 33)) {
+        const TriangleRay tr(r0);
+        BvhRay br(r0);
+        uint32_t best = kNoPrim;
+        auto leaf = [&](uint32_t first, uint32_t count, float& tmax) {
+            bool hit = false;
+            for (uint32_t s = first; s < first + count; ++s) {
+                const uint32_t t = bvh.prim_indices[s];
+                const uint32_t* v = &m.indices[3 * size_t(t)];
+                TriangleHit h{};
+                if (intersect_triangle(tr, TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]),
+                                       r0.tmin, tmax, h)) {
+                    tmax = h.t;
+                    best = t;
+                    hit = true;
+                }
+            }
+            return hit;
+        };
+        NoTraversalCounters none;
+        const bool found = traverse_bvh<false>(bvh, br, leaf, none);
+        BvhRay any_ray(r0);
+        const bool any = traverse_bvh<true>(bvh, any_ray, leaf, none);
+        Ray r = r0;
+        Hit h;
+        const bool ref = acc.intersect(r, h);
+        if (found != ref || any != ref || (ref && (br.tmax != h.t))) ++bad;
+        if (ref && best != prim_index(h.prim) && br.tmax != h.t) ++bad;
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("the built tree does not depend on the thread count") {
+    const TriangleMesh m = make_icosphere(5);  // 20k triangles: subtrees are built as parallel tasks
+    BvhBuildParams p;
+    p.parallel_threshold = 512;
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const Bvh one = build_for_mesh(m, BvhBuilder::binned, p);
+    omp_set_num_threads(2);
+    const Bvh two = build_for_mesh(m, BvhBuilder::binned, p);
+    omp_set_num_threads(saved);
+    CHECK(one.prim_indices == two.prim_indices);
+    const BvhPairs a = make_bvh_pairs(one), b = make_bvh_pairs(two);
+    REQUIRE(a.nodes.size() == b.nodes.size());
+    CHECK(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhPairNode)) == 0);
+}
+
+TEST_CASE("pair layout mirrors the canonical tree") {
+    const TriangleMesh m = make_icosphere(3);
+    const Bvh bvh = build_for_mesh(m, BvhBuilder::binned);
+    const BvhPairs pairs = make_bvh_pairs(bvh);
+    CHECK(pairs.nodes.size() == compute_bvh_stats(bvh).leaves - 1);
+    size_t leaf_prims = 0;
+    for (const BvhPairNode& n : pairs.nodes)
+        for (int c = 0; c < 2; ++c) {
+            leaf_prims += n.count[c];
+            if (!n.count[c]) CHECK(n.index[c] < pairs.nodes.size());
+        }
+    CHECK(leaf_prims == m.triangle_count());
+}
+
+TEST_CASE("flat loop and tree give the same answers on small scenes") {
+    Scene scene;
+    for (int i = 0; i < 4; ++i) scene.spheres.push_back(Sphere{Vec3(float(i), 0, 0), 0.4f});
+    AcceleratorOptions flat, tree;
+    flat.flat_loop_max_prims = 100;
+    tree.flat_loop_max_prims = 0;
+    const Accelerator a(scene, flat), b(scene, tree);
+    CHECK(!a.uses_tree());
+    CHECK(b.uses_tree());
+    int bad = 0;
+    for (const Ray& r0 : make_random_rays(a.bounds(), 20000, 3)) {
+        Ray r1 = r0, r2 = r0;
+        Hit h1, h2;
+        if (a.intersect(r1, h1) != b.intersect(r2, h2) || h1.prim != h2.prim || h1.t != h2.t) ++bad;
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("counted traversal gives the same hits and counts work") {
+    Scene scene = scene_from_mesh(make_icosphere(4));
+    const Accelerator acc(scene);
+    TraversalCounters c;
+    int bad = 0;
+    const std::vector<Ray> rays = make_random_rays(acc.bounds(), 2000, 9);
+    for (const Ray& r0 : rays) {
+        Ray r1 = r0, r2 = r0;
+        Hit h1, h2;
+        if (acc.intersect(r1, h1) != acc.intersect_counted(r2, h2, c) || h1.prim != h2.prim) ++bad;
+        if (acc.occluded(r0) != acc.occluded_counted(r0, c)) ++bad;
+    }
+    CHECK(bad == 0);
+    CHECK(c.nodes_visited >= 2 * rays.size());
+    CHECK(c.prims_tested > 0);
+}
+
+TEST_CASE("empty scene") {
+    Scene scene;
+    const Accelerator acc(scene);
+    Ray r{{0, 0, 0}, {1, 0, 0}};
+    Hit h;
+    CHECK(!acc.intersect(r, h));
+    CHECK(!acc.occluded(r));
+}
+
+// ---- sahara vs Embree and the tool commands --------------------------------
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "app/bench_rays.h"
+#include "app/commands.h"
+#include "app/ray_batch.h"
+
+namespace {
+
+/// Runs a command with stdout captured into a string (via a temporary file).
+template <class Fn>
+std::pair<int, std::string> run_captured(Fn fn, std::vector<std::string> args) {
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    const auto path = std::filesystem::temp_directory_path() / ("sahara_capture_" + std::to_string(::getpid()));
+    std::fflush(stdout);
+    const int saved = ::dup(1);
+    std::FILE* f = std::fopen(path.string().c_str(), "w");
+    ::dup2(::fileno(f), 1);
+    const int code = fn(int(argv.size()), argv.data());
+    std::fflush(stdout);
+    ::dup2(saved, 1);
+    ::close(saved);
+    std::fclose(f);
+    std::ifstream in(path);
+    std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::filesystem::remove(path);
+    return {code, out};
+}
+
+std::filesystem::path temp_dir(const std::string& name) {
+    const auto dir = std::filesystem::temp_directory_path() / ("sahara_" + name + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+void write_file(const std::filesystem::path& p, const void* data, size_t bytes) {
+    std::ofstream out(p, std::ios::binary);
+    out.write(static_cast<const char*>(data), std::streamsize(bytes));
+}
+
+}  // namespace
+
+TEST_CASE("sahara agrees with Embree on the shared meshes (bench ray sets)") {
+    if (!EmbreeReference::available()) {
+        MESSAGE("built without Embree: skipped");
+        return;
+    }
+    const int side = kSanitized ? 48 : 128;
+    for (const auto& f : shared_obj_files()) {
+        const TriangleMesh mesh = read_obj_triangles(f);
+        Scene scene = scene_from_mesh(mesh);
+        const Accelerator acc(scene);
+        const EmbreeReference embree(mesh.positions, mesh.indices);
+        const BenchRaySets sets = make_bench_rays(mesh, acc, side, side);
+        for (int s = 0; s < 3; ++s) {
+            const std::vector<Ray>& rays = s == 0 ? sets.primary : s == 1 ? sets.diffuse : sets.shadow;
+            RayAnswers a, b;
+            trace_sahara(acc, rays, s == 2, 2, true, a);
+            trace_embree(embree, rays, s == 2, 2, true, b);
+            const Disagreements d = compare_answers(a, b, rays, mesh);
+            INFO(f.string(), " set ", s, " ties ", d.ties, " confirmed for sahara ", d.confirmed_for_a);
+            CHECK(d.total == 0);
+            CHECK(a.hits() > 0);
+        }
+    }
+}
+
+TEST_CASE("compare_answers counts hit/miss, t and primitive differences") {
+    TriangleMesh mesh = make_icosphere(1);
+    std::vector<Ray> rays(4, Ray{{0, 0, 5}, {0, 0, -1}});
+    RayAnswers a{{4.0f, kInfinity, 4.0f, 4.0f}, {1, kNoPrim, 2, 3}};
+    RayAnswers b{{4.0f, 4.0f, 4.5f, 4.0f}, {1, 7, 2, 9}};
+    const Disagreements d = compare_answers(a, b, rays, mesh);
+    // ray 1: b hits, a misses, but double precision says the ray hits the sphere: not for a.
+    // ray 2: t differs by 12%; ray 3: another primitive at the same t is a tie.
+    CHECK(d.ties == 1);
+    CHECK(d.total + d.confirmed_for_a == 2);
+    CHECK(d.total >= 1);
+}
+
+TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
+    const auto dir = temp_dir("trace");
+    const auto obj = dir / "quad.obj", rays_file = dir / "in.rays", hits = dir / "out.hits", occl = dir / "out.occl";
+    {
+        std::ofstream o(obj);
+        o << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 5 5 5\nf 1 2 3 4\n";  // degenerate first: index 0
+    }
+    const float rays[3][8] = {{0.8f, 0.2f, 1, 0, 0, -1, 0, 100},   // triangle (v0,v1,v2) = index 1
+                              {0.2f, 0.8f, 1, 0, 0, -1, 0, 100},   // triangle (v0,v2,v3) = index 2
+                              {3.0f, 3.0f, 1, 0, 0, -1, 0, 100}};  // miss
+    write_file(rays_file, rays, sizeof(rays));
+    auto run = [&](std::vector<std::string> args) { return run_captured(run_trace_command, std::move(args)).first; };
+    REQUIRE(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", hits.string(), "--occlusion",
+                 occl.string()}) == 0);
+    std::ifstream h(hits, std::ios::binary);
+    const std::vector<char> hb((std::istreambuf_iterator<char>(h)), std::istreambuf_iterator<char>());
+    REQUIRE(hb.size() == 24);
+    float t[3];
+    uint32_t prim[3];
+    for (int i = 0; i < 3; ++i) {
+        std::memcpy(&t[i], &hb[size_t(8 * i)], 4);
+        std::memcpy(&prim[i], &hb[size_t(8 * i + 4)], 4);
+    }
+    CHECK(t[0] == doctest::Approx(1.0f));
+    CHECK(prim[0] == 1);
+    CHECK(prim[1] == 2);
+    CHECK(std::isinf(t[2]));
+    CHECK(prim[2] == kNoPrim);
+    std::ifstream oc(occl, std::ios::binary);
+    const std::vector<char> ob((std::istreambuf_iterator<char>(oc)), std::istreambuf_iterator<char>());
+    CHECK(ob == std::vector<char>{1, 1, 0});
+    // Bad input: exit 2, and no output left behind.
+    const auto out2 = dir / "bad.hits";
+    write_file(dir / "short.rays", rays, 33);
+    CHECK(run({"trace", obj.string(), "--rays", (dir / "short.rays").string(), "--hits", out2.string()}) == 2);
+    float nan_ray[8] = {0, 0, 1, 0, 0, -1, 0, std::nanf("")};
+    write_file(dir / "nan.rays", nan_ray, sizeof(nan_ray));
+    CHECK(run({"trace", obj.string(), "--rays", (dir / "nan.rays").string(), "--hits", out2.string()}) == 2);
+    CHECK(run({"trace", (dir / "missing.obj").string(), "--rays", rays_file.string(), "--hits", out2.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", (dir / "missing.rays").string(), "--hits", out2.string()}) == 2);
+    CHECK(!std::filesystem::exists(out2));
+    CHECK(run({"trace", obj.string(), "--hits", out2.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--bogus"}) == 2);
+    const auto help = run_captured(run_trace_command, {"trace", "--help"});
+    CHECK(help.first == 0);
+    CHECK(help.second.find("fan-split") != std::string::npos);
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("bvh and bench commands: JSON output, usage errors") {
+    const std::string mesh = SAHARA_ASSETS_DIR "/obj/suzanne/suzanne.obj";
+    const auto bvh = run_captured(run_bvh_command, {"bvh", mesh, "--builder", "sweep", "--size", "32", "--json"});
+    REQUIRE(bvh.first == 0);
+    for (const char* key : {"\"primitives\"", "\"nodes\"", "\"leaves\"", "\"max_depth\"", "\"sah_cost\"", "\"build_ms\"",
+                            "\"bytes\"", "\"leaf_size_histogram\"", "\"nodes_visited\"", "\"prims_tested\""})
+        CHECK(bvh.second.find(key) != std::string::npos);
+    const auto text = run_captured(run_bvh_command, {"bvh", mesh, "--size", "16"});
+    CHECK(text.first == 0);
+    CHECK(text.second.find("SAH cost") != std::string::npos);
+    CHECK(run_captured(run_bvh_command, {"bvh", mesh, "--builder", "fast"}).first == 2);
+    CHECK(run_captured(run_bvh_command, {"bvh"}).first == 2);
+    CHECK(run_captured(run_bvh_command, {"bvh", "/nonexistent.obj"}).first == 2);
+    CHECK(run_captured(run_bvh_command, {"bvh", "--help"}).first == 0);
+
+    const auto bench = run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--threads", "2",
+                                                        "--json"});
+    REQUIRE(bench.first == 0);
+    for (const char* key : {"\"mesh\"", "\"primitives\"", "\"threads\":2", "\"build_ms\"", "\"primary\"", "\"diffuse\"",
+                            "\"shadow\"", "\"mrays_s\"", "\"hit_rate\""})
+        CHECK(bench.second.find(key) != std::string::npos);
+    if (EmbreeReference::available()) {
+        CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
+        CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
+    }
+    const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays", "shadow",
+                                                       "--no-embree"});
+    CHECK(only.first == 0);
+    CHECK(only.second.find("primary") == std::string::npos);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--rays", "sideways"}).first == 2);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--threads", "0"}).first == 2);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--frobnicate"}).first == 2);
+    CHECK(run_captured(run_bench_command, {"bench", "--help"}).first == 0);
+}
