@@ -1,3 +1,5 @@
+#include <omp.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +18,7 @@
 #include "io/image_io.h"
 #include "render/progress.h"
 #include "render/renderer.h"
+#include "render/bvh_cost.h"
 #include "render/stats.h"
 #include "render/tonemap.h"
 #include "scene/scene_parser.h"
@@ -29,12 +32,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-/// Integrators that are parsed from scene files but not implemented yet are
-/// refused up front rather than silently replaced by another.
-void check_integrator(IntegratorType t) {
-    if (t == IntegratorType::bvh_cost) throw InputError("integrator 'bvh-cost' is not supported yet");
-}
 
 /// Wall time of each phase, for --stats.
 struct PhaseTimes {
@@ -185,6 +182,16 @@ void print_stats(const RenderJob& job, const RenderResult& r) {
     s.print(stderr);
 }
 
+/// The bvh-cost inspection image: one primary ray per pixel, no sampling.
+int write_bvh_cost(const RenderArgs& a, const Scene& scene) {
+    const BvhCostImage img = render_bvh_cost(scene, scene.render.width, scene.render.height, a.threads > 0 ? a.threads : omp_get_max_threads());
+    write_image(a.output, img.width, img.height, img.rgb, {{"integrator", "bvh-cost"}, {"version", SAHARA_VERSION}});
+    if (!a.quiet)
+        std::fprintf(stderr, "sahara: bvh-cost %dx%d: mean %.1f, max %.0f nodes + primitives per primary ray -> %s\n",
+                     scene.render.width, scene.render.height, img.mean_cost, img.max_cost, a.output.c_str());
+    return 0;
+}
+
 /// Renders, writes the output (and the resumable partial file if needed), reports.
 int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     const RenderArgs& a = job.args;
@@ -285,11 +292,12 @@ int render_one(const RenderArgs& a, const std::function<SceneDesc()>& load_scene
             desc.camera.shutter_open += float(*a.frame);
             desc.camera.shutter_close += float(*a.frame);
         }
-        check_integrator(desc.render.integrator);
         times.load = seconds_since(t);
         t = Clock::now();
         const Scene scene = build_scene(desc);
         times.build = seconds_since(t);
+        // One primary ray per pixel: rank 0 alone draws it.
+        if (scene.render.integrator == IntegratorType::bvh_cost) return root ? write_bvh_cost(a, scene) : 0;
         Film film(scene.render.width, scene.render.height);
         RenderJob job(a, scene, film);
         job.times = times;
