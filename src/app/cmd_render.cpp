@@ -3,9 +3,11 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "app/commands.h"
+#include "app/mpi_render.h"
 #include "app/preview.h"
 #include "app/render_args.h"
 #include "app/render_file.h"
@@ -50,17 +52,33 @@ struct RenderJob {
     std::unique_ptr<Preview> preview;
     int snapshots = 0;
     Clock::time_point last_checkpoint = Clock::now();
+    MpiSession* mpi = nullptr;  ///< set when the render is split across MPI ranks
 };
 
+/// Copies a consistent film out of a running render.
+using SnapshotFn = std::function<void(Film&)>;
+
 /// Writes a consistent copy of the film while the render runs.
-void write_snapshot(RenderJob& job, RenderSession& session, const fs::path& file) {
+void write_snapshot(RenderJob& job, const SnapshotFn& snapshot, double elapsed, const fs::path& file) {
     Film copy(job.film.width(), job.film.height());
-    session.snapshot(copy);
+    snapshot(copy);
     RenderResult partial;
     partial.spp_done = int(min_sample_count(copy));
     partial.stop = StopReason::interrupted;
-    write_render(file, job.scene, copy, render_metadata(job.scene, copy, partial,
-                                                        job.previous_seconds + session.elapsed_seconds()));
+    write_render(file, job.scene, copy, render_metadata(job.scene, copy, partial, job.previous_seconds + elapsed));
+}
+
+void write_snapshot(RenderJob& job, RenderSession& session, const fs::path& file) {
+    write_snapshot(job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds(), file);
+}
+
+/// --checkpoint: the output (and the resumable OUT.partial.exr) every so often.
+void maybe_checkpoint(RenderJob& job, const SnapshotFn& snapshot, double elapsed) {
+    if (!job.args.checkpoint_s || seconds_since(job.last_checkpoint) < *job.args.checkpoint_s) return;
+    const fs::path out(job.args.output);
+    write_snapshot(job, snapshot, elapsed, out);
+    if (out.extension() != ".exr") write_snapshot(job, snapshot, elapsed, partial_path(out));
+    job.last_checkpoint = Clock::now();
 }
 
 void on_tick(RenderJob& job, RenderSession& session) {
@@ -75,12 +93,39 @@ void on_tick(RenderJob& job, RenderSession& session) {
             log_info("snapshot written to " + snap.string());
         }
     }
-    if (job.args.checkpoint_s && seconds_since(job.last_checkpoint) >= *job.args.checkpoint_s) {
-        const fs::path out(job.args.output);
-        write_snapshot(job, session, out);
-        if (out.extension() != ".exr") write_snapshot(job, session, partial_path(out));
-        job.last_checkpoint = Clock::now();
-    }
+    maybe_checkpoint(job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds());
+}
+
+// --- MPI: one image across ranks (see app/mpi_render.h) ----------------------
+
+/// Rank 0's render of a distributed job: every rank renders tiles, rank 0
+/// checkpoints. Ranks lost on the way are reported and end the job after writing.
+RenderResult render_distributed(RenderJob& job, const RenderOptions& local) {
+    if (job.preview) log_warning("--preview is not available when rendering across MPI ranks");
+    job.preview.reset();
+    DistributedOptions options;
+    options.threads = local.threads;
+    options.progress = local.progress;
+    options.stop = local.stop;
+    options.on_tick = [&job](DistributedRender& d) {
+        maybe_checkpoint(job, [&d](Film& f) { d.snapshot(f); }, d.elapsed_seconds());
+    };
+    DistributedRender render(*job.mpi, job.scene, job.film, options);
+    const RenderResult r = render.run();
+    if (render.lost_ranks() > 0) job.mpi->abort_at_exit(kExitInterrupted);
+    if (job.args.stats) std::fprintf(stderr, "Ranks (%d):\n%s", job.mpi->size(), render.rank_report().c_str());
+    return r;
+}
+
+/// The scene must be the same on every rank: rank 0 compares the others'
+/// identity (scene file hash, seed, size, spp...) with its own. Collective.
+bool ranks_agree(const MpiSession& mpi, const Scene& scene) {
+    std::string id;
+    for (const auto& [k, v] : render_identity(scene)) id += k + "=" + v + ";";
+    id += "spp=" + std::to_string(scene.render.spp) + ";sampler=" + std::to_string(int(scene.render.sampler));
+    const bool same = mpi.broadcast(id) == id;
+    if (!same) std::fprintf(stderr, "sahara: rank %d: the scene or settings differ from rank 0's\n", mpi.rank());
+    return mpi.all_ok(same);
 }
 
 std::string final_line(const RenderJob& job, const RenderResult& r, double est_error, double true_error) {
@@ -165,7 +210,8 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     options.stop = &signal_stop;
     options.on_tick = [&job](RenderSession& s) { on_tick(job, s); };
     reset_counters();
-    const RenderResult result = render_image(job.scene, job.film, options);
+    const RenderResult result =
+        job.mpi ? render_distributed(job, options) : render_image(job.scene, job.film, options);
     job.times.render = result.seconds;
 
     const double est_error = estimated_relative_error(job.film);
@@ -225,30 +271,83 @@ int run_render_command(const std::vector<std::string>& args) {
     return run_render(a, [&a] { return a.scene ? parse_scene_file(*a.scene) : default_scene(); });
 }
 
-int run_render(const RenderArgs& a, const std::function<SceneDesc()>& load_scene) {
-    const std::atomic<bool>& signal_stop = install_stop_signals();
+namespace {
+
+/// Loads, builds and renders one image: the whole job in one process, or
+/// rank `mpi.rank()`'s part of it when `distributed`.
+int render_one(const RenderArgs& a, const std::function<SceneDesc()>& load_scene, MpiSession& mpi, bool distributed,
+               const std::atomic<bool>& signal_stop) {
+    const bool root = !distributed || mpi.rank() == 0;
+    bool agreed = false;
     try {
-        set_log_quiet(a.quiet);
-        check_output_path(a.output);
-        if (a.preview_dump) check_output_path(fs::path(*a.preview_dump).replace_extension(".png"));
+        set_log_quiet(a.quiet || !root);
+        if (root) check_output_path(a.output);
+        if (root && a.preview_dump) check_output_path(fs::path(*a.preview_dump).replace_extension(".png"));
         PhaseTimes times;
         auto t = Clock::now();
         SceneDesc desc = load_scene();
         a.overrides.apply(desc.render);
+        if (a.frame) {
+            // Frame f sees the scene at times f + shutter: moving objects move on.
+            desc.camera.shutter_open += float(*a.frame);
+            desc.camera.shutter_close += float(*a.frame);
+        }
         times.load = seconds_since(t);
         t = Clock::now();
         const Scene scene = build_scene(desc);
         times.build = seconds_since(t);
-        if (scene.render.integrator == IntegratorType::bvh_cost) return write_bvh_cost(a, scene);
+        // One primary ray per pixel: rank 0 alone draws it.
+        if (scene.render.integrator == IntegratorType::bvh_cost) return root ? write_bvh_cost(a, scene) : 0;
         Film film(scene.render.width, scene.render.height);
         RenderJob job(a, scene, film);
         job.times = times;
-        if (a.resume) job.previous_seconds = resume_film(*a.resume, scene, film);
+        if (root && a.resume) job.previous_seconds = resume_film(*a.resume, scene, film);
+        if (distributed) {
+            agreed = true;
+            if (!mpi.all_ok(true) || !ranks_agree(mpi, scene)) return 2;
+            if (!root) {
+                serve_distributed_render(mpi, scene, a.threads, signal_stop);
+                return signal_stop.load() ? kExitInterrupted : 0;
+            }
+            job.mpi = &mpi;
+        }
         return run_job(job, signal_stop);
     } catch (const InputError& e) {
         std::fprintf(stderr, "sahara: error: %s\n", e.what());
+        // Before the agreement the other ranks learn of it there; after it they
+        // would wait for tiles forever.
+        if (distributed && !agreed) mpi.all_ok(false);
+        if (distributed && agreed) mpi.abort(2);
         return 2;
     }
+}
+
+/// --frames A..B: whole frames, one after another; under MPI rank r takes
+/// frames A+r, A+r+N, ... (static interleaving: neighbouring frames cost about
+/// the same, and no rank has to coordinate).
+int render_frames(const RenderArgs& a, const std::function<SceneDesc()>& load_scene, MpiSession& mpi,
+                  const std::atomic<bool>& signal_stop) {
+    const auto [first, last] = *a.frames;
+    int worst = 0;
+    for (int f = first + mpi.rank(); f <= last && !signal_stop.load(); f += mpi.size()) {
+        RenderArgs frame_args = a;
+        frame_args.frame = f;
+        frame_args.output = frame_output_name(a.output, f);
+        if (!a.quiet) log_info("frame " + std::to_string(f) + " -> " + frame_args.output);
+        const int code = render_one(frame_args, load_scene, mpi, false, signal_stop);
+        if (code == 2) return code;
+        worst = std::max(worst, code);
+    }
+    return worst;
+}
+
+}  // namespace
+
+int run_render(const RenderArgs& a, const std::function<SceneDesc()>& load_scene) {
+    const std::atomic<bool>& signal_stop = install_stop_signals();
+    MpiSession mpi;
+    if (a.frames) return render_frames(a, load_scene, mpi, signal_stop);
+    return render_one(a, load_scene, mpi, mpi.distributed(), signal_stop);
 }
 
 }  // namespace sahara

@@ -1,16 +1,18 @@
 #include "app/render_args.h"
 
-#include "render/tonemap.h"
-
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+
+#include "render/tonemap.h"
 
 namespace sahara {
 
 const char* const kRenderUsage =
     "usage: sahara render [SCENE.json] [-o OUT.png|.exr|.hdr|.pfm] [options]\n"
     "\n"
-    "Renders SCENE (or the built-in default scene) to an image.\n"
+    "Renders SCENE (or the built-in default scene) to an image. Started by mpirun or srun\n"
+    "(MPI builds), the ranks share the image's tiles, or whole frames with --frames.\n"
     "\n"
     "  -o, --output FILE    output image (default sahara.png); the extension picks the format\n"
     "  --spp N              samples per pixel\n"
@@ -32,6 +34,10 @@ const char* const kRenderUsage =
     "  --preview            show the image in a window while it renders (Esc: stop and save,\n"
     "                       S: save a snapshot)\n"
     "  --preview-dump FILE  write the preview window's last frame to FILE (for tests)\n"
+    "  --frames A..B        render frames A to B: OUT names the files with # (frame number,\n"
+    "                       zero-padded to the run of #) or %04d; frame f shifts the camera\n"
+    "                       shutter by f (moving spheres move). Under mpirun, ranks take\n"
+    "                       whole frames; otherwise frames render one after another\n"
     "  --stats              print statistics at the end\n"
     "  --quiet              no progress and no summary line\n"
     "  -h, --help           this text\n";
@@ -78,7 +84,40 @@ const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
     return args[++i];
 }
 
+/// "A..B" (or "A") as an inclusive frame range.
+std::pair<int, int> parse_frame_range(const std::string& flag, const std::string& v) {
+    const size_t dots = v.find("..");
+    const int a = int(parse_int_value(flag, v.substr(0, dots), 0, 10000000));
+    const int b = dots == std::string::npos ? a : int(parse_int_value(flag, v.substr(dots + 2), 0, 10000000));
+    if (b < a) throw UsageError(flag + ": the range " + v + " is empty (expected A..B with A <= B)");
+    return {a, b};
+}
+
 }  // namespace
+
+std::string frame_output_name(const std::string& pattern, int frame) {
+    const std::string number = std::to_string(frame);
+    const size_t hash = pattern.find('#');
+    if (hash != std::string::npos) {
+        const size_t run = pattern.find_first_not_of('#', hash);
+        const size_t width = (run == std::string::npos ? pattern.size() : run) - hash;
+        const std::string padded = std::string(width > number.size() ? width - number.size() : 0, '0') + number;
+        return pattern.substr(0, hash) + padded + pattern.substr(hash + width);
+    }
+    // %d or %0Nd, parsed here rather than handed to printf (a file name is no format string).
+    for (size_t p = pattern.find('%'); p != std::string::npos; p = pattern.find('%', p + 1)) {
+        size_t q = p + 1;
+        size_t width = 0;
+        if (q < pattern.size() && pattern[q] == '0') ++q;
+        while (q < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[q])) && width < 100)
+            width = width * 10 + size_t(pattern[q++] - '0');
+        if (q < pattern.size() && pattern[q] == 'd') {
+            const std::string padded = std::string(width > number.size() ? width - number.size() : 0, '0') + number;
+            return pattern.substr(0, p) + padded + pattern.substr(q + 1);
+        }
+    }
+    throw UsageError("--frames: the output name '" + pattern + "' needs # or %04d where the frame number goes");
+}
 
 bool parse_override_flag(const std::vector<std::string>& args, size_t& i, RenderOverrides& o) {
     const std::string& a = args[i];
@@ -130,10 +169,15 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
         else if (a == "--reference") r.reference = flag_value(args, i);
         else if (a == "--preview") r.preview = true;
         else if (a == "--preview-dump") r.preview_dump = flag_value(args, i);
+        else if (a == "--frames") r.frames = parse_frame_range(a, flag_value(args, i));
         else if (parse_override_flag(args, i, r.overrides)) continue;
         else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
         else if (r.scene) throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
         else r.scene = a;
+    }
+    if (r.frames) {
+        if (r.resume) throw UsageError("--frames and --resume cannot be combined (resume one frame at a time)");
+        frame_output_name(r.output, r.frames->first);  // checks the pattern now
     }
     return r;
 }

@@ -4,6 +4,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/scene_desc.h"
@@ -42,7 +43,15 @@ struct RenderArgs {
     bool preview = false;                    ///< --preview: live window
     std::optional<std::string> preview_dump; ///< --preview-dump: write the window's last frame here
     RenderOverrides overrides;
+    // --- sequences (distributed over MPI ranks when launched by mpirun) ---
+    std::optional<std::pair<int, int>> frames;  ///< --frames A..B: render frames A to B (inclusive)
+    std::optional<int> frame;                   ///< the frame this render is (set per frame, not a flag)
 };
+
+/// The output name of frame `frame`: the first run of '#' becomes the frame
+/// number zero-padded to the run's length, or a printf-style %d / %0Nd is
+/// replaced. Throws UsageError when `pattern` has neither.
+std::string frame_output_name(const std::string& pattern, int frame);
 
 /// Parses the arguments after `render`. Throws UsageError.
 RenderArgs parse_render_args(const std::vector<std::string>& args);

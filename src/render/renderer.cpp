@@ -30,16 +30,7 @@ double luminance_d(const Vec3d& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722
 /// Takes samples [begin, end) of pixel (x, y), in index order.
 void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x, int y,
                   uint32_t begin, uint32_t end) {
-    for (uint32_t s = begin; s < end; ++s) {
-        sampler.start(uint32_t(x), uint32_t(y), s);
-        const Vec2 jitter = sampler.next_2d();
-        const Vec2 lens = sampler.next_2d();
-        const float time_u = sampler.next_1d();
-        const Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y, lens, time_u);
-        count_ray(RayKind::camera);
-        film.add_sample(x, y, estimate_radiance(scene, ray, sampler, scene.render.max_depth));
-    }
-    if (end > begin) film.add_count(x, y, end - begin);
+    render_pixel_samples(scene, camera, film, sampler, x, y, x, y, begin, end);
 }
 
 std::vector<TileRect> make_tiles(int w, int h) {
@@ -51,6 +42,20 @@ std::vector<TileRect> make_tiles(int w, int h) {
 }
 
 }  // namespace
+
+void render_pixel_samples(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x, int y, int fx,
+                          int fy, uint32_t begin, uint32_t end) {
+    for (uint32_t s = begin; s < end; ++s) {
+        sampler.start(uint32_t(x), uint32_t(y), s);
+        const Vec2 jitter = sampler.next_2d();
+        const Vec2 lens = sampler.next_2d();
+        const float time_u = sampler.next_1d();
+        const Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y, lens, time_u);
+        count_ray(RayKind::camera);
+        film.add_sample(fx, fy, estimate_radiance(scene, ray, sampler, scene.render.max_depth));
+    }
+    if (end > begin) film.add_count(fx, fy, end - begin);
+}
 
 void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_end, int threads, Progress* progress) {
     const Camera camera(scene.camera, film.width(), film.height());
@@ -129,41 +134,10 @@ void RenderSession::run_pass(const std::vector<uint32_t>* targets, uint32_t unif
     }
 }
 
-/// One round of adaptive sampling: pixels whose (3x3-smoothed) estimated error
-/// exceeds the target get more samples, as many as the 1/sqrt(n) law says they
-/// need, at most doubling per round. Returns false when no pixel needs more.
+/// One round of adaptive sampling (see adaptive_sample_targets).
 bool RenderSession::adaptive_round() {
-    const int w = film_.width(), h = film_.height();
-    const double target = *scene_.render.target_error;
-    const uint32_t cap = uint32_t(scene_.render.spp);
-    const std::vector<float> err = relative_error_map(film_);
-    std::vector<uint32_t> targets(err.size());
-    bool any = false;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            // Smoothing spreads demand to neighbours whose own estimate is luckily low.
-            double e2 = 0;
-            int n = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                    const double e = err[size_t(yy) * size_t(w) + size_t(xx)];
-                    e2 += e * e;
-                    ++n;
-                }
-            const double e = std::sqrt(e2 / n);
-            const uint32_t count = film_.count(x, y);
-            uint32_t want = count;
-            if (e > target && count < cap) {
-                const double needed = std::ceil(double(count) * (e / target) * (e / target)) - double(count);
-                const uint32_t more = uint32_t(std::clamp(needed, 4.0, double(std::max(count, 4u))));
-                want = std::min(cap, count + more);
-                any = true;
-            }
-            targets[size_t(y) * size_t(w) + size_t(x)] = want;
-        }
-    if (!any) return false;
+    std::vector<uint32_t> targets;
+    if (!adaptive_sample_targets(film_, *scene_.render.target_error, uint32_t(scene_.render.spp), targets)) return false;
     pass_target_.store(0);
     run_pass(&targets, 0);
     return true;
@@ -313,6 +287,38 @@ double relative_error_to(const Film& film, const std::vector<float>& reference_r
             sum += d * d / (ref * ref + kRelErrorEpsilon);
         }
     return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+bool adaptive_sample_targets(const Film& film, double target, uint32_t cap, std::vector<uint32_t>& targets) {
+    const int w = film.width(), h = film.height();
+    const std::vector<float> err = relative_error_map(film);
+    targets.assign(err.size(), 0);
+    bool any = false;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            // Smoothing spreads demand to neighbours whose own estimate is luckily low.
+            double e2 = 0;
+            int n = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int xx = x + dx, yy = y + dy;
+                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                    const double e = err[size_t(yy) * size_t(w) + size_t(xx)];
+                    e2 += e * e;
+                    ++n;
+                }
+            const double e = std::sqrt(e2 / n);
+            const uint32_t count = film.count(x, y);
+            uint32_t want = count;
+            if (e > target && count < cap) {
+                const double needed = std::ceil(double(count) * (e / target) * (e / target)) - double(count);
+                const uint32_t more = uint32_t(std::clamp(needed, 4.0, double(std::max(count, 4u))));
+                want = std::min(cap, count + more);
+                any = true;
+            }
+            targets[size_t(y) * size_t(w) + size_t(x)] = want;
+        }
+    return any;
 }
 
 uint32_t min_sample_count(const Film& film) {

@@ -130,4 +130,15 @@ double relative_error_to(const Film& film, const std::vector<float>& reference_r
 /// Smallest sample count of any pixel.
 uint32_t min_sample_count(const Film& film);
 
+/// Takes samples [begin, end) of image pixel (x, y), in index order, into pixel
+/// (fx, fy) of `film` (which may be a tile-sized film: distributed rendering).
+void render_pixel_samples(const Scene& scene, const class Camera& camera, Film& film, class Sampler& sampler, int x,
+                          int y, int fx, int fy, uint32_t begin, uint32_t end);
+
+/// The per-pixel sample targets of the next adaptive-sampling round: pixels
+/// whose (3x3-smoothed) estimated error exceeds `target_error` get as many more
+/// samples as the 1/sqrt(n) law says they need, at most doubling, capped at
+/// `cap`. Returns false when no pixel needs more.
+bool adaptive_sample_targets(const Film& film, double target_error, uint32_t cap, std::vector<uint32_t>& targets);
+
 }  // namespace sahara
