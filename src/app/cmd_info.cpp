@@ -8,6 +8,7 @@
 
 #include "base/error.h"
 #include "io/model_loader.h"
+#include "render/features.h"
 #include "render/stats.h"
 #include "scene/scene.h"
 #include "scene/scene_parser.h"
@@ -131,6 +132,8 @@ StatsReport scene_info(const std::optional<std::string>& input) {
     StatsReport s;
     describe_contents(s, desc, scene);
     describe_memory(s, scene);
+    const std::string features = describe_features(scene);
+    s.add("Features", "Enabled", features, features);
     s.add_seconds("Time", "Load", load);
     s.add_seconds("Time", "Build", build);
     return s;

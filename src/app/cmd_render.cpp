@@ -19,6 +19,7 @@
 #include "render/progress.h"
 #include "render/renderer.h"
 #include "render/bvh_cost.h"
+#include "render/features.h"
 #include "render/stats.h"
 #include "render/tonemap.h"
 #include "scene/scene_parser.h"
@@ -159,6 +160,8 @@ std::string final_line(const RenderJob& job, const RenderResult& r, double est_e
 void print_stats(const RenderJob& job, const RenderResult& r) {
     const Counters c = counter_totals();
     StatsReport s;
+    const std::string features = describe_features(job.scene);
+    s.add("Features", "Enabled", features, features);
     s.add_count("Render", "Camera rays", c.rays[int(RayKind::camera)]);
     s.add_count("Render", "Closest-hit rays (camera + bounce)", c.rays[int(RayKind::closest_hit)]);
     s.add_count("Render", "Shadow rays", c.rays[int(RayKind::shadow)]);
