@@ -201,7 +201,7 @@ TEST_CASE("BVH4 box test matches the single-node test, including zero directions
         if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
         const BvhRay r(ray);
         __m128 tv;
-        const int mask = intersect_bvh4(n, r, tv);
+        const int mask = intersect_bvh4(n, Bvh4Ray(r), r.tmin, r.tmax, tv);
         alignas(16) float t4[4];
         _mm_store_ps(t4, tv);
         for (int c = 0; c < 4; ++c) {

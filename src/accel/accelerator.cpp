@@ -90,8 +90,9 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
-    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, options.params)
-                      : single_leaf_bvh(prims);
+    BvhBuildParams params = options.params;
+    if (options.layout == BvhLayout::wide4) params.intersection_cost *= options.wide4_leaf_cost_scale;
+    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params) : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
     slots_.resize(slots);

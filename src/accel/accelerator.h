@@ -48,6 +48,12 @@ struct AcceleratorOptions {
     BvhLayout layout = BvhLayout::wide4;
     BvhBuilder builder = BvhBuilder::binned;
     BvhBuildParams params;
+    /// The wide4 layout builds with params.intersection_cost times this: its
+    /// leaves test four triangles per SSE step, so larger leaves pay off.
+    /// 0.5 measured best-or-equal against 0.25-1.0 with `sahara bench` on the
+    /// bunny (one thread, 2026-11-22; differences within the machine's noise
+    /// between 0.25 and 0.7, 1.0 clearly slower on diffuse rays).
+    float wide4_leaf_cost_scale = 0.5f;
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;

@@ -12,8 +12,10 @@
 /// the far distance is enlarged by 1 + 2 gamma(3) (Ize, "Robust BVH Ray
 /// Traversal", 2013). Unused child slots hold an empty box (lo = +inf,
 /// hi = -inf), which no ray with a finite origin can hit.
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <emmintrin.h>
@@ -62,26 +64,45 @@ bool cpu_has_avx2();
 /// "sse2" or "avx2".
 const char* simd_path_name(SimdPath path);
 
+/// Per-ray constants of the BVH4 box test: broadcast origin and inverse
+/// direction, and the byte offsets of each axis's near and far planes in a node.
+struct Bvh4Ray {
+    __m128 org[3], inv[3];
+    uint32_t near_off[3], far_off[3];
+
+    explicit Bvh4Ray(const BvhRay& r) {
+        const uint32_t lo[3] = {offsetof(Bvh4Node, lo_x), offsetof(Bvh4Node, lo_y), offsetof(Bvh4Node, lo_z)};
+        const uint32_t hi[3] = {offsetof(Bvh4Node, hi_x), offsetof(Bvh4Node, hi_y), offsetof(Bvh4Node, hi_z)};
+        for (int a = 0; a < 3; ++a) {
+            org[a] = _mm_set1_ps(r.org[a]);
+            inv[a] = _mm_set1_ps(r.inv_dir[a]);
+            // Near plane of an axis is `hi` for a negative direction.
+            near_off[a] = r.neg[a] ? hi[a] : lo[a];
+            far_off[a] = r.neg[a] ? lo[a] : hi[a];
+        }
+    }
+};
+
 /// Tests the four children of `n`; bit c of the result is set when child c is
-/// hit, and t_near[c] is its entry distance. Same answers as intersect_bvh_node per child.
-__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const BvhRay& r, __m128& t_near) {
-    // Near plane of an axis is `hi` for a negative direction; _mm_max_ps(x, acc)
-    // and _mm_min_ps(x, acc) return acc when x is NaN (the NaN-ignoring order).
-    __m128 t0 = _mm_set1_ps(r.tmin), t1 = _mm_set1_ps(r.tmax);
-    const float* lo[3] = {n.lo_x, n.lo_y, n.lo_z};
-    const float* hi[3] = {n.hi_x, n.hi_y, n.hi_z};
+/// hit, and lane c of t_near is then its entry distance. Same answers as
+/// intersect_bvh_node per child.
+__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin, float tmax,
+                                                         __m128& t_near) {
+    // _mm_max_ps(x, acc) and _mm_min_ps(x, acc) return acc when x is NaN (the NaN-ignoring order).
+    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+    const char* base = reinterpret_cast<const char*>(&n);
     for (int a = 0; a < 3; ++a) {
-        const __m128 org = _mm_set1_ps(r.org[a]), inv = _mm_set1_ps(r.inv_dir[a]);
-        const float* near = r.neg[a] ? hi[a] : lo[a];
-        const float* far = r.neg[a] ? lo[a] : hi[a];
-        t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(near), org), inv), t0);
-        t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(far), org), inv), t1);
+        const __m128 near = _mm_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
+        const __m128 far = _mm_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
+        t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.org[a]), r.inv[a]), t0);
+        t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, r.org[a]), r.inv[a]), t1);
     }
     t_near = t0;
     return _mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(kRobustFarScale))));
 }
 
-/// Ordered traversal of a BVH4, with the contract of traverse_bvh (bvh_traverse.h).
+/// Ordered traversal of a BVH4, with the contract of traverse_bvh (bvh_traverse.h):
+/// the nearest hit child is visited next, the others are pushed farthest first.
 template <bool kAnyHit, class Counters, class LeafFn>
 __attribute__((always_inline)) inline bool traverse_bvh4(const Bvh4& bvh, BvhRay& ray, LeafFn&& leaf,
                                                          Counters& counters) {
@@ -94,50 +115,61 @@ __attribute__((always_inline)) inline bool traverse_bvh4(const Bvh4& bvh, BvhRay
         return leaf(bvh.root.index, bvh.root.count, ray.tmax);
     }
     struct Entry {
-        uint32_t index;  ///< node index, or first slot of a leaf
+        uint32_t index;  ///< node index, or first leaf item
         uint32_t count;  ///< 0: inner node
         float t_entry;
     };
-    // Each node pops one entry and pushes at most four: 3 per level plus 4.
+    const Bvh4Ray r4(ray);
+    // Each node pushes at most three entries: 3 per level plus slack.
     Entry stack[3 * kBvhMaxDepth + 4];
     int top = 0;
     bool found = false;
-    stack[top++] = Entry{0, 0, t_root};
-    while (top > 0) {
-        const Entry e = stack[--top];
-        if (e.t_entry > ray.tmax * kRobustFarScale) continue;
-        if (e.count) {
-            counters.on_prims(e.count);
-            if (leaf(e.index, e.count, ray.tmax)) {
+    Entry cur{0, 0, t_root};
+    for (;;) {
+        if (cur.count) {
+            counters.on_prims(cur.count);
+            if (leaf(cur.index, cur.count, ray.tmax)) {
                 if constexpr (kAnyHit) return true;
                 found = true;
             }
-            continue;
-        }
-        const Bvh4Node& n = bvh.nodes[e.index];
-        if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
-            for (int c = 0; c < 4; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
-        __m128 tv;
-        int mask = intersect_bvh4(n, ray, tv);
-        if (!mask) continue;
-        alignas(16) float t[4];
-        _mm_store_ps(t, tv);
-        // Push the hit children farthest first (insertion into the stack top),
-        // so the nearest is popped next.
-        const int base = top;
-        while (mask) {
-            const int c = __builtin_ctz(unsigned(mask));
-            mask &= mask - 1;
-            const Entry in{n.child[c], n.count[c], t[c]};
-            int k = top++;
-            while (k > base && stack[k - 1].t_entry < in.t_entry) {
-                stack[k] = stack[k - 1];
-                --k;
+        } else {
+            const Bvh4Node& n = bvh.nodes[cur.index];
+            if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
+                for (int c = 0; c < 4; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
+            __m128 tv;
+            int mask = intersect_bvh4(n, r4, ray.tmin, ray.tmax, tv);
+            if (mask) {
+                alignas(16) float t[4];
+                _mm_store_ps(t, tv);
+                int c = __builtin_ctz(unsigned(mask));
+                mask &= mask - 1;
+                cur = Entry{n.child[c], n.count[c], t[c]};
+                if (!mask) continue;  // one child hit: no ordering, no stack
+                // Insert the others into the stack top sorted by distance (farthest
+                // deepest); the nearest of all becomes `cur`.
+                const int base = top;
+                do {
+                    c = __builtin_ctz(unsigned(mask));
+                    mask &= mask - 1;
+                    Entry in{n.child[c], n.count[c], t[c]};
+                    if (in.t_entry < cur.t_entry) std::swap(in, cur);
+                    int k = top++;
+                    while (k > base && stack[k - 1].t_entry < in.t_entry) {
+                        stack[k] = stack[k - 1];
+                        --k;
+                    }
+                    stack[k] = in;
+                } while (mask);
+                continue;
             }
-            stack[k] = in;
+        }
+        // Pop the nearest pending entry that can still hold a closer hit.
+        for (;;) {
+            if (top == 0) return found;
+            cur = stack[--top];
+            if (cur.t_entry <= ray.tmax * kRobustFarScale) break;
         }
     }
-    return found;
 }
 
 }  // namespace sahara
