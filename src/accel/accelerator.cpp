@@ -31,7 +31,7 @@ struct PrimitiveList {
 PrimitiveList collect_primitives(const Scene& scene) {
     PrimitiveList list;
     const TriangleSoup& soup = scene.triangles;
-    const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size();
+    const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
     list.boxes.reserve(n);
     list.centers.reserve(n);
     list.ids.reserve(n);
@@ -44,6 +44,8 @@ PrimitiveList collect_primitives(const Scene& scene) {
         list.add(scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
                  make_prim_id(PrimKind::sphere, i));
     for (uint32_t i = 0; i < scene.boxes.size(); ++i) list.add(scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+    for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
+        list.add(scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
 }
 
@@ -84,7 +86,7 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
 }
 
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
-    : spheres_(scene.spheres) {
+    : spheres_(scene.spheres), quadrics_(scene.quadrics) {
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
@@ -146,12 +148,12 @@ void Accelerator::make_leaf_blocks() {
 }
 
 size_t Accelerator::bytes() const {
+    const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
+                         quadrics_.size() * sizeof(Quadric);
     // The wide4 layout traverses blocks_ instead of slots_ (kept for brute force and other kinds).
-    if (layout_ == BvhLayout::wide4)
-        return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + spheres_.size() * sizeof(Sphere) +
-               boxes_.size() * sizeof(Bounds3);
-    return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
-           spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3);
+    if (layout_ == BvhLayout::wide4) return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + other;
+    return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
+           bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
 }
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in `hit`.
@@ -181,6 +183,15 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
             case PrimKind::box:
                 if (!intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t)) continue;
                 break;
+            case PrimKind::quadric: {
+                Ray r = ray;
+                r.tmax = tmax;
+                const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
+                if (!qh.hit()) continue;
+                t = qh.t;
+                u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
+                break;
+            }
             case PrimKind::plane:
                 continue;  // unbounded: never in the tree
         }

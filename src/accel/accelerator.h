@@ -14,6 +14,7 @@
 #include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"
 #include "geometry/hit.h"
+#include "geometry/quadric.h"
 #include "geometry/sphere.h"
 #include "geometry/triangle.h"
 #include "math/bounds.h"
@@ -123,6 +124,7 @@ private:
     std::vector<Slot> slots_;                ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
     std::vector<Sphere> spheres_;            ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;             ///< copy of Scene::boxes (indexed by box index)
+    std::vector<Quadric> quadrics_;          ///< copy of Scene::quadrics (indexed by quadric index)
     Bounds3 bounds_;
     bool uses_tree_ = false;
     double build_ms_ = 0;

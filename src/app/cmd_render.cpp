@@ -31,9 +31,7 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 /// Integrators that are parsed from scene files but not implemented yet are
 /// refused up front rather than silently replaced by another.
 void check_integrator(IntegratorType t) {
-    if (t == IntegratorType::whitted || t == IntegratorType::bvh_cost)
-        throw InputError("integrator '" + std::string(t == IntegratorType::whitted ? "whitted" : "bvh-cost") +
-                         "' is not supported yet");
+    if (t == IntegratorType::bvh_cost) throw InputError("integrator 'bvh-cost' is not supported yet");
 }
 
 /// Wall time of each phase, for --stats.

@@ -9,12 +9,14 @@ namespace sahara {
 
 inline constexpr uint32_t kNoPrim = 0xFFFFFFFFu;
 
-/// Primitive ids carry their kind in the top two bits so that a leaf can hold
-/// mixed primitives and dispatch with a switch (no virtual call per test).
-enum class PrimKind : uint32_t { triangle = 0, sphere = 1, box = 2, plane = 3 };
-inline constexpr uint32_t kPrimIndexMask = 0x3FFFFFFFu;
-constexpr uint32_t make_prim_id(PrimKind kind, uint32_t index) { return (uint32_t(kind) << 30) | index; }
-constexpr PrimKind prim_kind(uint32_t id) { return PrimKind(id >> 30); }
+/// Primitive ids carry their kind in the top three bits so that a leaf can hold
+/// mixed primitives and dispatch with a switch (no virtual call per test); the
+/// other 29 bits index the kind's array (up to 536M primitives per kind).
+enum class PrimKind : uint32_t { triangle = 0, sphere = 1, box = 2, plane = 3, quadric = 4 };
+inline constexpr int kPrimKindShift = 29;
+inline constexpr uint32_t kPrimIndexMask = (1u << kPrimKindShift) - 1u;
+constexpr uint32_t make_prim_id(PrimKind kind, uint32_t index) { return (uint32_t(kind) << kPrimKindShift) | index; }
+constexpr PrimKind prim_kind(uint32_t id) { return PrimKind(id >> kPrimKindShift); }
 constexpr uint32_t prim_index(uint32_t id) { return id & kPrimIndexMask; }
 
 struct Hit {

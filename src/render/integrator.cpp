@@ -3,6 +3,8 @@
 #include "geometry/spawn.h"
 #include "math/sampling.h"
 #include "render/background.h"
+#include "render/bsdf.h"
+#include "render/lights.h"
 #include "render/texture.h"
 
 namespace sahara {
@@ -12,51 +14,220 @@ namespace {
 /// Paths shorter than this never face Russian roulette.
 constexpr int kRouletteStartDepth = 4;
 
-}  // namespace
+/// What light sampling a kernel does. `none`: the scene has nothing to sample
+/// (or BSDF sampling only is forced); `delta`: point/directional lights only,
+/// so no MIS is ever needed; `mis`: everything; `light_only`: for tests.
+enum class Strategy : uint8_t { none, delta, mis, light_only };
 
-Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
-    Rgb radiance(0.0f), throughput(1.0f);
+/// Weight of emission found by BSDF sampling from a non-delta vertex whose
+/// direction light sampling could also have produced with density light_pdf.
+template <Strategy S>
+float hit_weight(float bsdf_pdf, float light_pdf) {
+    if constexpr (S == Strategy::mis) return power_heuristic(bsdf_pdf, light_pdf);
+    else if constexpr (S == Strategy::light_only) return 0.0f;
+    else return 1.0f;
+}
+
+/// The Lambertian-only kernels' BSDF: no dispatch, no frame until sampling.
+struct LambertShading {
+    Rgb albedo;
+    Vec3 ns, ng;
+    bool is_delta() const { return false; }
+};
+
+inline Rgb eval_shading(const LambertShading& b, const Vec3&, const Vec3& wi, float* pdf) {
+    const float cos = dot(wi, b.ns);
+    if (dot(wi, b.ng) <= 0 || cos <= 0) {
+        *pdf = 0;
+        return Rgb(0.0f);
+    }
+    *pdf = cos * kInvPi;
+    return b.albedo * (cos * kInvPi);
+}
+inline Rgb eval_shading(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) { return eval_bsdf(b, wo, wi, pdf); }
+
+inline bool sample_shading(const LambertShading& b, const Vec3&, Sampler& sampler, BsdfSample& bs) {
+    const Vec3 local = sample_cosine_hemisphere(sampler.next_2d());
+    bs.wi = Frame(b.ns).to_world(local);
+    bs.weight = b.albedo;
+    bs.pdf = local.z * kInvPi;
+    return dot(bs.wi, b.ng) > 0;  // below the geometric surface: absorbed
+}
+inline bool sample_shading(const Bsdf& b, const Vec3& wo, Sampler& sampler, BsdfSample& bs) {
+    const Vec2 u = sampler.next_2d();
+    return sample_bsdf(b, wo, u, sampler.next_1d(), bs);
+}
+
+template <bool kLambertOnly>
+auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+    if constexpr (kLambertOnly) return LambertShading{eval_color(m.albedo, textures, si.p, si.uv), si.ns, si.ng};
+    else return make_bsdf(m, si, textures);
+}
+
+/// Next-event estimation at a non-delta vertex: one emitter, one shadow ray.
+template <Strategy S, class Shading>
+Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading& bsdf, const Vec3& wo, float time,
+                 float u_select, Vec2 u) {
+    LightSample ls;
+    if (!sample_light(scene, si.p, time, u_select, u, ls)) return Rgb(0.0f);
+    float bsdf_pdf = 0;
+    const Rgb f_cos = eval_shading(bsdf, wo, ls.wi, &bsdf_pdf);
+    if (max_component(f_cos) <= 0 || max_component(ls.li) <= 0) return Rgb(0.0f);
+    if (scene.occluded(shadow_ray(si.p, si.ng, ls, time))) return Rgb(0.0f);
+    const float w = (S == Strategy::mis && !ls.delta) ? power_heuristic(ls.pdf, bsdf_pdf) : 1.0f;
+    return f_cos * ls.li * (w / ls.pdf);
+}
+
+/// Where the previous scattering event was, for MIS weights of emission found next.
+struct PrevVertex {
+    Vec3 p;
+    float pdf = 0;
+    bool delta = true;  // emitters seen by the camera or through a mirror count fully
+};
+
+/// Emission of an emissive surface hit by the path, MIS-weighted against light sampling.
+template <Strategy S>
+Rgb hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const SurfaceInteraction& si,
+                 const MaterialDesc& mat, const PrevVertex& prev) {
+    if (!si.front_face) return Rgb(0.0f);
+    float w = 1;
+    if constexpr (S == Strategy::mis || S == Strategy::light_only) {
+        const uint32_t e = emitter_of_hit(scene, hit);
+        if (!prev.delta && e != kNoEmitter)
+            w = hit_weight<S>(prev.pdf, area_light_pdf(scene, e, prev.p, si.p, si.ng, ray.time));
+    }
+    return eval_color(mat.radiance, scene.textures, si.p, si.uv) * w;
+}
+
+/// The background seen by a path that leaves the scene, MIS-weighted against envmap sampling.
+template <Strategy S>
+Rgb escaped(const Scene& scene, const Ray& ray, const PrevVertex& prev) {
+    float w = 1;
+    if constexpr (S == Strategy::mis || S == Strategy::light_only)
+        if (!prev.delta && scene.envmap_emitter != kNoEmitter)
+            w = hit_weight<S>(prev.pdf, envmap_light_pdf(scene, ray.dir));
+    return eval_background(scene.background, ray.dir) * w;
+}
+
+/// One path. D rays at most, camera ray included; a shadow ray counts as the
+/// next ray, so direct light is gathered only below max_depth.
+template <Strategy S, bool kLambertOnly>
+Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
+    // The plain Lambertian kernel is chosen only for scenes without any emission.
+    constexpr bool kEmission = !(S == Strategy::none && kLambertOnly);
+    Rgb radiance(0.0f), beta(1.0f);
+    float eta_scale = 1;  // undoes the 1/eta^2 of refraction for Russian roulette
+    PrevVertex prev;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
         if (!scene.intersect(ray, hit)) {
-            radiance += throughput * eval_background(scene.background, ray.dir);
+            radiance += beta * escaped<S>(scene, ray, prev);
             break;
         }
         const SurfaceInteraction si = scene.interact(ray, hit);
         const MaterialDesc& mat = scene.materials[si.material];
         if (mat.type == MaterialType::emissive) {
-            if (si.front_face) radiance += throughput * eval_color(mat.radiance, scene.textures, si.p, si.uv);
+            if constexpr (kEmission) radiance += beta * hit_emission<S>(scene, ray, hit, si, mat, prev);
             break;
         }
+        if constexpr (kEmission) radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if (depth == max_depth) break;
-        const Vec3 wi = Frame(si.ns).to_world(sample_cosine_hemisphere(sampler.next_2d()));
-        if (dot(wi, si.ng) <= 0.0f) break;  // below the geometric surface: absorbed
-        throughput *= eval_color(mat.albedo, scene.textures, si.p, si.uv);
-        if (depth >= kRouletteStartDepth) {
-            const float survive = std::min(1.0f, max_component(throughput));
-            if (sampler.next_1d() >= survive) break;
-            throughput /= survive;
+
+        const Vec3 wo = -ray.dir;
+        const auto bsdf = make_shading<kLambertOnly>(mat, si, scene.textures);
+        if constexpr (S != Strategy::none) {
+            const float u_select = sampler.next_1d();
+            const Vec2 u_light = sampler.next_2d();
+            if (!bsdf.is_delta()) radiance += beta * direct_light<S>(scene, si, bsdf, wo, ray.time, u_select, u_light);
         }
-        ray = Ray{offset_ray_origin(si.p, si.ng), wi, 0.0f, kInfinity, ray.time};
+        BsdfSample bs;
+        if (!sample_shading(bsdf, wo, sampler, bs)) break;
+        beta *= bs.weight;
+        eta_scale *= bs.eta_scale;
+        prev = PrevVertex{si.p, bs.pdf, bs.delta};
+        if (depth >= kRouletteStartDepth) {
+            const float survive = std::min(1.0f, max_component(beta) * eta_scale);
+            if (sampler.next_1d() >= survive) break;
+            beta /= survive;
+        }
+        ray = Ray{offset_ray_origin(si.p, bs.transmit ? -si.ng : si.ng), bs.wi, 0.0f, kInfinity, ray.time};
     }
     return radiance;
 }
 
+/// The kernels a scene can get; chosen once per scene from its features.
+enum class PathKernel : uint8_t { plain_lambert, plain, delta_lambert, delta, mis_lambert, mis };
+
+PathKernel choose_kernel(const SceneFeatures& f) {
+    if (f.has_area_lights || f.has_envmap) return f.lambertian_only ? PathKernel::mis_lambert : PathKernel::mis;
+    if (f.has_lights) return f.lambertian_only ? PathKernel::delta_lambert : PathKernel::delta;
+    // The plain Lambertian kernel skips emission altogether.
+    return f.lambertian_only && !f.has_emitters ? PathKernel::plain_lambert : PathKernel::plain;
+}
+
+}  // namespace
+
+Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
+    switch (choose_kernel(scene.features)) {
+        case PathKernel::plain_lambert: return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth);
+        case PathKernel::plain: return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+        case PathKernel::delta_lambert: return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth);
+        case PathKernel::delta: return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth);
+        case PathKernel::mis_lambert: return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth);
+        case PathKernel::mis: break;
+    }
+    return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
+}
+
+Rgb path_trace_with(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, LightStrategy strategy) {
+    switch (strategy) {
+        case LightStrategy::bsdf_only: return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+        case LightStrategy::light_only: return path_kernel<Strategy::light_only, false>(scene, ray, sampler, max_depth);
+        case LightStrategy::mis: break;
+    }
+    return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
+}
+
+const char* path_kernel_name(const Scene& scene) {
+    switch (choose_kernel(scene.features)) {
+        case PathKernel::plain_lambert: return "path<no light sampling, lambertian only>";
+        case PathKernel::plain: return "path<no light sampling, all materials>";
+        case PathKernel::delta_lambert: return "path<delta lights, lambertian only>";
+        case PathKernel::delta: return "path<delta lights, all materials>";
+        case PathKernel::mis_lambert: return "path<MIS, lambertian only>";
+        case PathKernel::mis: break;
+    }
+    return "path<MIS, all materials>";
+}
+
+namespace {
+
+/// The inspection images: first-hit albedo, shading normal, or distance.
+Rgb inspect(const Scene& scene, Ray ray) {
+    Hit hit;
+    const IntegratorType type = scene.render.integrator;
+    if (!scene.intersect(ray, hit))
+        return type == IntegratorType::albedo ? eval_background(scene.background, ray.dir) : Rgb(0.0f);
+    const SurfaceInteraction si = scene.interact(ray, hit);
+    if (type == IntegratorType::normals) return (si.ns + Vec3(1.0f)) * 0.5f;
+    if (type == IntegratorType::depth) return Rgb(hit.t);
+    const MaterialDesc& m = scene.materials[si.material];
+    switch (m.type) {
+        case MaterialType::dielectric: return Rgb(1.0f);
+        case MaterialType::emissive: return eval_color(m.radiance, scene.textures, si.p, si.uv);
+        default: return eval_color(m.albedo, scene.textures, si.p, si.uv);
+    }
+}
+
+}  // namespace
+
 Rgb estimate_radiance(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
     switch (scene.render.integrator) {
         case IntegratorType::path: return path_trace(scene, ray, sampler, max_depth);
+        case IntegratorType::whitted: return whitted(scene, ray, max_depth);
         case IntegratorType::albedo:
         case IntegratorType::normals:
-        case IntegratorType::depth: {
-            Hit hit;
-            if (!scene.intersect(ray, hit)) return scene.render.integrator == IntegratorType::albedo
-                                                      ? eval_background(scene.background, ray.dir)
-                                                      : Rgb(0.0f);
-            const SurfaceInteraction si = scene.interact(ray, hit);
-            if (scene.render.integrator == IntegratorType::normals) return (si.ns + Vec3(1.0f)) * 0.5f;
-            if (scene.render.integrator == IntegratorType::depth) return Rgb(hit.t);
-            return eval_color(scene.materials[si.material].albedo, scene.textures, si.p, si.uv);
-        }
+        case IntegratorType::depth: return inspect(scene, ray);
         default: return path_trace(scene, ray, sampler, max_depth);
     }
 }

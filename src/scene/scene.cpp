@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "accel/accelerator.h"
@@ -14,7 +15,9 @@ Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
 Scene& Scene::operator=(Scene&&) noexcept = default;
 
-size_t Scene::primitive_count() const { return spheres.size() + triangles.size() + boxes.size() + planes.size(); }
+size_t Scene::primitive_count() const {
+    return spheres.size() + triangles.size() + boxes.size() + planes.size() + quadrics.size();
+}
 
 void Scene::build_accelerator() {
     accel_ = std::make_unique<Accelerator>(*this);
@@ -108,6 +111,25 @@ Vec3 box_normal(const Bounds3& b, const Vec3& p) {
 
 }  // namespace
 
+/// The runtime quadric of a parsed description: the description's local frame
+/// already holds the placement, so the named forms sit at the origin along +z.
+Quadric make_quadric(const QuadricDesc& d) {
+    const Vec3 o(0, 0, 0), z(0, 0, 1);
+    Quadric q;
+    switch (d.type) {
+        case QuadricDesc::Type::ellipsoid: q = make_ellipsoid(o, d.radii, d.world_from_local); break;
+        case QuadricDesc::Type::cylinder: q = make_cylinder(o, z, d.radius, d.height, d.capped, d.world_from_local); break;
+        case QuadricDesc::Type::cone: q = make_cone(o, z, d.angle, d.height, d.capped, d.world_from_local); break;
+        case QuadricDesc::Type::paraboloid: q = make_paraboloid(o, z, d.radius, d.height, d.world_from_local); break;
+        case QuadricDesc::Type::hyperboloid:
+            q = make_hyperboloid(o, z, d.radius, d.waist, d.height, d.world_from_local);
+            break;
+        case QuadricDesc::Type::general: q = make_general_quadric(d.coefficients, d.local_bounds, d.world_from_local); break;
+    }
+    q.material = d.material;
+    return q;
+}
+
 SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
     SurfaceInteraction si;
     const uint32_t idx = prim_index(hit.prim);
@@ -129,13 +151,29 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
             const Box& b = boxes[idx];
             si.p = ray.at(hit.t);
             si.ng = si.ns = box_normal(b.box, si.p);
+            // Snap onto the face: textures keyed on position (checkers) must not
+            // see the hit wander to either side of it.
+            const int axis = max_dimension(abs(si.ng));
+            si.p[axis] = si.ng[axis] > 0 ? b.box.hi[axis] : b.box.lo[axis];
             si.uv = {0, 0};
             si.material = b.material;
+            break;
+        }
+        case PrimKind::quadric: {
+            // The accelerator stores the hit part (side or cap) in hit.u.
+            const Quadric& q = quadrics[idx];
+            const QuadricSurface qs = q.surface(ray, QuadricHit{hit.t, QuadricPart(int(hit.u))});
+            si.p = qs.p;
+            si.ng = si.ns = qs.n;
+            si.uv = qs.uv;
+            si.material = q.material;
             break;
         }
         case PrimKind::plane: {
             const Plane& pl = planes[idx];
             si.p = ray.at(hit.t);
+            // Project onto the plane (exact for axis-aligned planes), as for boxes.
+            si.p -= pl.normal * dot(si.p - pl.point, pl.normal);
             si.ng = si.ns = pl.normal;
             si.uv = {0, 0};
             si.material = pl.material;
@@ -164,6 +202,7 @@ Scene build_scene(const SceneDesc& desc) {
     scene.lights = desc.lights;
     for (const SphereDesc& s : desc.spheres) scene.spheres.push_back({s.center, s.radius, s.velocity, s.material});
     for (const PlaneDesc& p : desc.planes) scene.planes.push_back({p.point, normalize(p.normal), p.material});
+    for (const QuadricDesc& q : desc.quadrics) scene.quadrics.push_back(make_quadric(q));
     for (const BoxDesc& b : desc.boxes) scene.boxes.push_back({Bounds3{min(b.lo, b.hi), max(b.lo, b.hi)}, b.material});
 
     bool any_normals = false, any_uvs = false;
@@ -189,6 +228,8 @@ Scene build_scene(const SceneDesc& desc) {
             soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
     }
     scene.build_accelerator();
+    const char* force = std::getenv("SAHARA_FORCE_ALL_FEATURES");
+    scene.prepare_lighting(force != nullptr && force[0] == '1');
     return scene;
 }
 

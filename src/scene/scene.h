@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "geometry/hit.h"
+#include "geometry/quadric.h"
 #include "geometry/sphere.h"
+#include "math/distribution.h"
 #include "scene/scene_desc.h"
 
 namespace sahara {
@@ -42,6 +44,30 @@ struct Box {
     uint32_t material = 0;
 };
 
+/// Which rendering machinery a scene needs, decided once at build time so that
+/// the integrator runs a kernel specialised for it instead of testing flags
+/// per ray (see render/integrator.cpp).
+struct SceneFeatures {
+    bool has_lights = false;             ///< point or directional lights
+    bool has_emitters = false;           ///< any emissive surface (sampled or not)
+    bool has_area_lights = false;        ///< emitters that are sampled directly (spheres, triangles, boxes)
+    bool has_envmap = false;             ///< an image background, importance-sampled
+    bool has_delta_lights_only = false;  ///< light sampling needed, but never MIS
+    bool has_motion = false;             ///< something moves while the shutter is open
+    bool has_lens = false;               ///< thin-lens depth of field
+    bool has_textures = false;           ///< checker or image colour sources
+    bool has_metal = false, has_rough_metal = false, has_dielectric = false;
+    bool lambertian_only = true;         ///< no metal, no dielectric
+    bool forced_all = false;             ///< everything on (SAHARA_FORCE_ALL_FEATURES=1), for measurements
+};
+
+/// Something that light sampling can pick: a light, an emissive primitive, or the envmap.
+struct Emitter {
+    enum class Kind : uint8_t { point, directional, sphere, triangle, box, envmap } kind = Kind::point;
+    uint32_t index = 0;  ///< into lights, spheres, triangles or boxes
+};
+inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
+
 class Accelerator;  // accel/: the BVH over bounded primitives
 
 class Scene {
@@ -67,6 +93,7 @@ public:
     TriangleSoup triangles;
     std::vector<Plane> planes;
     std::vector<Box> boxes;
+    std::vector<Quadric> quadrics;
     // appearance (kept as plain data for now)
     std::vector<MaterialDesc> materials;
     std::vector<TextureDesc> textures;
@@ -76,14 +103,31 @@ public:
     RenderSettings render;
     std::string source;
 
+    // lighting, derived from the above by prepare_lighting()
+    SceneFeatures features;
+    std::vector<Emitter> emitters;           ///< what light sampling picks from
+    Distribution1D emitter_distribution;     ///< over emitters, by estimated power
+    std::vector<uint32_t> sphere_emitter;    ///< emitter id per sphere (kNoEmitter: none); empty if none emit
+    std::vector<uint32_t> triangle_emitter;  ///< same per triangle
+    std::vector<uint32_t> box_emitter;       ///< same per box
+    uint32_t envmap_emitter = kNoEmitter;
+    Distribution2D envmap_distribution;      ///< over the envmap's (u, v), luminance * sin(theta)
+    float scene_radius = 1;                  ///< bounding-sphere radius of the bounded geometry
+
     /// Builds the acceleration structure over the current geometry.
     void build_accelerator();
+    /// Collects emitters, builds the light and envmap distributions and the
+    /// feature set; `force_all_features` turns every feature on.
+    void prepare_lighting(bool force_all_features);
     const Accelerator* accelerator() const { return accel_.get(); }
 
 private:
     std::unique_ptr<Accelerator> accel_;
     Bounds3 bounds_;
 };
+
+/// The runtime quadric for a parsed quadric object.
+Quadric make_quadric(const QuadricDesc& desc);
 
 /// Builds the runtime scene from plain data (merges meshes, builds the BVH).
 Scene build_scene(const SceneDesc& desc);

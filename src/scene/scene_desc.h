@@ -23,13 +23,17 @@ struct Image {
 
 enum class WrapMode : uint8_t { repeat, clamp, mirror };
 
-/// An image texture addressed by UVs (v = 0 at the image bottom, as glTF/OBJ tools
-/// usually mean it; loaders flip where their format says otherwise).
+/// An image texture addressed by UVs. Convention for everything in SceneDesc:
+/// v = 0 is the image BOTTOM (as in OBJ), so the texel row is (1 - v') * height
+/// with Image row 0 at the top. OBJ uvs are stored as written; glTF uvs (v = 0
+/// at the top) are converted at load to v = 1 - v_gltf, and their
+/// KHR_texture_transform is rewritten for the flipped space (gltf_loader.cpp).
 struct TextureDesc {
     std::string path;  ///< for messages and `sahara info`
     std::shared_ptr<const Image> image;
     WrapMode wrap_u = WrapMode::repeat, wrap_v = WrapMode::repeat;
-    /// uv' = [offset] + rotate(rotation) * (scale * uv)  (KHR_texture_transform)
+    /// uv' = [offset] + rotate(rotation) * (scale * uv), rotate(a) = [cos a, sin a; -sin a, cos a]
+    /// as render/texture.cpp applies it (glTF's transform, expressed in these v-up uvs).
     Vec2 uv_offset{0, 0}, uv_scale{1, 1};
     float uv_rotation = 0;
     int texcoord = 0;  ///< which UV set (only set 0 is stored on meshes today)
@@ -54,6 +58,10 @@ struct MaterialDesc {
     float roughness = 0.0f;    ///< metal
     float ior = 1.5f;          ///< dielectric
     ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};  ///< emissive (front side)
+    /// Lambertian only: radiance it also emits, from both sides. Not light-sampled
+    /// (found by BSDF sampling only); meant for analytic scenes such as the closed
+    /// glowing sphere whose radiance is emission / (1 - albedo).
+    Rgb emission{0.0f, 0.0f, 0.0f};
     /// Cut-outs: alpha in [0,1] (times the texture's alpha when alpha_texture >= 0).
     float alpha = 1.0f;
     int alpha_texture = -1;

@@ -1,0 +1,107 @@
+#include "io/image_bytes.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "base/error.h"
+
+namespace sahara {
+
+float srgb_to_linear_value(float c) {
+    if (c <= 0.04045f) return c * (1.0f / 12.92f);
+    return std::pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
+}
+
+namespace {
+
+/// OpenImageIO picks its reader by file extension; embedded images carry no
+/// name, so the extension comes from the format's magic number.
+std::string format_hint(const unsigned char* data, size_t size) {
+    if (size >= 8 && std::memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0) return "embedded.png";
+    if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) return "embedded.jpg";
+    if (size >= 6 && (std::memcmp(data, "GIF87a", 6) == 0 || std::memcmp(data, "GIF89a", 6) == 0))
+        return "embedded.gif";
+    if (size >= 2 && data[0] == 'B' && data[1] == 'M') return "embedded.bmp";
+    return "";
+}
+
+uint32_t be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+
+/// CRC-32 (ISO 3309, as the PNG specification defines it) of `n` bytes.
+uint32_t crc32(const unsigned char* p, size_t n) {
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; ++i) {
+        crc ^= p[i];
+        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+}
+
+/// Walks a PNG's chunk list (bounds, CRCs, IHDR first, IEND last). libpng
+/// reports such damage by longjmp through OpenImageIO, which leaks its error
+/// text; catching it here first also gives a clearer message.
+std::string png_structure_error(const unsigned char* data, size_t size) {
+    size_t at = 8;
+    for (int index = 0;; ++index) {
+        if (size - at < 12) return "PNG is truncated (chunk " + std::to_string(index) + " header)";
+        const size_t length = be32(data + at);
+        const std::string type(reinterpret_cast<const char*>(data + at + 4), 4);
+        if (length > size - at - 12) return "PNG chunk " + std::to_string(index) + " is truncated";
+        if (crc32(data + at + 4, length + 4) != be32(data + at + 8 + length))
+            return "PNG chunk " + std::to_string(index) + " has a bad CRC";
+        if (index == 0 && type != "IHDR") return "PNG does not start with IHDR";
+        at += 12 + length;
+        if (type == "IEND") return "";
+    }
+}
+
+/// Expands 1-4 channel float pixels to RGBA (grey, grey+alpha, RGB, RGBA).
+void expand_to_rgba(const std::vector<float>& src, int channels, bool srgb, Image& out) {
+    const size_t n = size_t(out.width) * size_t(out.height);
+    out.rgba.resize(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+        const float* s = &src[i * size_t(channels)];
+        float r = s[0], g = s[0], b = s[0], a = 1.0f;
+        if (channels == 2) a = s[1];
+        if (channels >= 3) { g = s[1]; b = s[2]; }
+        if (channels >= 4) a = s[3];
+        if (srgb) { r = srgb_to_linear_value(r); g = srgb_to_linear_value(g); b = srgb_to_linear_value(b); }
+        float* d = &out.rgba[i * 4];
+        d[0] = r; d[1] = g; d[2] = b; d[3] = a;
+    }
+}
+
+}  // namespace
+
+std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_t size, bool srgb_to_linear,
+                                                const std::string& file, const std::string& element) {
+    const std::string hint = format_hint(data, size);
+    if (hint.empty()) throw input_error(file, element, "image data is not PNG, JPEG, GIF or BMP");
+    if (hint == "embedded.png")
+        if (const std::string why = png_structure_error(data, size); !why.empty())
+            throw input_error(file, element, "cannot decode image: " + why);
+    OIIO::Filesystem::IOMemReader proxy(data, size);
+    auto in = OIIO::ImageInput::open(hint, nullptr, &proxy);
+    if (!in) throw input_error(file, element, "cannot decode image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        throw input_error(file, element, "image has no pixels");
+    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
+        throw input_error(file, element, "image is " + std::to_string(spec.width) + "x" +
+                                             std::to_string(spec.height) + ", over " +
+                                             std::to_string(kMaxImageSide) + " pixels per side");
+    const int channels = std::min(spec.nchannels, 4);
+    std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+        throw input_error(file, element, "cannot decode image: " + in->geterror());
+    auto image = std::make_shared<Image>();
+    image->width = spec.width;
+    image->height = spec.height;
+    expand_to_rgba(pixels, channels, srgb_to_linear, *image);
+    return image;
+}
+
+}  // namespace sahara

@@ -1,0 +1,70 @@
+#pragma once
+/// Scattering at a surface point: Lambertian, metal (perfect mirror or GGX
+/// microfacet) and dielectric (glass). A closed set dispatched by a switch.
+/// Conventions: wo and wi are unit world directions pointing away from the
+/// surface (wo towards the previous vertex); eval returns f * |cos(theta_i)|.
+#include <vector>
+
+#include "math/sampling.h"
+#include "scene/scene.h"
+
+namespace sahara {
+
+enum class BsdfKind : uint8_t { lambertian, mirror, ggx, dielectric, none };
+
+/// Metal roughness below this is treated as a perfect mirror (GGX with a
+/// tinier alpha is numerically a delta anyway).
+inline constexpr float kMinGgxAlpha = 1e-3f;
+
+/// A BSDF instantiated at one surface point.
+struct Bsdf {
+    BsdfKind kind = BsdfKind::none;
+    Rgb albedo{0.0f};  ///< Lambertian reflectance, or the metal's F0
+    float alpha = 0;   ///< GGX roughness parameter (= roughness^2)
+    float eta = 1;     ///< ior on the far side / ior on the side of wo (dielectric)
+    Frame frame{Vec3(0, 0, 1)};  ///< around the shading normal
+    Vec3 ng;           ///< geometric normal on the side of wo
+
+    bool is_delta() const { return kind == BsdfKind::mirror || kind == BsdfKind::dielectric; }
+};
+
+/// One sampled direction with its Monte Carlo weight f * |cos| / pdf.
+struct BsdfSample {
+    Vec3 wi;
+    Rgb weight{0.0f};
+    float pdf = 0;        ///< solid-angle density (1 for delta lobes: unused)
+    bool delta = false;
+    bool transmit = false;  ///< wi goes through the surface (spawn on the far side)
+    float eta_scale = 1;  ///< radiance scale 1/eta^2 undone, for Russian roulette
+};
+
+/// The BSDF of material `m` at `si`.
+Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+
+/// f(wo, wi) * |cos(theta_i)| and the density sample() would give wi; zero for delta BSDFs.
+Rgb eval_bsdf(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);
+
+/// Samples wi given wo; u picks the direction, u_lobe a lobe (dielectric).
+bool sample_bsdf(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s);
+
+/// Exact unpolarised Fresnel reflectance of a dielectric interface for light
+/// arriving at cos_i (>= 0) from the side of ior n_i, eta = n_t / n_i; 1 under
+/// total internal reflection.
+float fresnel_dielectric(float cos_i, float eta);
+
+/// Schlick's approximation with reflectance f0 at normal incidence (used for metals).
+Rgb fresnel_schlick(const Rgb& f0, float cos_i);
+
+/// Mirror reflection of w about n.
+inline Vec3 reflect(const Vec3& w, const Vec3& n) { return n * (2.0f * dot(w, n)) - w; }
+
+/// Refraction of wo (on the side n points to) into the far side; eta = n_t / n_i.
+/// False under total internal reflection.
+bool refract(const Vec3& wo, const Vec3& n, float eta, Vec3* wt);
+
+/// GGX (Trowbridge-Reitz) microfacet density of the local half vector wm.
+float ggx_d(const Vec3& wm, float alpha);
+/// Smith's Lambda for GGX, in local coordinates.
+float ggx_lambda(const Vec3& w, float alpha);
+
+}  // namespace sahara

@@ -1,0 +1,102 @@
+/// The Whitted integrator (Whitted 1980, "An Improved Illumination Model for
+/// Shaded Display"): deterministic, one ray per branch, a fast preview.
+#include "geometry/spawn.h"
+#include "render/background.h"
+#include "render/bsdf.h"
+#include "render/integrator.h"
+#include "render/texture.h"
+
+namespace sahara {
+
+namespace {
+
+/// Branches whose weight on the pixel falls below this are not traced: glass
+/// would otherwise double the ray count at every level of recursion.
+constexpr float kMinBranchWeight = 1e-4f;
+
+/// Lambert shading from point and directional lights, with hard shadows.
+Rgb direct_lights(const Scene& scene, const SurfaceInteraction& si, const Rgb& albedo, float time) {
+    Rgb sum(0.0f);
+    for (const LightDesc& l : scene.lights) {
+        Vec3 wi;
+        Rgb e;
+        float tmax = kInfinity;
+        if (l.type == LightDesc::Type::point) {
+            const Vec3 d = l.position - si.p;
+            const float dist2 = length_squared(d);
+            if (!(dist2 > 0)) continue;
+            const float dist = std::sqrt(dist2);
+            wi = d / dist;
+            e = l.intensity / dist2;  // inverse-square law
+            tmax = dist * (1.0f - 1e-4f);
+        } else {
+            wi = -normalize(l.direction);
+            e = l.irradiance;
+        }
+        const float cos = dot(wi, si.ns);
+        if (cos <= 0 || dot(wi, si.ng) <= 0) continue;
+        if (scene.occluded(Ray{offset_ray_origin(si.p, si.ng), wi, 0.0f, tmax, time})) continue;
+        sum += e * cos;
+    }
+    return albedo * sum * kInvPi;
+}
+
+Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight);
+
+/// Continues along a reflected or refracted direction if the branch still matters.
+Rgb branch(const Scene& scene, const SurfaceInteraction& si, const Vec3& dir, bool transmit, float time, int depth,
+           int max_depth, float weight) {
+    if (weight < kMinBranchWeight) return Rgb(0.0f);
+    const Ray next{offset_ray_origin(si.p, transmit ? -si.ng : si.ng), dir, 0.0f, kInfinity, time};
+    return trace(scene, next, depth + 1, max_depth, weight);
+}
+
+Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
+    Hit hit;
+    if (!scene.intersect(ray, hit)) return eval_background(scene.background, ray.dir);
+    const SurfaceInteraction si = scene.interact(ray, hit);
+    const MaterialDesc& m = scene.materials[si.material];
+    if (m.type == MaterialType::emissive)
+        return si.front_face ? eval_color(m.radiance, scene.textures, si.p, si.uv) : Rgb(0.0f);
+    Rgb radiance = m.type == MaterialType::lambertian ? m.emission : Rgb(0.0f);
+    if (depth >= max_depth) return radiance;  // the next ray (shadow or secondary) would exceed max_depth
+    const Vec3 wo = -ray.dir;
+    switch (m.type) {
+        case MaterialType::lambertian: {
+            const Rgb albedo = eval_color(m.albedo, scene.textures, si.p, si.uv);
+            radiance += albedo * eval_background(scene.background, si.ns);  // ambient
+            radiance += direct_lights(scene, si, albedo, ray.time);
+            break;
+        }
+        case MaterialType::metal: {  // roughness ignored: a perfect mirror
+            const Rgb f = fresnel_schlick(eval_color(m.albedo, scene.textures, si.p, si.uv), dot(wo, si.ns));
+            const Vec3 wr = reflect(wo, si.ns);
+            if (dot(wr, si.ng) > 0)
+                radiance += f * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * max_component(f));
+            break;
+        }
+        case MaterialType::dielectric: {
+            const float eta = si.front_face ? m.ior : 1.0f / m.ior;
+            const float r = fresnel_dielectric(dot(wo, si.ns), eta);
+            const Vec3 wr = reflect(wo, si.ns);
+            if (dot(wr, si.ng) > 0) radiance += r * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * r);
+            Vec3 wt;
+            if (r < 1.0f && refract(wo, si.ns, eta, &wt) && dot(wt, si.ng) < 0) {
+                const float t = (1.0f - r) / (eta * eta);  // radiance compression across the interface
+                radiance += t * branch(scene, si, wt, true, ray.time, depth, max_depth, weight * (1.0f - r));
+            }
+            break;
+        }
+        case MaterialType::emissive: break;
+    }
+    return radiance;
+}
+
+}  // namespace
+
+Rgb whitted(const Scene& scene, Ray ray, int max_depth) {
+    ray.dir = normalize(ray.dir);
+    return trace(scene, ray, 1, max_depth, 1.0f);
+}
+
+}  // namespace sahara

@@ -1,0 +1,159 @@
+/// Scene::prepare_lighting: the emitter list for light sampling, its power
+/// distribution, the envmap distribution and the scene's feature set. Plain
+/// data only; the sampling code that reads it is in render/lights.cpp.
+#include <cmath>
+#include <numbers>
+
+#include "scene/scene.h"
+
+namespace sahara {
+
+namespace {
+
+constexpr float kPiF = std::numbers::pi_v<float>;
+
+/// A rough mean of a colour source, enough to pick lights by power.
+float mean_color(const ColorSource& c) {
+    switch (c.kind) {
+        case ColorSource::Kind::constant: return average(c.color);
+        case ColorSource::Kind::checker: return 0.5f * (average(c.even) + average(c.odd));
+        case ColorSource::Kind::texture: return average(c.color);  // the texture's mean is not known here
+    }
+    return average(c.color);
+}
+
+bool is_sampled_emitter(const MaterialDesc& m) { return m.type == MaterialType::emissive && mean_color(m.radiance) > 0; }
+
+float triangle_area(const TriangleSoup& soup, size_t i) {
+    const Vec3& p0 = soup.positions[soup.indices[3 * i]];
+    return 0.5f * length(cross(soup.positions[soup.indices[3 * i + 1]] - p0, soup.positions[soup.indices[3 * i + 2]] - p0));
+}
+
+float bounding_radius(const Scene& s) {
+    Bounds3 b;
+    for (const Sphere& sp : s.spheres) b.extend(sp.bounds(s.camera.shutter_open, s.camera.shutter_close));
+    for (const Vec3& p : s.triangles.positions) b.extend(p);
+    for (const Box& bx : s.boxes) b.extend(bx.box);
+    if (b.empty()) return 1.0f;
+    const float r = 0.5f * length(b.extent());
+    return r > 0 && std::isfinite(r) ? r : 1.0f;
+}
+
+/// Envmap pixel weights: luminance times sin(theta) of the row centre, since a
+/// lat-long pixel covers a solid angle proportional to sin(theta).
+std::vector<float> envmap_weights(const Image& img, double* mean_radiance) {
+    std::vector<float> w(size_t(img.width) * size_t(img.height));
+    double total = 0, solid = 0;
+    for (int y = 0; y < img.height; ++y) {
+        const float sin_theta = std::sin(kPiF * (float(y) + 0.5f) / float(img.height));
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = &img.rgba[(size_t(y) * size_t(img.width) + size_t(x)) * 4];
+            const float lum = std::max(0.0f, luminance(Rgb(p[0], p[1], p[2])));
+            const float v = std::isfinite(lum) ? lum * sin_theta : 0.0f;
+            w[size_t(y) * size_t(img.width) + size_t(x)] = v;
+            total += double(v);
+            solid += double(sin_theta);
+        }
+    }
+    *mean_radiance = solid > 0 ? total / solid : 0.0;
+    return w;
+}
+
+/// Point and directional lights: the power a point light emits in all
+/// directions; the part of a directional light's flux that crosses the scene.
+void collect_lights(const Scene& s, float disk, std::vector<Emitter>& emitters, std::vector<float>& power) {
+    for (uint32_t i = 0; i < s.lights.size(); ++i) {
+        const LightDesc& l = s.lights[i];
+        const bool point = l.type == LightDesc::Type::point;
+        const float p = point ? 4.0f * kPiF * average(l.intensity) : disk * average(l.irradiance);
+        if (!(p > 0)) continue;
+        emitters.push_back({point ? Emitter::Kind::point : Emitter::Kind::directional, i});
+        power.push_back(p);
+    }
+}
+
+/// Adds area emitter i if its material emits; a Lambertian emitter of area A
+/// and radiance L emits pi * A * L.
+void add_area_emitter(std::vector<uint32_t>& map, size_t count, Emitter::Kind kind, uint32_t i, float area,
+                      const MaterialDesc& m, std::vector<Emitter>& emitters, std::vector<float>& power) {
+    if (!is_sampled_emitter(m) || !(area > 0)) return;
+    if (map.empty()) map.assign(count, kNoEmitter);
+    map[i] = uint32_t(emitters.size());
+    emitters.push_back({kind, i});
+    power.push_back(kPiF * area * mean_color(m.radiance));
+}
+
+void collect_features(const Scene& s, SceneFeatures& f) {
+    for (const MaterialDesc& m : s.materials) {
+        f.has_emitters |= (m.type == MaterialType::emissive && mean_color(m.radiance) > 0) ||
+                          (m.type == MaterialType::lambertian && max_component(m.emission) > 0);
+        f.has_metal |= m.type == MaterialType::metal;
+        f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
+        f.has_dielectric |= m.type == MaterialType::dielectric;
+        f.has_textures |= m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
+    }
+    f.lambertian_only = !f.has_metal && !f.has_dielectric;
+    const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
+    for (const Sphere& sp : s.spheres) f.has_motion |= shutter && sp.velocity != Vec3(0.0f);
+    f.has_lens = s.camera.aperture > 0;
+}
+
+void force_all(SceneFeatures& f) {
+    f.has_lights = f.has_emitters = f.has_area_lights = f.has_envmap = true;
+    f.has_delta_lights_only = false;
+    f.has_motion = f.has_lens = f.has_textures = true;
+    f.has_metal = f.has_rough_metal = f.has_dielectric = true;
+    f.lambertian_only = false;
+    f.forced_all = true;
+}
+
+}  // namespace
+
+void Scene::prepare_lighting(bool force_all_features) {
+    emitters.clear();
+    sphere_emitter.clear();
+    triangle_emitter.clear();
+    box_emitter.clear();
+    envmap_emitter = kNoEmitter;
+    scene_radius = bounding_radius(*this);
+    const float disk = kPiF * scene_radius * scene_radius;  // cross-section of the scene
+    std::vector<float> power;
+
+    collect_lights(*this, disk, emitters, power);
+    const size_t delta_count = emitters.size();
+    for (uint32_t i = 0; i < spheres.size(); ++i)
+        add_area_emitter(sphere_emitter, spheres.size(), Emitter::Kind::sphere, i,
+                         4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material], emitters,
+                         power);
+    for (uint32_t i = 0; i < triangles.size(); ++i)
+        add_area_emitter(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i, triangle_area(triangles, i),
+                         materials[triangles.material[i]], emitters, power);
+    for (uint32_t i = 0; i < boxes.size(); ++i)
+        add_area_emitter(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
+                         materials[boxes[i].material], emitters, power);
+    const size_t area_count = emitters.size() - delta_count;
+
+    envmap_distribution = Distribution2D();
+    const Image* img = background.type == BackgroundDesc::Type::envmap ? background.image.get() : nullptr;
+    if (img && img->width > 0 && img->height > 0 && background.strength > 0) {
+        double mean = 0;
+        const std::vector<float> w = envmap_weights(*img, &mean);
+        if (mean > 0) {
+            envmap_distribution = Distribution2D(w, img->width, img->height);
+            envmap_emitter = uint32_t(emitters.size());
+            emitters.push_back({Emitter::Kind::envmap, 0});
+            power.push_back(4.0f * kPiF * disk * float(mean) * background.strength);  // 4 pi sr over the disk
+        }
+    }
+    emitter_distribution = Distribution1D(std::move(power));
+
+    features = SceneFeatures();
+    features.has_lights = delta_count > 0;
+    features.has_area_lights = area_count > 0;
+    features.has_envmap = envmap_emitter != kNoEmitter;
+    features.has_delta_lights_only = features.has_lights && !features.has_area_lights && !features.has_envmap;
+    collect_features(*this, features);
+    if (force_all_features) force_all(features);
+}
+
+}  // namespace sahara

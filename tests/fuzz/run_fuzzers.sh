@@ -1,0 +1,36 @@
+#!/bin/sh
+# Builds the loader fuzz targets with clang-14's libFuzzer + AddressSanitizer
+# (outside the gcc CMake build) and runs each for a bounded time.
+# Usage: tests/fuzz/run_fuzzers.sh [seconds per target, default 30]
+set -eu
+secs=${1:-30}
+root=$(cd "$(dirname "$0")/../.." && pwd)
+out=${FUZZ_OUT:-$root/build-fuzz}
+mkdir -p "$out"
+cxx="clang++-14 -std=c++20 -O1 -g -fsanitize=fuzzer,address -fno-omit-frame-pointer -DSAHARA_VERSION=\"fuzz\" -I$root/src -I/usr/include/opencv4"
+libs="-ltinyobjloader -ltinygltf -lOpenImageIO -lOpenImageIO_Util"
+srcs="$root/src/io/obj_loader.cpp $root/src/io/gltf_loader.cpp $root/src/io/gltf_scene.cpp $root/src/io/gltf_accessor.cpp
+      $root/src/io/gltf_material.cpp $root/src/io/model_loader.cpp $root/src/io/mesh_utils.cpp $root/src/io/image_bytes.cpp
+      $root/src/base/log.cpp $root/src/base/pending_file.cpp"
+srcs="$srcs $root/src/io/image_io.cpp"
+
+status=0
+for target in obj gltf; do
+    echo "== building fuzz_$target"
+    # shellcheck disable=SC2086
+    $cxx -o "$out/fuzz_$target" "$root/tests/fuzz/fuzz_$target.cpp" $srcs $libs
+    corpus="$out/corpus_$target"
+    mkdir -p "$corpus"
+    cp -n "$root/tests/fuzz/corpus_$target"/* "$corpus"/ 2>/dev/null || true
+    echo "== running fuzz_$target for ${secs}s"
+    if "$out/fuzz_$target" "$corpus" -max_total_time="$secs" -max_len=16384 -rss_limit_mb=2048 -timeout=10 \
+        -artifact_prefix="$out/crash_${target}_" -print_final_stats=1 2>"$out/fuzz_$target.log"; then
+        echo "fuzz_$target: no crash ($(grep -E '^stat::number_of_executed_units' "$out/fuzz_$target.log" | awk '{print $2}') runs," \
+             "corpus $(ls "$corpus" | wc -l) files)"
+    else
+        status=1
+        echo "fuzz_$target: FAILED, see $out/fuzz_$target.log and $out/crash_${target}_*"
+        grep -E "ERROR|SUMMARY" "$out/fuzz_$target.log" | head -5
+    fi
+done
+exit $status
