@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include <chrono>
+#include <limits>
 
 #include "accel/box_intersect.h"
 #include "scene/scene.h"
@@ -72,6 +73,18 @@ Bvh single_leaf_bvh(const PrimitiveList& prims) {
 
 }  // namespace
 
+const char* bvh_layout_name(BvhLayout layout) {
+    return layout == BvhLayout::pairs ? "pairs" : layout == BvhLayout::wide4_slots ? "wide4-slots" : "wide4";
+}
+
+bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
+    if (text == "wide4") out = BvhLayout::wide4;
+    else if (text == "wide4-slots") out = BvhLayout::wide4_slots;
+    else if (text == "pairs") out = BvhLayout::pairs;
+    else return false;
+    return true;
+}
+
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     : spheres_(scene.spheres), quadrics_(scene.quadrics) {
     const auto start = std::chrono::steady_clock::now();
@@ -79,8 +92,9 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
-    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, options.params)
-                      : single_leaf_bvh(prims);
+    BvhBuildParams params = options.params;
+    if (options.layout == BvhLayout::wide4) params.intersection_cost *= options.wide4_leaf_cost_scale;
+    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params) : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
     slots_.resize(slots);
@@ -94,15 +108,52 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
             slots_[s].tri = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
         }
     }
-    pairs_ = make_bvh_pairs(bvh_);
+    layout_ = options.layout;
+    if (layout_ == BvhLayout::pairs) {
+        pairs_ = make_bvh_pairs(bvh_);
+    } else {
+        wide_ = make_bvh4(bvh_);
+        if (layout_ == BvhLayout::wide4) make_leaf_blocks();
+    }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     build_cpu_ms_ = process_cpu_ms() - cpu_start;
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// Rewrites every BVH4 leaf (first slot, count) to (first block, count), its
+/// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
+void Accelerator::make_leaf_blocks() {
+    auto add_leaf = [this](uint32_t first, uint32_t count) {
+        const auto block = uint32_t(blocks_.size());
+        for (uint32_t s = first; s < first + count; s += 4) {
+            TriangleBlock4 b{};
+            for (int l = 0; l < 4; ++l) {
+                const uint32_t slot = s + uint32_t(l);
+                const bool in_leaf = slot < first + count;
+                const bool tri = in_leaf && prim_kind(slots_[slot].id) == PrimKind::triangle;
+                b.slot[l] = !in_leaf ? TriangleBlock4::kEmptyLane : tri ? slot : slot | TriangleBlock4::kOtherKind;
+                for (int v = 0; v < 3; ++v)
+                    for (int a = 0; a < 3; ++a)
+                        b.p[v][a][l] = tri ? slots_[slot].tri.p[v][a] : std::numeric_limits<float>::quiet_NaN();
+            }
+            blocks_.push_back(b);
+        }
+        return block;
+    };
+    if (wide_.empty) return;
+    if (wide_.root.is_leaf()) wide_.root.index = add_leaf(wide_.root.index, wide_.root.count);
+    for (Bvh4Node& n : wide_.nodes)
+        for (int c = 0; c < 4; ++c)
+            if (n.count[c]) n.child[c] = add_leaf(n.child[c], n.count[c]);
+}
+
 size_t Accelerator::bytes() const {
-    return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
-           spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) + quadrics_.size() * sizeof(Quadric);
+    const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
+                         quadrics_.size() * sizeof(Quadric);
+    // The wide4 layout traverses blocks_ instead of slots_ (kept for brute force and other kinds).
+    if (layout_ == BvhLayout::wide4) return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + other;
+    return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
+           bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
 }
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in `hit`.
@@ -152,8 +203,81 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
     return found;
 }
 
+/// The BVH4 traversal; trace_wide_avx2 is the same code compiled for AVX2
+/// (both inline this body, so each gets its own instruction selection).
+template <bool kAnyHit, bool kBlocks, class Counters>
+__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const {
+    const TriangleRay tr(ray);
+    BvhRay br(ray);
+    Hit best;
+    const bool found = traverse_bvh4<kAnyHit>(
+        wide_, br,
+        [&](uint32_t first, uint32_t count, float& tmax) {
+            if constexpr (kBlocks) return test_blocks<kAnyHit>(ray, tr, first, count, tmax, best);
+            else return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
+        },
+        counters);
+    if (found && !kAnyHit) {
+        hit = best;
+        ray.tmax = best.t;
+    }
+    return found;
+}
+
+template <bool kAnyHit, bool kBlocks, class Counters>
+bool Accelerator::trace_wide(Ray& ray, Hit& hit, Counters& counters) const {
+    return trace_wide_body<kAnyHit, kBlocks>(ray, hit, counters);
+}
+
+template <bool kAnyHit, bool kBlocks, class Counters>
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const {
+    return trace_wide_body<kAnyHit, kBlocks>(ray, hit, counters);
+}
+
+/// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
+/// time, other kinds through test_slots; the closest hit lowers `tmax`.
+template <bool kAnyHit>
+__attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
+                                                                    uint32_t first, uint32_t count, float& tmax,
+                                                                    Hit& hit) const {
+    bool found = false;
+    for (uint32_t b = first; b < first + (count + 3) / 4; ++b) {
+        const TriangleBlock4& block = blocks_[b];
+        float t[4], u[4], v[4];
+        const int mask = intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
+        if (mask) {
+            if constexpr (kAnyHit) return true;
+            int best = __builtin_ctz(unsigned(mask));
+            for (int m = mask & (mask - 1); m; m &= m - 1) {
+                const int l = __builtin_ctz(unsigned(m));
+                if (t[l] < t[best]) best = l;
+            }
+            tmax = t[best];
+            hit = Hit{t[best], slots_[block.slot[best]].id, u[best], v[best]};
+            found = true;
+        }
+        // Sign bits of the slots: lanes of other kinds (and padding, skipped).
+        const int other = _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+        for (int m = other; m; m &= m - 1) {
+            const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
+            if (slot == TriangleBlock4::kEmptyLane) continue;
+            if (test_slots<kAnyHit>(ray, tr, slot & ~TriangleBlock4::kOtherKind, 1, tmax, hit)) {
+                if constexpr (kAnyHit) return true;
+                found = true;
+            }
+        }
+    }
+    return found;
+}
+
 template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
+    const bool avx2 = active_simd_path() == SimdPath::avx2;
+    if (layout_ == BvhLayout::wide4)
+        return avx2 ? trace_wide_avx2<kAnyHit, true>(ray, hit, counters) : trace_wide<kAnyHit, true>(ray, hit, counters);
+    if (layout_ == BvhLayout::wide4_slots)
+        return avx2 ? trace_wide_avx2<kAnyHit, false>(ray, hit, counters)
+                    : trace_wide<kAnyHit, false>(ray, hit, counters);
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;

@@ -5,9 +5,12 @@
 /// in the primitive id (geometry/hit.h) with a switch, never a virtual call.
 /// The accelerator copies the primitive data it tests (triangle vertices in
 /// leaf order, spheres, boxes), so it stays valid when the Scene is moved.
+#include <string_view>
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh4.h"
+#include "accel/bvh4_leaf.h"
 #include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"
 #include "geometry/hit.h"
@@ -29,10 +32,29 @@ class Scene;
 /// 32 triangles: 124.7 vs 53.7 ns). So no separate flat path: 0.
 inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
+/// Traversal structure built from the binary SAH tree.
+enum class BvhLayout : uint8_t {
+    wide4,        ///< 4-wide BVH (accel/bvh4.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h); the default
+    wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
+    pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
+};
+
+/// "wide4", "wide4-slots" or "pairs".
+const char* bvh_layout_name(BvhLayout layout);
+/// Parses a bvh_layout_name(); returns false for anything else.
+bool parse_bvh_layout(std::string_view text, BvhLayout& out);
+
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
+    BvhLayout layout = BvhLayout::wide4;
     BvhBuilder builder = BvhBuilder::binned;
     BvhBuildParams params;
+    /// The wide4 layout builds with params.intersection_cost times this: its
+    /// leaves test four triangles per SSE step, so larger leaves pay off.
+    /// 0.5 measured best-or-equal against 0.25-1.0 with `sahara bench` on the
+    /// bunny (one thread, 2026-11-22; differences within the machine's noise
+    /// between 0.25 and 0.7, 1.0 clearly slower on diffuse rays).
+    float wide4_leaf_cost_scale = 0.5f;
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
@@ -57,6 +79,12 @@ public:
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
+    BvhLayout layout() const { return layout_; }
+    /// The 4-wide tree (empty for the pairs layout; with the wide4 layout a leaf's
+    /// child index is its first TriangleBlock4, not its first slot).
+    const Bvh4& bvh4() const { return wide_; }
+    /// Leaf triangle blocks of the wide4 layout (empty for the other layouts).
+    const std::vector<TriangleBlock4>& leaf_blocks() const { return blocks_; }
     /// Elapsed build time (BVH, pair layout, leaf-ordered primitive copies).
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
@@ -68,12 +96,25 @@ public:
 private:
     template <bool kAnyHit, class Counters>
     bool trace(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kBlocks, class Counters>
+    bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kBlocks, class Counters>
+    bool trace_wide(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kBlocks, class Counters>
+    __attribute__((target("avx2"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit>
+    bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
+                     Hit& hit) const;
+    void make_leaf_blocks();
     template <bool kAnyHit>
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
 
     Bvh bvh_;          ///< canonical tree (statistics, validation)
-    BvhPairs pairs_;   ///< the same tree in traversal layout
+    BvhPairs pairs_;   ///< the same tree in pair layout (layout_ == pairs)
+    Bvh4 wide_;        ///< the same tree collapsed to 4-wide nodes (wide layouts)
+    std::vector<TriangleBlock4> blocks_;  ///< wide4 layout: each leaf's slots in blocks of four
+    BvhLayout layout_ = BvhLayout::wide4;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).
     struct Slot {

@@ -21,13 +21,17 @@ namespace {
 
 constexpr const char* kBenchUsage =
     "usage: sahara bench MESH [--threads N] [--rays primary|diffuse|shadow|all] [--json]\n"
-    "                         [--builder binned|sweep] [--size N] [--repeat K] [--no-embree]\n"
+    "                         [--builder binned|sweep] [--layout L] [--size N] [--repeat K]\n"
+    "                         [--no-embree]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  MESH        a mesh (.obj)\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
     "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh,\n"
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the mesh\n"
+    "  --layout L  traversal structure: wide4 (default: 4-wide BVH, leaf triangles tested 4 at a\n"
+    "              time), wide4-slots (4-wide BVH, one leaf slot at a time) or pairs (binary BVH);\n"
+    "              the wide layouts use AVX2 when the CPU has it, SSE2 with SAHARA_SIMD=sse2\n"
     "  --size N    primary image side (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
@@ -46,6 +50,7 @@ struct BenchOptions {
     int threads = 1;
     std::vector<std::string> sets;
     BvhBuilder builder = BvhBuilder::binned;
+    BvhLayout layout = BvhLayout::wide4;
     int size = 1024;
     int repeat = 3;
     bool embree = true;
@@ -94,6 +99,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     const Scene scene = scene_from_mesh(mesh);
     AcceleratorOptions aopt;
     aopt.builder = opt.builder;
+    aopt.layout = opt.layout;
     const Accelerator accel(scene, aopt);
     std::unique_ptr<EmbreeReference> embree;
     if (opt.embree && EmbreeReference::available()) embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices);
@@ -102,6 +108,9 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
                         {"primitives", accel.primitive_count()},
                         {"threads", opt.threads},
                         {"builder", bvh_builder_name(opt.builder)},
+                        {"layout", bvh_layout_name(opt.layout)},
+                        {"simd", simd_path_name(active_simd_path())},
+                        {"tree_bytes_per_primitive", double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
                         {"build_ms", accel.build_ms()},
                         {"build_cpu_ms", accel.build_cpu_ms()}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
@@ -115,10 +124,11 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
 void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
     std::printf("mesh        %s\nprimitives  %zu\nthreads     %d\n", j["mesh"].get<std::string>().c_str(),
                 j["primitives"].get<size_t>(), j["threads"].get<int>());
-    std::printf("build       %.1f ms, CPU %.1f ms (%s SAH)", j["build_ms"].get<double>(), j["build_cpu_ms"].get<double>(),
-                j["builder"].get<std::string>().c_str());
+    std::printf("build       %.1f ms, CPU %.1f ms (%s SAH, %s layout, %s)", j["build_ms"].get<double>(),
+                j["build_cpu_ms"].get<double>(), j["builder"].get<std::string>().c_str(),
+                j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms")) std::printf(", Embree %.1f ms", j["embree_build_ms"].get<double>());
-    std::printf("\n");
+    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n", j["tree_bytes_per_primitive"].get<double>());
     const bool embree = j.contains("embree_build_ms");
     if (!embree)
         std::printf("Embree      %s\n", embree_wanted ? "not available (sahara was built without Embree 3)" : "skipped");
@@ -194,6 +204,7 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--repeat must be a positive integer";
     if (!parse_bvh_builder(args.value_or("--builder", "binned"), opt.builder))
         return "--builder must be binned or sweep";
+    if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout)) return "--layout must be wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");
     if (sets == "all") opt.sets = {"primary", "diffuse", "shadow"};
     else if (sets == "primary" || sets == "diffuse" || sets == "shadow") opt.sets = {sets};
@@ -207,7 +218,7 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
 
 int run_bench_command(int argc, char** argv) {
     ToolArgs args;
-    std::string err = parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--size", "--repeat"},
+    std::string err = parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat"},
                                       {"--json", "--no-embree", "--small-scenes"}, args);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     if (args.help) {

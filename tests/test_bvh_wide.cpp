@@ -1,0 +1,275 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "accel/accelerator.h"
+#include "accel/bvh4.h"
+#include "app/mesh_input.h"
+#include "mesh_fixtures.h"
+#include "scene/scene.h"
+
+using namespace sahara;
+using namespace sahara::test;
+
+namespace {
+
+std::vector<std::filesystem::path> obj_files() {
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(SAHARA_ASSETS_DIR "/obj"))
+        if (e.path().extension() == ".obj") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+std::vector<TriangleMesh> procedural() {
+    return {make_icosphere(3), make_tiny_grid(30), make_slivers(1000), make_degenerate_mesh()};
+}
+
+/// Restores automatic SIMD path selection when a test ends.
+struct SimdPathGuard {
+    ~SimdPathGuard() { force_simd_path(cpu_has_avx2() ? SimdPath::avx2 : SimdPath::sse2); }
+};
+
+/// The SIMD paths this CPU can run (SSE2 always).
+std::vector<SimdPath> runnable_paths() {
+    std::vector<SimdPath> paths{SimdPath::sse2};
+    if (cpu_has_avx2()) paths.push_back(SimdPath::avx2);
+    return paths;
+}
+
+Bounds3 child_box(const Bvh4Node& n, int c) {
+    return {{n.lo_x[c], n.lo_y[c], n.lo_z[c]}, {n.hi_x[c], n.hi_y[c], n.hi_z[c]}};
+}
+
+bool inside(const Bounds3& inner, const Bounds3& outer) {
+    if (inner.lo.x > inner.hi.x) return true;  // empty
+    for (int a = 0; a < 3; ++a)
+        if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+    return true;
+}
+
+/// Marks the slots of one leaf (first slot or, with leaf blocks, first block; count slots).
+void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vector<int>& slot_uses) {
+    if (acc.layout() != BvhLayout::wide4) {
+        REQUIRE(first + count <= slot_uses.size());
+        for (uint32_t s = 0; s < count; ++s) ++slot_uses[first + s];
+        return;
+    }
+    const auto& blocks = acc.leaf_blocks();
+    REQUIRE(first + (count + 3) / 4 <= blocks.size());
+    uint32_t lanes = 0;
+    for (uint32_t b = first; b < first + (count + 3) / 4; ++b)
+        for (uint32_t slot : blocks[b].slot) {
+            if (slot == TriangleBlock4::kEmptyLane) continue;
+            ++lanes;
+            slot &= ~TriangleBlock4::kOtherKind;
+            REQUIRE(slot < slot_uses.size());
+            ++slot_uses[slot];
+        }
+    CHECK(lanes == count);
+}
+
+/// Every slot in exactly one leaf, every node reached once, child boxes inside the parent's box.
+void check_bvh4_valid(const Accelerator& acc) {
+    const Bvh4& t = acc.bvh4();
+    REQUIRE_FALSE(t.empty);
+    std::vector<int> slot_uses(acc.primitive_count(), 0), node_uses(t.nodes.size(), 0);
+    if (t.root.is_leaf()) {
+        use_leaf(acc, t.root.index, t.root.count, slot_uses);
+    } else {
+        std::vector<std::pair<uint32_t, Bounds3>> stack{{0u, t.root.box()}};
+        while (!stack.empty()) {
+            const auto [index, box] = stack.back();
+            stack.pop_back();
+            REQUIRE(index < t.nodes.size());
+            ++node_uses[index];
+            const Bvh4Node& n = t.nodes[index];
+            int children = 0;
+            for (int c = 0; c < 4; ++c) {
+                if (!n.has_child(c)) {
+                    CHECK(n.count[c] == 0);
+                    CHECK(child_box(n, c).lo.x > child_box(n, c).hi.x);
+                    continue;
+                }
+                ++children;
+                CHECK(inside(child_box(n, c), box));
+                if (n.count[c]) {
+                    use_leaf(acc, n.child[c], n.count[c], slot_uses);
+                } else {
+                    stack.push_back({n.child[c], child_box(n, c)});
+                }
+            }
+            CHECK(children >= 2);
+        }
+    }
+    CHECK(std::all_of(slot_uses.begin(), slot_uses.end(), [](int u) { return u == 1; }));
+    CHECK(std::all_of(node_uses.begin(), node_uses.end(), [](int u) { return u == 1; }));
+}
+
+bool same_t(float a, float b) { return std::fabs(a - b) <= 1e-6f * std::max(std::fabs(a), std::fabs(b)); }
+
+/// Rays on which `acc` (BVH4) disagrees with the brute-force loop, for intersect and occluded.
+int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
+    int bad = 0;
+    for (const Ray& r0 : rays) {
+        Ray a = r0, b = r0;
+        Hit ha, hb;
+        const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
+        if (fa != fb || acc.occluded(r0) != fb) ++bad;
+        else if (fa && (!same_t(ha.t, hb.t) || (ha.prim != hb.prim && ha.t != hb.t) || a.tmax != ha.t)) ++bad;
+    }
+    return bad;
+}
+
+/// Both wide layouts on every runnable SIMD path: valid trees, brute-force answers.
+void check_mesh(const TriangleMesh& mesh, uint32_t seed) {
+    const Scene scene = scene_from_mesh(mesh);
+    const double budget = 2.5e7 / double(std::max<size_t>(mesh.triangle_count(), 1));
+    const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
+    const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
+    SimdPathGuard guard;
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide4_slots}) {
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        const Accelerator acc(scene, opt);
+        REQUIRE(acc.layout() == layout);
+        check_bvh4_valid(acc);
+        for (SimdPath path : runnable_paths()) {
+            force_simd_path(path);
+            INFO(mesh.name, " layout ", bvh_layout_name(layout), " path ", simd_path_name(path), " rays ", rays.size());
+            CHECK(active_simd_path() == path);
+            CHECK(disagreements(acc, rays) == 0);
+        }
+    }
+}
+
+}  // namespace
+
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on every SIMD path") {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++);
+}
+
+TEST_CASE("BVH4 is valid and agrees with brute force on the shared OBJ meshes, on every SIMD path") {
+    uint32_t seed = 600;
+    for (const auto& f : obj_files()) check_mesh(read_obj_triangles(f), seed++);
+}
+
+TEST_CASE("BVH4 and pair layouts give the same hits") {
+    const TriangleMesh m = make_icosphere(4);  // random rays hit it often, even the few under ASan
+    const Scene scene = scene_from_mesh(m);
+    AcceleratorOptions wide, pairs;
+    pairs.layout = BvhLayout::pairs;
+    const Accelerator a(scene, wide), b(scene, pairs);
+    CHECK(b.layout() == BvhLayout::pairs);
+    CHECK(b.bvh4().empty);
+    int bad = 0, hits = 0;
+    for (const Ray& r0 : make_random_rays(mesh_bounds(m), 20000 / kSanitizerDivisor, 77)) {
+        Ray ra = r0, rb = r0;
+        Hit ha, hb;
+        const bool fa = a.intersect(ra, ha), fb = b.intersect(rb, hb);
+        hits += fa;
+        if (fa != fb || (fa && ha.t != hb.t) || a.occluded(r0) != b.occluded(r0)) ++bad;
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+}
+
+TEST_CASE("BVH4 box test matches the single-node test, including zero directions on slab planes") {
+    std::mt19937 rng(31);
+    std::uniform_int_distribution<int> coord(-2, 2);  // small integers: origins often exactly on planes
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0;
+    for (int i = 0; i < 100000 / kSanitizerDivisor; ++i) {
+        BvhNode child[4];
+        Bvh4Node n{};
+        for (int c = 0; c < 4; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};  // empty box
+            child[c].set_box(b);
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+        }
+        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+        const BvhRay r(ray);
+        __m128 tv;
+        const int mask = intersect_bvh4(n, Bvh4Ray(r), r.tmin, r.tmax, tv);
+        alignas(16) float t4[4];
+        _mm_store_ps(t4, tv);
+        for (int c = 0; c < 4; ++c) {
+            float t = 0.0f;
+            const bool hit = intersect_bvh_node(child[c], r, t);
+            if (hit != bool(mask & (1 << c)) || (hit && t != t4[c])) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight test") {
+    // A fine grid: rays through shared edges and vertices give exactly-zero edge functions.
+    const TriangleMesh m = make_tiny_grid(12, 1.0f, 1.0f);
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> coord(-1, 13);
+    int bad = 0, hits = 0, checked = 0;
+    const std::vector<Ray> random = make_random_rays(mesh_bounds(m), 4000 / kSanitizerDivisor, 8);
+    for (size_t i = 0; i < random.size(); ++i) {
+        Ray ray = random[i];
+        if (i % 2 == 0)  // integer origins straight down: through grid vertices and edges
+            ray = Ray{Vec3(float(coord(rng)) * 0.5f, float(coord(rng)) * 0.5f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)};
+        const TriangleRay tr(ray);
+        for (size_t first = 0; first + 4 <= m.triangle_count(); first += 4) {
+            TriangleBlock4 b{};
+            TriangleVerts tri[4];
+            for (int l = 0; l < 4; ++l) {
+                const uint32_t* v = &m.indices[3 * (first + size_t(l))];
+                tri[l] = TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]);
+                for (int k = 0; k < 3; ++k)
+                    for (int a = 0; a < 3; ++a) b.p[k][a][l] = tri[l].p[k][a];
+                b.slot[l] = uint32_t(l);
+            }
+            float t[4], u[4], v[4];
+            const int mask = intersect_triangle_block4(tr, b, ray.tmin, ray.tmax, t, u, v);
+            for (int l = 0; l < 4; ++l) {
+                TriangleHit h{};
+                const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
+                ++checked;
+                hits += hit;
+                if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l]))) ++bad;
+            }
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+    CHECK(checked > 0);
+}
+
+TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
+    Scene scene = scene_from_mesh(make_icosphere(2, 0.5f));
+    scene.spheres.push_back(Sphere{Vec3(2.0f, 0.0f, 0.0f), 0.4f});
+    scene.boxes.push_back(Box{Bounds3{{-2.5f, -0.5f, -0.5f}, {-1.5f, 0.5f, 0.5f}}});
+    const Accelerator acc(scene);
+    check_bvh4_valid(acc);
+    CHECK(disagreements(acc, make_random_rays(acc.bounds(), 20000 / kSanitizerDivisor, 91)) == 0);
+    TraversalCounters counters;
+    Ray r{Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1.0f)};
+    Hit h;
+    REQUIRE(acc.intersect_counted(r, h, counters));
+    CHECK(counters.nodes_visited > 1);
+    CHECK(counters.prims_tested > 0);
+    BvhLayout layout{};
+    CHECK(parse_bvh_layout("pairs", layout));
+    CHECK(layout == BvhLayout::pairs);
+    CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide4), layout));
+    CHECK(layout == BvhLayout::wide4);
+    CHECK(parse_bvh_layout("wide4-slots", layout));
+    CHECK(layout == BvhLayout::wide4_slots);
+    CHECK_FALSE(parse_bvh_layout("bvh8", layout));
+}
