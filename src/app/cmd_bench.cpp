@@ -95,7 +95,7 @@ nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& ac
 
 nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     omp_set_num_threads(opt.threads);
-    const TriangleMesh mesh = read_obj_triangles(opt.mesh);
+    const TriangleMesh mesh = read_mesh_triangles(opt.mesh);
     const Scene scene = scene_from_mesh(mesh);
     AcceleratorOptions aopt;
     aopt.builder = opt.builder;

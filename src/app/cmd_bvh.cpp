@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kBvhUsage =
     "usage: sahara bvh FILE [--builder binned|sweep] [--size N] [--json]\n"
-    "  FILE        a mesh (.obj); polygons are fan-split, degenerate triangles kept\n"
+    "  FILE        a mesh (.obj, .gltf, .glb); OBJ polygons are fan-split, degenerate triangles kept\n"
     "  --builder   binned (default: binned SAH, parallel) or sweep (exact sweep SAH)\n"
     "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays\n"
     "  --json      print one JSON object instead of text\n"
@@ -49,7 +49,7 @@ nlohmann::ordered_json work_json(const TraversalCounters& c, size_t rays) {
 }
 
 nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, int size) {
-    const TriangleMesh mesh = read_obj_triangles(file);
+    const TriangleMesh mesh = read_mesh_triangles(file);
     const Scene scene = scene_from_mesh(mesh);
     AcceleratorOptions opt;
     opt.builder = builder;

@@ -6,6 +6,8 @@
 
 #include "base/error.h"
 
+#include "io/model_loader.h"
+
 namespace sahara {
 
 TriangleMesh read_obj_triangles(const std::filesystem::path& file) {
@@ -47,6 +49,20 @@ TriangleMesh read_obj_triangles(const std::filesystem::path& file) {
         }
     }
     return mesh;
+}
+
+TriangleMesh read_mesh_triangles(const std::filesystem::path& file) {
+    const std::string ext = file.extension().string();
+    if (ext != ".gltf" && ext != ".glb") return read_obj_triangles(file);
+    LoadedModel model = load_model(file);
+    TriangleMesh all;
+    all.name = file.string();
+    for (const TriangleMesh& m : model.meshes) {
+        const auto base = uint32_t(all.positions.size());
+        all.positions.insert(all.positions.end(), m.positions.begin(), m.positions.end());
+        for (uint32_t i : m.indices) all.indices.push_back(base + i);
+    }
+    return all;
 }
 
 Scene scene_from_mesh(const TriangleMesh& mesh) {

@@ -19,6 +19,11 @@ namespace sahara {
 /// for a missing or malformed file, an out-of-range index or a non-finite position.
 TriangleMesh read_obj_triangles(const std::filesystem::path& file);
 
+/// Triangles of any mesh file: OBJ through read_obj_triangles (file order kept,
+/// degenerate triangles kept), .gltf/.glb through the glTF loader with every
+/// mesh of the default scene merged into one.
+TriangleMesh read_mesh_triangles(const std::filesystem::path& file);
+
 /// A Scene holding only `mesh`'s triangles (no BVH yet; call build_accelerator or build an Accelerator).
 Scene scene_from_mesh(const TriangleMesh& mesh);
 
