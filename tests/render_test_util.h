@@ -85,7 +85,8 @@ inline Stat radiance_stats(const Scene& scene, const Ray& ray, int n, int max_de
 /// |a - b| <= k standard errors (+ a relative slack for float rounding) in every channel.
 inline bool within(const Stat& s, const Rgb& expected, float k, float rel = 1e-4f) {
     for (int c = 0; c < 3; ++c)
-        if (std::abs(s.mean[c] - expected[c]) > k * s.se[c] + rel * std::abs(expected[c]) + 1e-7f) return false;
+        if (std::abs(s.mean[c] - expected[c]) > k * s.se[c] + rel * std::abs(expected[c]) + 1e-7f)
+            return false;
     return true;
 }
 

@@ -27,7 +27,9 @@ std::vector<std::filesystem::path> shared_obj_files() {
     return files;
 }
 
-bool same_t(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b)); }
+bool same_t(float a, float b, float rel) {
+    return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b));
+}
 
 /// Number of rays on which the tree disagrees with the brute-force loop: hit/miss,
 /// t beyond 1e-6 relative, or a different primitive at a different t; occluded() must match hit/miss.
@@ -39,9 +41,12 @@ int count_disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
         Hit ha, hb;
         const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
         const bool occ = acc.occluded(rays[i]);
-        if (fa != fb || occ != fb) ++bad;
-        else if (fa && (!same_t(ha.t, hb.t, 1e-6f) || (ha.prim != hb.prim && ha.t != hb.t))) ++bad;
-        else if (fa && a.tmax != ha.t) ++bad;
+        if (fa != fb || occ != fb)
+            ++bad;
+        else if (fa && (!same_t(ha.t, hb.t, 1e-6f) || (ha.prim != hb.prim && ha.t != hb.t)))
+            ++bad;
+        else if (fa && a.tmax != ha.t)
+            ++bad;
     }
     return bad;
 }
@@ -54,12 +59,14 @@ int ray_budget(size_t tris, int max_rays) {
     return int(std::clamp(budget, 1000.0, double(max_rays))) / kSanitizerDivisor;
 }
 
-void check_against_brute_force(const TriangleMesh& mesh, BvhBuilder builder, uint32_t seed, int max_rays = 100000) {
+void check_against_brute_force(const TriangleMesh& mesh, BvhBuilder builder, uint32_t seed,
+                               int max_rays = 100000) {
     Scene scene = scene_from_mesh(mesh);
     AcceleratorOptions opt;
     opt.builder = builder;
     const Accelerator acc(scene, opt);
-    const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), ray_budget(mesh.triangle_count(), max_rays), seed);
+    const std::vector<Ray> rays =
+        make_random_rays(mesh_bounds(mesh), ray_budget(mesh.triangle_count(), max_rays), seed);
     INFO(mesh.name, " builder ", bvh_builder_name(builder), " rays ", rays.size());
     CHECK(count_disagreements(acc, rays) == 0);
 }
@@ -153,7 +160,8 @@ TEST_CASE("BVH agrees with brute force on procedural meshes") {
 
 TEST_CASE("BVH agrees with brute force on the shared OBJ meshes") {
     uint32_t seed = 100;
-    for (const auto& f : shared_obj_files()) check_against_brute_force(read_obj_triangles(f), BvhBuilder::binned, seed++);
+    for (const auto& f : shared_obj_files())
+        check_against_brute_force(read_obj_triangles(f), BvhBuilder::binned, seed++);
 }
 
 TEST_CASE("spheres, boxes and triangles in one tree agree with brute force") {
@@ -205,7 +213,8 @@ TEST_CASE("axis-parallel rays with the origin on a node's slab plane are not los
         for (int x = 0; x < 8; ++x) {
             const auto b = uint32_t(m.positions.size());
             const Vec3 o(float(x), float(y), 0);
-            m.positions.insert(m.positions.end(), {o, o + Vec3(1, 0, 0), o + Vec3(1, 1, 0), o + Vec3(0, 1, 0)});
+            m.positions.insert(m.positions.end(),
+                               {o, o + Vec3(1, 0, 0), o + Vec3(1, 1, 0), o + Vec3(0, 1, 0)});
             m.indices.insert(m.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
         }
     Scene scene = scene_from_mesh(m);
@@ -239,9 +248,12 @@ TEST_CASE("pair-node box test matches the single-node test, including zero direc
         }
         BvhPairNode p{};
         for (int c = 0; c < 2; ++c) {
-            p.x[c] = child[c].bounds[0]; p.x[c + 2] = child[c].bounds[1];
-            p.y[c] = child[c].bounds[2]; p.y[c + 2] = child[c].bounds[3];
-            p.z[c] = child[c].bounds[4]; p.z[c + 2] = child[c].bounds[5];
+            p.x[c] = child[c].bounds[0];
+            p.x[c + 2] = child[c].bounds[1];
+            p.y[c] = child[c].bounds[2];
+            p.y[c + 2] = child[c].bounds[3];
+            p.z[c] = child[c].bounds[4];
+            p.z[c + 2] = child[c].bounds[5];
         }
         Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
         for (int a = 0; a < 3; ++a)
@@ -274,8 +286,9 @@ TEST_CASE("generic traversal of the canonical tree with a caller-supplied leaf t
                 const uint32_t t = bvh.prim_indices[s];
                 const uint32_t* v = &m.indices[3 * size_t(t)];
                 TriangleHit h{};
-                if (intersect_triangle(tr, TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]),
-                                       r0.tmin, tmax, h)) {
+                if (intersect_triangle(
+                        tr, TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]),
+                        r0.tmin, tmax, h)) {
                     tmax = h.t;
                     best = t;
                     hit = true;
@@ -390,7 +403,8 @@ template <class Fn>
 std::pair<int, std::string> run_captured(Fn fn, std::vector<std::string> args) {
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
-    const auto path = std::filesystem::temp_directory_path() / ("sahara_capture_" + std::to_string(::getpid()));
+    const auto path =
+        std::filesystem::temp_directory_path() / ("sahara_capture_" + std::to_string(::getpid()));
     std::fflush(stdout);
     const int saved = ::dup(1);
     std::FILE* f = std::fopen(path.string().c_str(), "w");
@@ -407,7 +421,8 @@ std::pair<int, std::string> run_captured(Fn fn, std::vector<std::string> args) {
 }
 
 std::filesystem::path temp_dir(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("sahara_" + name + "_" + std::to_string(::getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("sahara_" + name + "_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     return dir;
 }
@@ -459,16 +474,20 @@ TEST_CASE("compare_answers counts hit/miss, t and primitive differences") {
 
 TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
     const auto dir = temp_dir("trace");
-    const auto obj = dir / "quad.obj", rays_file = dir / "in.rays", hits = dir / "out.hits", occl = dir / "out.occl";
+    const auto obj = dir / "quad.obj", rays_file = dir / "in.rays", hits = dir / "out.hits",
+               occl = dir / "out.occl";
     {
         std::ofstream o(obj);
-        o << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 5 5 5\nf 1 2 3 4\n";  // degenerate first: index 0
+        o << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 5 5 5\nf 5 5 5\nf 1 2 3 4\n";  // degenerate first: index
+                                                                                   // 0
     }
     const float rays[3][8] = {{0.8f, 0.2f, 1, 0, 0, -1, 0, 100},   // triangle (v0,v1,v2) = index 1
                               {0.2f, 0.8f, 1, 0, 0, -1, 0, 100},   // triangle (v0,v2,v3) = index 2
                               {3.0f, 3.0f, 1, 0, 0, -1, 0, 100}};  // miss
     write_file(rays_file, rays, sizeof(rays));
-    auto run = [&](std::vector<std::string> args) { return run_captured(run_trace_command, std::move(args)).first; };
+    auto run = [&](std::vector<std::string> args) {
+        return run_captured(run_trace_command, std::move(args)).first;
+    };
     REQUIRE(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", hits.string(), "--occlusion",
                  occl.string()}) == 0);
     std::ifstream h(hits, std::ios::binary);
@@ -491,15 +510,19 @@ TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
     // Bad input: exit 2, and no output left behind.
     const auto out2 = dir / "bad.hits";
     write_file(dir / "short.rays", rays, 33);
-    CHECK(run({"trace", obj.string(), "--rays", (dir / "short.rays").string(), "--hits", out2.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", (dir / "short.rays").string(), "--hits", out2.string()}) ==
+          2);
     float nan_ray[8] = {0, 0, 1, 0, 0, -1, 0, std::nanf("")};
     write_file(dir / "nan.rays", nan_ray, sizeof(nan_ray));
     CHECK(run({"trace", obj.string(), "--rays", (dir / "nan.rays").string(), "--hits", out2.string()}) == 2);
-    CHECK(run({"trace", (dir / "missing.obj").string(), "--rays", rays_file.string(), "--hits", out2.string()}) == 2);
-    CHECK(run({"trace", obj.string(), "--rays", (dir / "missing.rays").string(), "--hits", out2.string()}) == 2);
+    CHECK(run({"trace", (dir / "missing.obj").string(), "--rays", rays_file.string(), "--hits",
+               out2.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", (dir / "missing.rays").string(), "--hits", out2.string()}) ==
+          2);
     CHECK(!std::filesystem::exists(out2));
     CHECK(run({"trace", obj.string(), "--hits", out2.string()}) == 2);
-    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--bogus"}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--bogus"}) ==
+          2);
     const auto help = run_captured(run_trace_command, {"trace", "--help"});
     CHECK(help.first == 0);
     CHECK(help.second.find("fan-split") != std::string::npos);
@@ -508,10 +531,12 @@ TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
 
 TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     const std::string mesh = SAHARA_ASSETS_DIR "/obj/suzanne/suzanne.obj";
-    const auto bvh = run_captured(run_bvh_command, {"bvh", mesh, "--builder", "sweep", "--size", "32", "--json"});
+    const auto bvh =
+        run_captured(run_bvh_command, {"bvh", mesh, "--builder", "sweep", "--size", "32", "--json"});
     REQUIRE(bvh.first == 0);
-    for (const char* key : {"\"primitives\"", "\"nodes\"", "\"leaves\"", "\"max_depth\"", "\"sah_cost\"", "\"build_ms\"",
-                            "\"bytes\"", "\"leaf_size_histogram\"", "\"nodes_visited\"", "\"prims_tested\""})
+    for (const char* key :
+         {"\"primitives\"", "\"nodes\"", "\"leaves\"", "\"max_depth\"", "\"sah_cost\"", "\"build_ms\"",
+          "\"bytes\"", "\"leaf_size_histogram\"", "\"nodes_visited\"", "\"prims_tested\""})
         CHECK(bvh.second.find(key) != std::string::npos);
     const auto text = run_captured(run_bvh_command, {"bvh", mesh, "--size", "16"});
     CHECK(text.first == 0);
@@ -521,18 +546,18 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     CHECK(run_captured(run_bvh_command, {"bvh", "/nonexistent.obj"}).first == 2);
     CHECK(run_captured(run_bvh_command, {"bvh", "--help"}).first == 0);
 
-    const auto bench = run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--threads", "2",
-                                                        "--json"});
+    const auto bench = run_captured(
+        run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--threads", "2", "--json"});
     REQUIRE(bench.first == 0);
-    for (const char* key : {"\"mesh\"", "\"primitives\"", "\"threads\":2", "\"build_ms\"", "\"primary\"", "\"diffuse\"",
-                            "\"shadow\"", "\"mrays_s\"", "\"hit_rate\""})
+    for (const char* key : {"\"mesh\"", "\"primitives\"", "\"threads\":2", "\"build_ms\"", "\"primary\"",
+                            "\"diffuse\"", "\"shadow\"", "\"mrays_s\"", "\"hit_rate\""})
         CHECK(bench.second.find(key) != std::string::npos);
     if (EmbreeReference::available()) {
         CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
         CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
     }
-    const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays", "shadow",
-                                                       "--no-embree"});
+    const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1",
+                                                       "--rays", "shadow", "--no-embree"});
     CHECK(only.first == 0);
     CHECK(only.second.find("primary") == std::string::npos);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--rays", "sideways"}).first == 2);

@@ -119,8 +119,10 @@ int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
         Ray a = r0, b = r0;
         Hit ha, hb;
         const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
-        if (fa != fb || acc.occluded(r0) != fb) ++bad;
-        else if (fa && (!same_t(ha.t, hb.t) || (ha.prim != hb.prim && ha.t != hb.t) || a.tmax != ha.t)) ++bad;
+        if (fa != fb || acc.occluded(r0) != fb)
+            ++bad;
+        else if (fa && (!same_t(ha.t, hb.t) || (ha.prim != hb.prim && ha.t != hb.t) || a.tmax != ha.t))
+            ++bad;
     }
     return bad;
 }
@@ -140,7 +142,8 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed) {
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
-            INFO(mesh.name, " layout ", bvh_layout_name(layout), " path ", simd_path_name(path), " rays ", rays.size());
+            INFO(mesh.name, " layout ", bvh_layout_name(layout), " path ", simd_path_name(path), " rays ",
+                 rays.size());
             CHECK(active_simd_path() == path);
             CHECK(disagreements(acc, rays) == 0);
         }
@@ -223,7 +226,8 @@ TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight tes
     for (size_t i = 0; i < random.size(); ++i) {
         Ray ray = random[i];
         if (i % 2 == 0)  // integer origins straight down: through grid vertices and edges
-            ray = Ray{Vec3(float(coord(rng)) * 0.5f, float(coord(rng)) * 0.5f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)};
+            ray =
+                Ray{Vec3(float(coord(rng)) * 0.5f, float(coord(rng)) * 0.5f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)};
         const TriangleRay tr(ray);
         for (size_t first = 0; first + 4 <= m.triangle_count(); first += 4) {
             TriangleBlock4 b{};
@@ -242,7 +246,8 @@ TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight tes
                 const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
                 ++checked;
                 hits += hit;
-                if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l]))) ++bad;
+                if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l])))
+                    ++bad;
             }
         }
     }

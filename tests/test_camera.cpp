@@ -43,7 +43,8 @@ TEST_CASE("camera: the 20-minutes Euler form follows the scene-format formula") 
     const int w = 320, h = 240;
     const Camera cam(d, w, h);
     const Mat4 r = Mat4::rotate_euler(Vec3d(d.euler));
-    const Vec3 right = r.apply_vector({1, 0, 0}), up = r.apply_vector({0, 1, 0}), front = r.apply_vector({0, 0, 1});
+    const Vec3 right = r.apply_vector({1, 0, 0}), up = r.apply_vector({0, 1, 0}),
+               front = r.apply_vector({0, 0, 1});
     for (auto [i, j] : {std::pair{0, 0}, {120, 160}, {239, 5}, {17, 300}}) {
         const Vec3 expect = normalize(front * d.focal_length + right * (float(j) / float(w) - 0.5f) +
                                       up * (float(h) / float(w)) * (0.5f - float(i) / float(h)));

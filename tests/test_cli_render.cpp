@@ -88,7 +88,8 @@ void wait_for_sigint_handler(pid_t pid) {
         std::ifstream status("/proc/" + std::to_string(pid) + "/status");
         std::string line;
         while (std::getline(status, line))
-            if (line.rfind("SigCgt:", 0) == 0 && (std::stoull(line.substr(7), nullptr, 16) & (1ull << (SIGINT - 1))))
+            if (line.rfind("SigCgt:", 0) == 0 &&
+                (std::stoull(line.substr(7), nullptr, 16) & (1ull << (SIGINT - 1))))
                 return;
         std::this_thread::sleep_for(std::chrono::milliseconds(25));
     }
@@ -178,8 +179,8 @@ TEST_CASE("cli: metadata is readable back from PNG and EXR") {
 TEST_CASE("cli: 32 spp then --resume to 64 spp equals 64 spp in one run, bit for bit") {
     TempDir dir("resume");
     REQUIRE(run_sahara("render" + kSmall + "--spp 32 -o " + (dir / "half.exr"), dir).code == 0);
-    const RunResult r = run_sahara("render" + kSmall + "--spp 64 --resume " + (dir / "half.exr") + " -o " +
-                                       (dir / "resumed.exr"), dir);
+    const RunResult r = run_sahara(
+        "render" + kSmall + "--spp 64 --resume " + (dir / "half.exr") + " -o " + (dir / "resumed.exr"), dir);
     REQUIRE(r.code == 0);
     REQUIRE(run_sahara("render" + kSmall + "--spp 64 -o " + (dir / "full.exr"), dir).code == 0);
     CHECK(read_image(dir / "resumed.exr", false)->rgba == read_image(dir / "full.exr", false)->rgba);
@@ -190,8 +191,8 @@ TEST_CASE("cli: 32 spp then --resume to 64 spp equals 64 spp in one run, bit for
 TEST_CASE("cli: --resume refuses a file rendered with other settings") {
     TempDir dir("resume_bad");
     REQUIRE(run_sahara("render" + kSmall + "--spp 2 -o " + (dir / "a.exr"), dir).code == 0);
-    RunResult r = run_sahara("render" + kSmall + "--spp 4 --seed 3 --resume " + (dir / "a.exr") + " -o " +
-                                 (dir / "b.exr"), dir);
+    RunResult r = run_sahara(
+        "render" + kSmall + "--spp 4 --seed 3 --resume " + (dir / "a.exr") + " -o " + (dir / "b.exr"), dir);
     CHECK(r.code == 2);
     CHECK(r.err.find("seed") != std::string::npos);
     CHECK_FALSE(fs::exists(dir / "b.exr"));
@@ -203,8 +204,8 @@ TEST_CASE("cli: --resume refuses a file rendered with other settings") {
 TEST_CASE("cli: SIGINT stops, writes the samples done and exits 130") {
     TempDir dir("sigint");
     const std::string out = dir / "long.png";
-    const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out},
-                                   dir / "err.txt");
+    const pid_t pid = spawn_sahara(
+        {"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out}, dir / "err.txt");
     wait_for_sigint_handler(pid);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     ::kill(pid, SIGINT);
@@ -222,8 +223,8 @@ TEST_CASE("cli: SIGINT stops, writes the samples done and exits 130") {
 TEST_CASE("cli: a second SIGINT exits at once and leaves no partial file") {
     TempDir dir("sigint2");
     const std::string out = dir / "long.exr";
-    const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out},
-                                   dir / "err.txt");
+    const pid_t pid = spawn_sahara(
+        {"render", "--width", "24", "--height", "16", "--spp", "1000000", "-o", out}, dir / "err.txt");
     wait_for_sigint_handler(pid);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     ::kill(pid, SIGINT);
@@ -251,8 +252,9 @@ TEST_CASE("cli: --time stops early with a valid image") {
 TEST_CASE("cli: --checkpoint writes the image while the render runs") {
     TempDir dir("checkpoint");
     const std::string out = dir / "c.png";
-    const pid_t pid = spawn_sahara({"render", "--width", "24", "--height", "16", "--spp", "1000000", "--checkpoint",
-                                    "0.2", "-o", out}, dir / "err.txt");
+    const pid_t pid = spawn_sahara(
+        {"render", "--width", "24", "--height", "16", "--spp", "1000000", "--checkpoint", "0.2", "-o", out},
+        dir / "err.txt");
     wait_for_sigint_handler(pid);
     bool appeared = false;
     for (int i = 0; i < 600 && !appeared; ++i) {
@@ -269,7 +271,8 @@ TEST_CASE("cli: --target-error reports its estimate, --reference the true error"
     TempDir dir("adaptive");
     REQUIRE(run_sahara("render" + kSmall + "--spp 256 --seed 99 -o " + (dir / "ref.exr"), dir).code == 0);
     const RunResult r = run_sahara("render" + kSmall + "--spp 256 --target-error 0.05 --reference " +
-                                       (dir / "ref.exr") + " -o " + (dir / "a.exr"), dir);
+                                       (dir / "ref.exr") + " -o " + (dir / "a.exr"),
+                                   dir);
     CHECK(r.code == 0);
     CHECK(r.err.find("est. error") != std::string::npos);
     CHECK(r.err.find("true error") != std::string::npos);

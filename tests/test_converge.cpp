@@ -58,9 +58,9 @@ TEST_CASE("plot: axes, labels and series land in the image") {
 TEST_CASE("converge: end to end on a tiny default scene writes CSV, plot and reference") {
     const std::string prefix = (std::filesystem::temp_directory_path() / "sahara_test_converge").string();
     // Tiny image and budget: a smoke test of the whole command, files included.
-    const int rc = run_converge_command({"--width", "32", "--height", "24", "--budget", "0.3", "--max-spp", "64",
-                                         "--threads", "2", "-o", prefix, "--compare", "sobol=--sampler sobol",
-                                         "--compare", "random=--sampler independent"});
+    const int rc = run_converge_command(
+        {"--width", "32", "--height", "24", "--budget", "0.3", "--max-spp", "64", "--threads", "2", "-o",
+         prefix, "--compare", "sobol=--sampler sobol", "--compare", "random=--sampler independent"});
     REQUIRE(rc == 0);
     std::ifstream csv(prefix + ".csv");
     std::string header;

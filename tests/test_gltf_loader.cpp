@@ -37,7 +37,8 @@ std::vector<uint8_t> read_all(const fs::path& f) {
 }
 
 void write_bytes(const fs::path& f, const std::vector<uint8_t>& b) {
-    std::ofstream(f, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
+    std::ofstream(f, std::ios::binary)
+        .write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
 }
 
 void write_text(const fs::path& f, const std::string& s) { std::ofstream(f, std::ios::binary) << s; }
@@ -73,17 +74,26 @@ struct Blob {
 
 /// A glTF document built in the tests: one buffer (embedded as a data URI by default).
 struct Doc {
-    json j = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", json::array()}}}},
-              {"nodes", json::array()}, {"meshes", json::array()}, {"accessors", json::array()},
-              {"bufferViews", json::array()}, {"buffers", json::array()}};
+    json j = {{"asset", {{"version", "2.0"}}},
+              {"scene", 0},
+              {"scenes", {{{"nodes", json::array()}}}},
+              {"nodes", json::array()},
+              {"meshes", json::array()},
+              {"accessors", json::array()},
+              {"bufferViews", json::array()},
+              {"buffers", json::array()}};
     Blob blob;
 
     /// Adds data as its own bufferView and an accessor over it.
     template <class T>
-    int accessor(const std::vector<T>& data, int component_type, const char* type, size_t count, bool normalized = false) {
+    int accessor(const std::vector<T>& data, int component_type, const char* type, size_t count,
+                 bool normalized = false) {
         const size_t at = blob.add(data);
-        j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", data.size() * sizeof(T)}});
-        json a = {{"bufferView", j["bufferViews"].size() - 1}, {"componentType", component_type}, {"type", type},
+        j["bufferViews"].push_back(
+            {{"buffer", 0}, {"byteOffset", at}, {"byteLength", data.size() * sizeof(T)}});
+        json a = {{"bufferView", j["bufferViews"].size() - 1},
+                  {"componentType", component_type},
+                  {"type", type},
                   {"count", count}};
         if (normalized) a["normalized"] = true;
         j["accessors"].push_back(a);
@@ -105,7 +115,8 @@ struct Doc {
     }
     std::string text() {
         j["buffers"] = json::array();
-        if (!blob.bytes.empty()) j["buffers"].push_back({{"byteLength", blob.bytes.size()}, {"uri", blob.data_uri()}});
+        if (!blob.bytes.empty())
+            j["buffers"].push_back({{"byteLength", blob.bytes.size()}, {"uri", blob.data_uri()}});
         return j.dump();
     }
     fs::path write(const fs::path& file) {
@@ -163,10 +174,12 @@ Mat4 node_matrix(const json& n) {
     Mat4 m;
     if (n.contains("matrix")) {
         for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) m.m[size_t(r)][size_t(c)] = n["matrix"][size_t(c * 4 + r)].get<double>();
+            for (int c = 0; c < 4; ++c)
+                m.m[size_t(r)][size_t(c)] = n["matrix"][size_t(c * 4 + r)].get<double>();
         return m;
     }
-    if (n.contains("translation")) m = Mat4::translate({n["translation"][0], n["translation"][1], n["translation"][2]});
+    if (n.contains("translation"))
+        m = Mat4::translate({n["translation"][0], n["translation"][1], n["translation"][2]});
     if (n.contains("rotation")) {
         const auto& q = n["rotation"];
         m = m * Mat4::rotate_quaternion(q[0], q[1], q[2], q[3]);
@@ -192,7 +205,8 @@ Bounds3 corner_bounds(const json& j) {
                 const json& acc = j["accessors"][prim["attributes"]["POSITION"].get<size_t>()];
                 for (int c = 0; c < 8; ++c) {
                     Vec3 p;
-                    for (int k = 0; k < 3; ++k) p[k] = acc[(c >> k) & 1 ? "max" : "min"][size_t(k)].get<float>();
+                    for (int k = 0; k < 3; ++k)
+                        p[k] = acc[(c >> k) & 1 ? "max" : "min"][size_t(k)].get<float>();
                     b.extend(world.apply_point(p));
                 }
             }
@@ -257,9 +271,10 @@ TEST_CASE("every shared glTF asset loads with the published counts") {
         for (int m : mats) {
             if (m < 0) continue;
             const json& mat = j["materials"][size_t(m)];
-            if (mat.contains("pbrMetallicRoughness") && mat["pbrMetallicRoughness"].contains("baseColorTexture"))
-            {
-                const json& tex = j["textures"][mat["pbrMetallicRoughness"]["baseColorTexture"]["index"].get<size_t>()];
+            if (mat.contains("pbrMetallicRoughness") &&
+                mat["pbrMetallicRoughness"].contains("baseColorTexture")) {
+                const json& tex =
+                    j["textures"][mat["pbrMetallicRoughness"]["baseColorTexture"]["index"].get<size_t>()];
                 texs.insert({tex.value("source", -1), tex.value("sampler", -1)});
             }
         }
@@ -297,7 +312,8 @@ TEST_CASE("glTF cameras: Duck's camera includes its parent's 0.01 scale; Cameras
     CHECK(c.basis_forward.x == doctest::Approx(-cm[8].get<double>()).epsilon(1e-4));
     CHECK(c.basis_forward.z == doctest::Approx(-cm[10].get<double>()).epsilon(1e-4));
     CHECK(c.basis_up.y == doctest::Approx(cm[5].get<double>()).epsilon(1e-4));
-    CHECK(c.vfov == doctest::Approx(j["cameras"][0]["perspective"]["yfov"].get<double>() * 180 / std::numbers::pi));
+    CHECK(c.vfov ==
+          doctest::Approx(j["cameras"][0]["perspective"]["yfov"].get<double>() * 180 / std::numbers::pi));
 
     const LoadedModel cams = load_gltf(kAssets / "gltf/Cameras/glTF/Cameras.gltf");
     REQUIRE(cams.cameras.size() == 2);
@@ -312,7 +328,12 @@ TEST_CASE("glTF cameras: Duck's camera includes its parent's 0.01 scale; Cameras
 TEST_CASE("glTF node transforms: T * R * S, parents first, then world_from_model") {
     Doc d;
     const int mesh = d.mesh(d.positions({1, 0, 0, 0, 1, 0, 0, 0, 1}));
-    const int child = d.node({{"mesh", mesh}, {"translation", {0, 0, 5}}, {"rotation", {0, 0, std::sin(std::numbers::pi / 4), std::cos(std::numbers::pi / 4)}}, {"scale", {2, 2, 2}}}, false);
+    const int child =
+        d.node({{"mesh", mesh},
+                {"translation", {0, 0, 5}},
+                {"rotation", {0, 0, std::sin(std::numbers::pi / 4), std::cos(std::numbers::pi / 4)}},
+                {"scale", {2, 2, 2}}},
+               false);
     d.node({{"children", {child}}, {"translation", {10, 0, 0}}});
     const fs::path file = d.write(scratch("trs") / "trs.gltf");
     const LoadedModel m = load_gltf(file, Mat4::scale({1, 1, 3}));
@@ -338,7 +359,9 @@ TEST_CASE("glTF instancing: a mesh used by three nodes appears three times") {
 
 TEST_CASE("glTF mirroring transforms keep triangles front-facing") {
     Doc d;
-    const int mesh = d.mesh(d.positions(kTriangle), -1, 4, {{"NORMAL", d.accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}, 5126, "VEC3", 3)}});
+    const int mesh =
+        d.mesh(d.positions(kTriangle), -1, 4,
+               {{"NORMAL", d.accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}, 5126, "VEC3", 3)}});
     d.node({{"mesh", mesh}, {"scale", {-1, 1, 1}}});
     d.node({{"mesh", mesh}, {"matrix", {1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}});
     const LoadedModel m = load_gltf(d.write(scratch("mirror") / "mirror.gltf"));
@@ -360,16 +383,19 @@ TEST_CASE("glTF triangle strips and fans become consistently wound lists") {
         const double a = k * std::numbers::pi / 4;
         fan.insert(fan.end(), {float(std::cos(a)), float(std::sin(a)), 0});
     }
-    const int fan_mesh = d.mesh(d.positions(fan), d.accessor(std::vector<uint8_t>{0, 1, 2, 3, 4, 5}, 5121, "SCALAR", 6), 6);
+    const int fan_mesh =
+        d.mesh(d.positions(fan), d.accessor(std::vector<uint8_t>{0, 1, 2, 3, 4, 5}, 5121, "SCALAR", 6), 6);
     d.node({{"mesh", strip}});
     d.node({{"mesh", fan_mesh}});
-    d.j["meshes"][0]["primitives"][0]["indices"] = d.accessor(std::vector<uint8_t>{1, 0, 3, 2, 5, 4}, 5121, "SCALAR", 6);
+    d.j["meshes"][0]["primitives"][0]["indices"] =
+        d.accessor(std::vector<uint8_t>{1, 0, 3, 2, 5, 4}, 5121, "SCALAR", 6);
     const LoadedModel m = load_gltf(d.write(scratch("strip") / "strip.gltf"));
     REQUIRE(m.meshes.size() == 2);
     CHECK(m.meshes[0].triangle_count() == 4);
     CHECK(m.meshes[1].triangle_count() == 4);
     for (const auto& mesh : m.meshes)
-        for (size_t t = 0; t < mesh.triangle_count(); ++t) CHECK(face_normal(mesh, t).z == doctest::Approx(1));
+        for (size_t t = 0; t < mesh.triangle_count(); ++t)
+            CHECK(face_normal(mesh, t).z == doctest::Approx(1));
 }
 
 TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView") {
@@ -379,9 +405,10 @@ TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView
     const size_t val_at = d.blob.add(std::vector<float>{1, 1, 0, 0, 0, 7});
     d.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", idx_at}, {"byteLength", 4}});
     d.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", val_at}, {"byteLength", 24}});
-    const json sparse = {{"count", 2},
-                         {"indices", {{"bufferView", d.j["bufferViews"].size() - 2}, {"componentType", 5123}}},
-                         {"values", {{"bufferView", d.j["bufferViews"].size() - 1}}}};
+    const json sparse = {
+        {"count", 2},
+        {"indices", {{"bufferView", d.j["bufferViews"].size() - 2}, {"componentType", 5123}}},
+        {"values", {{"bufferView", d.j["bufferViews"].size() - 1}}}};
     d.j["accessors"][size_t(pos)]["sparse"] = sparse;
     // A second accessor: no bufferView, zeros plus the same substitution.
     d.j["accessors"].push_back({{"componentType", 5126}, {"type", "VEC3"}, {"count", 4}, {"sparse", sparse}});
@@ -411,10 +438,17 @@ TEST_CASE("glTF buffers: external .bin, data URI and .glb give the same mesh") {
         std::memcpy(&inter[size_t(v) * 16 + 12], uv, 4);
     }
     const size_t at = d.blob.add(inter);
-    d.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", inter.size()}, {"byteStride", 16}});
+    d.j["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", at}, {"byteLength", inter.size()}, {"byteStride", 16}});
     const int view = int(d.j["bufferViews"].size()) - 1;
-    d.j["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"type", "VEC3"}, {"count", 4}});
-    d.j["accessors"].push_back({{"bufferView", view}, {"byteOffset", 12}, {"componentType", 5123}, {"normalized", true}, {"type", "VEC2"}, {"count", 4}});
+    d.j["accessors"].push_back(
+        {{"bufferView", view}, {"componentType", 5126}, {"type", "VEC3"}, {"count", 4}});
+    d.j["accessors"].push_back({{"bufferView", view},
+                                {"byteOffset", 12},
+                                {"componentType", 5123},
+                                {"normalized", true},
+                                {"type", "VEC2"},
+                                {"count", 4}});
     const int nrm = int(d.j["accessors"].size()) - 2, uv = nrm + 1;
     d.node({{"mesh", d.mesh(pos, d.accessor(std::vector<uint16_t>{0, 1, 2, 2, 1, 3}, 5123, "SCALAR", 6), 4,
                             {{"NORMAL", nrm}, {"TEXCOORD_0", uv}})}});
@@ -500,11 +534,12 @@ std::vector<uint8_t> handmade_png(uint32_t w, uint32_t h, const std::vector<uint
 TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, sRGB decoding") {
     const fs::path dir = scratch("materials");
     const std::vector<uint8_t> png = tiny_png(dir);
-    const json material = {
-        {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 1, 0.8}}, {"baseColorTexture", {{"index", 0}}}}},
-        {"alphaMode", "MASK"}, {"alphaCutoff", 0.3},
-        {"emissiveFactor", {1, 0.5, 0}},
-        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}}}};
+    const json material = {{"pbrMetallicRoughness",
+                            {{"baseColorFactor", {0.5, 1, 1, 0.8}}, {"baseColorTexture", {{"index", 0}}}}},
+                           {"alphaMode", "MASK"},
+                           {"alphaCutoff", 0.3},
+                           {"emissiveFactor", {1, 0.5, 0}},
+                           {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}}}};
     Doc d = textured_doc(material);
     d.j["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
     d.j["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}}};
@@ -526,11 +561,11 @@ TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, 
     CHECK(t.wrap_v == WrapMode::mirror);
     const Image& img = *t.image;
     REQUIRE(img.width == 2);
-    CHECK(img.rgba[0] == doctest::Approx(1.0f));                                  // top-left red, row 0 = top
-    CHECK(img.rgba[5] == doctest::Approx(srgb_to_linear_value(128 / 255.0f)));   // sRGB decoded
+    CHECK(img.rgba[0] == doctest::Approx(1.0f));                                // top-left red, row 0 = top
+    CHECK(img.rgba[5] == doctest::Approx(srgb_to_linear_value(128 / 255.0f)));  // sRGB decoded
     CHECK(img.rgba[5] == doctest::Approx(0.2158605f).epsilon(1e-4));
-    CHECK(img.rgba[7] == doctest::Approx(128 / 255.0f));                          // alpha stays linear
-    CHECK(img.rgba[10] == doctest::Approx(1.0f));                                 // bottom-left blue
+    CHECK(img.rgba[7] == doctest::Approx(128 / 255.0f));  // alpha stays linear
+    CHECK(img.rgba[10] == doctest::Approx(1.0f));         // bottom-left blue
 
     // The same image from a bufferView (as in .glb files), opaque mode.
     Doc v = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
@@ -559,7 +594,8 @@ TEST_CASE("KHR_texture_transform is rewritten for sahara's v-up uvs") {
     REQUIRE(m.textures.size() == 1);
     const TextureDesc& t = m.textures[0];
     // For a few glTF uvs: the texel row/column glTF addresses must equal sahara's lookup.
-    for (const auto& [u, vg] : std::vector<std::pair<float, float>>{{0.1f, 0.2f}, {0.7f, 0.9f}, {0.5f, 0.0f}}) {
+    for (const auto& [u, vg] :
+         std::vector<std::pair<float, float>>{{0.1f, 0.2f}, {0.7f, 0.9f}, {0.5f, 0.0f}}) {
         // glTF: t = offset + R * (scale * uv) with the spec's column-major GLSL
         // mat3(cos, sin, 0, -sin, cos, 0, ...), i.e. R = [cos -sin; sin cos]; row = t.y * height.
         const float su = scl[0] * u, sv = scl[1] * vg;
@@ -584,7 +620,8 @@ TEST_CASE("KHR_lights_punctual lights and glTF cameras under a scaled parent") {
                              {{"type", "directional"}, {"intensity", 3}},
                              {{"type", "spot"}, {"intensity", 2}, {"spot", {{"outerConeAngle", 0.5}}}}}}}}};
     d.j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}},
-                      {{"type", "orthographic"}, {"orthographic", {{"xmag", 2}, {"ymag", 1.5}, {"znear", 0.1}, {"zfar", 10}}}}};
+                      {{"type", "orthographic"},
+                       {"orthographic", {{"xmag", 2}, {"ymag", 1.5}, {"znear", 0.1}, {"zfar", 10}}}}};
     auto light = [](int i) { return json{{"KHR_lights_punctual", {{"light", i}}}}; };
     const int c0 = d.node({{"translation", {0, 0, 10}}, {"extensions", light(0)}}, false);
     // Rotated -90 degrees about X: local -Z points to world -Y.
@@ -595,22 +632,27 @@ TEST_CASE("KHR_lights_punctual lights and glTF cameras under a scaled parent") {
     d.node({{"scale", {2, 2, 2}}, {"children", {c0, c1, c2, c3}}});
     const LoadedModel m = load_gltf(d.write(scratch("lights") / "lights.gltf"));
     REQUIRE(m.lights.size() == 3);
-    const auto point = std::find_if(m.lights.begin(), m.lights.end(), [](auto& l) { return l.intensity.x == 8.0f; });
+    const auto point =
+        std::find_if(m.lights.begin(), m.lights.end(), [](auto& l) { return l.intensity.x == 8.0f; });
     REQUIRE(point != m.lights.end());
     CHECK(point->type == LightDesc::Type::point);
     CHECK(point->position == Vec3(0, 0, 20));
     CHECK(point->intensity == Rgb(8, 4, 2));
-    const auto spot = std::find_if(m.lights.begin(), m.lights.end(), [](auto& l) { return l.intensity.x == 2.0f; });
+    const auto spot =
+        std::find_if(m.lights.begin(), m.lights.end(), [](auto& l) { return l.intensity.x == 2.0f; });
     REQUIRE(spot != m.lights.end());
     CHECK(spot->type == LightDesc::Type::point);
     CHECK(spot->position == Vec3(2, 0, 0));
-    const auto dir_it = std::find_if(m.lights.begin(), m.lights.end(), [](auto& l) { return l.type == LightDesc::Type::directional; });
+    const auto dir_it = std::find_if(m.lights.begin(), m.lights.end(),
+                                     [](auto& l) { return l.type == LightDesc::Type::directional; });
     REQUIRE(dir_it != m.lights.end());
     CHECK(dir_it->irradiance == Rgb(3, 3, 3));
     CHECK(dir_it->direction.y == doctest::Approx(-1));
     REQUIRE(m.cameras.size() == 2);
-    const auto persp = std::find_if(m.cameras.begin(), m.cameras.end(), [](auto& c) { return !c.orthographic; });
-    const auto ortho = std::find_if(m.cameras.begin(), m.cameras.end(), [](auto& c) { return c.orthographic; });
+    const auto persp =
+        std::find_if(m.cameras.begin(), m.cameras.end(), [](auto& c) { return !c.orthographic; });
+    const auto ortho =
+        std::find_if(m.cameras.begin(), m.cameras.end(), [](auto& c) { return c.orthographic; });
     CHECK(persp->position == Vec3(2, 0, 0));
     CHECK(persp->vfov == doctest::Approx(0.5 * 180 / std::numbers::pi));
     CHECK(persp->basis_forward == Vec3(0, 0, -1));
@@ -636,11 +678,13 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
     fs::create_directories(dir / "folder.glb");
     CHECK(error_of([&] { load_model(dir / "folder.glb"); }).find("not a regular file") != std::string::npos);
     write_text(dir / "broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
-    CHECK(error_of([&] { load_gltf(dir / "broken.gltf"); }).find("broken.gltf: malformed glTF") != std::string::npos);
+    CHECK(error_of([&] { load_gltf(dir / "broken.gltf"); }).find("broken.gltf: malformed glTF") !=
+          std::string::npos);
 
     {  // index out of range
         Doc d;
-        d.node({{"mesh", d.mesh(d.positions(kTriangle), d.accessor(std::vector<uint16_t>{0, 1, 3}, 5123, "SCALAR", 3))}});
+        d.node({{"mesh", d.mesh(d.positions(kTriangle),
+                                d.accessor(std::vector<uint16_t>{0, 1, 3}, 5123, "SCALAR", 3))}});
         CHECK(load(d) == f + ": meshes[0].primitives[0].indices: index 3 out of range (3 vertices)");
     }
     {  // NaN coordinate
@@ -670,11 +714,13 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
         write_bytes(dir / "small.bin", d.blob.bytes);
         write_text(dir / "big.gltf", j.dump());
         CHECK(error_of([&] { load_gltf(dir / "big.gltf"); }) ==
-              (dir / "big.gltf").string() + ": buffers[0]: byteLength 1000 is larger than small.bin (36 bytes)");
+              (dir / "big.gltf").string() +
+                  ": buffers[0]: byteLength 1000 is larger than small.bin (36 bytes)");
         j["buffers"] = {{{"byteLength", 1000}}};
         write_glb(dir / "big.glb", j, d.blob.bytes);
         CHECK(error_of([&] { load_gltf(dir / "big.glb"); }) ==
-              (dir / "big.glb").string() + ": buffers[0]: byteLength 1000 is larger than the GLB BIN chunk (36 bytes)");
+              (dir / "big.glb").string() +
+                  ": buffers[0]: byteLength 1000 is larger than the GLB BIN chunk (36 bytes)");
     }
     {  // unsupported required extension
         Doc d;
@@ -684,7 +730,8 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
     }
     {  // texture that fails to decode
         Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
-        d.j["images"] = {{{"uri", "data:image/png;base64," + base64({0x89, 'P', 'N', 'G', 13, 10, 26, 10, 1, 2, 3})}}};
+        d.j["images"] = {
+            {{"uri", "data:image/png;base64," + base64({0x89, 'P', 'N', 'G', 13, 10, 26, 10, 1, 2, 3})}}};
         d.j["textures"] = {{{"source", 0}}};
         CHECK(load(d) == f + ": images[0]: cannot decode image: PNG is truncated (chunk 0 header)");
         // Well-formed chunks around a corrupt zlib stream: the decoder itself fails.
@@ -694,7 +741,8 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
     }
     {  // an image over 32k pixels per side (a valid PNG header claiming 40000 x 8)
         // A well-formed PNG header claiming 40000 x 8 pixels.
-        const std::vector<uint8_t> png = handmade_png(40000, 8, {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});
+        const std::vector<uint8_t> png =
+            handmade_png(40000, 8, {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});
         Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
         write_bytes(dir / "huge.png", png);
         d.j["images"] = {{{"uri", "huge.png"}}};
@@ -732,10 +780,12 @@ TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/t
     auto near = [](Rgb a, Rgb b) { return length(a - b) < 1e-4f; };
 
     // glTF: v = 0 is the top row, so uv (0.25, 0.25) is the top-left texel (red).
-    for (const json& ktt : {json(nullptr), json{{"offset", {0.5, 0}}}, json{{"rotation", std::numbers::pi / 2}}}) {
+    for (const json& ktt :
+         {json(nullptr), json{{"offset", {0.5, 0}}}, json{{"rotation", std::numbers::pi / 2}}}) {
         CAPTURE(ktt.dump());
         Doc d;
-        const int uv = d.accessor(std::vector<float>{0.25f, 0.25f, 0.75f, 0.25f, 0.25f, 0.75f}, 5126, "VEC2", 3);
+        const int uv =
+            d.accessor(std::vector<float>{0.25f, 0.25f, 0.75f, 0.25f, 0.25f, 0.75f}, 5126, "VEC2", 3);
         d.node({{"mesh", d.mesh(d.positions(kTriangle), -1, 4, {{"TEXCOORD_0", uv}})}});
         d.j["meshes"][0]["primitives"][0]["material"] = 0;
         json info = {{"index", 0}};
@@ -751,15 +801,17 @@ TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/t
         } else if (ktt.contains("offset")) {
             CHECK(near(sample(m, 0), green));  // u + 0.5
         } else {
-            // glTF rotation pi/2: t = [cos -sin; sin cos] p = (-0.25, 0.25) -> wraps to (0.75, 0.25): top right.
+            // glTF rotation pi/2: t = [cos -sin; sin cos] p = (-0.25, 0.25) -> wraps to (0.75, 0.25): top
+            // right.
             CHECK(near(sample(m, 0), green));
         }
     }
 
     // OBJ: v = 0 is the bottom row, so vt 0.25 0.25 is the bottom-left texel (blue).
     write_text(dir / "t.mtl", "newmtl m\nmap_Kd tiny.png\n");
-    write_text(dir / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
-                              "usemtl m\nf 1/1 2/2 3/3\n");
+    write_text(dir / "t.obj",
+               "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
+               "usemtl m\nf 1/1 2/2 3/3\n");
     const LoadedModel obj = load_obj(dir / "t.obj");
     CHECK(near(sample(obj, 0), blue));
     CHECK(near(sample(obj, 1), green));  // (0.75, 0.75): top right
@@ -774,14 +826,16 @@ TEST_CASE("glTF: the material's TEXCOORD set, normalized byte normals, u8 and u3
     auto& attrs = d.j["meshes"][0]["primitives"][0]["attributes"];
     attrs["TEXCOORD_1"] = d.accessor(std::vector<uint8_t>{0, 0, 51, 0, 0, 255, 0, 0}, 5121, "VEC2", 3, true);
     // Signed normalized bytes: -127 maps to -1 exactly, 127 to 1.
-    attrs["NORMAL"] = d.accessor(std::vector<int8_t>{0, 0, 127, 0, 0, 127, 0, -127, 0, 0}, 5120, "VEC3", 3, true);
-    d.j["meshes"][0]["primitives"][0]["indices"] = d.accessor(std::vector<uint32_t>{2, 1, 0}, 5125, "SCALAR", 3);
+    attrs["NORMAL"] =
+        d.accessor(std::vector<int8_t>{0, 0, 127, 0, 0, 127, 0, -127, 0, 0}, 5120, "VEC3", 3, true);
+    d.j["meshes"][0]["primitives"][0]["indices"] =
+        d.accessor(std::vector<uint32_t>{2, 1, 0}, 5125, "SCALAR", 3);
     const LoadedModel m = load_gltf(d.write(dir / "sets.gltf"));
     const TriangleMesh& mesh = m.meshes.at(0);
     REQUIRE(mesh.uvs.size() == 3);
     CHECK(mesh.uvs[1].x == doctest::Approx(0.2f));  // 51/255 from TEXCOORD_1 (TEXCOORD_0 has 1 there)
-    CHECK(mesh.uvs[2].y == 0.0f);  // v_gltf = 1 -> 0
-    CHECK(mesh.uvs[1].y == 1.0f);  // v_gltf = 0 -> 1
+    CHECK(mesh.uvs[2].y == 0.0f);                   // v_gltf = 1 -> 0
+    CHECK(mesh.uvs[1].y == 1.0f);                   // v_gltf = 0 -> 1
     CHECK(mesh.normals[2] == Vec3(0, -1, 0));
     CHECK(mesh.indices == std::vector<uint32_t>{2, 1, 0});
 }

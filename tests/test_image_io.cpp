@@ -52,7 +52,8 @@ TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
     write_image(file, 9, 4, rgb);
     auto img = read_image(file, true);
     for (size_t i = 0; i < 36; ++i)
-        for (size_t c = 0; c < 3; ++c) CHECK(img->rgba[i * 4 + c] == doctest::Approx(rgb[i * 3 + c]).epsilon(0.01));
+        for (size_t c = 0; c < 3; ++c)
+            CHECK(img->rgba[i * 4 + c] == doctest::Approx(rgb[i * 3 + c]).epsilon(0.01));
     // Mid grey 0.5 encodes to sRGB 188/255 (IEC 61966-2-1).
     CHECK(std::lround(srgb_encode(0.5f) * 255) == 188);
     CHECK(srgb_decode(srgb_encode(0.2f)) == doctest::Approx(0.2f));
@@ -67,7 +68,8 @@ TEST_CASE("image writing is atomic and checks its path first") {
     write_image(dir / "a.png", 2, 2, std::vector<float>(12, 0.5f));
     // Nothing but the finished file is left in the directory.
     int files = 0;
-    for (const auto& e : fs::directory_iterator(dir)) files += e.path().filename().string().find(".tmp") != std::string::npos;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.path().filename().string().find(".tmp") != std::string::npos;
     CHECK(files == 0);
 }
 

@@ -23,7 +23,9 @@ Scene glowing_sphere(float rho, Rgb le) {
     return build_scene(d);
 }
 
-Ray ray_from_inside(const Vec3& origin, const Vec3& dir) { return Ray{origin, normalize(dir), 0.0f, kInfinity, 0.0f}; }
+Ray ray_from_inside(const Vec3& origin, const Vec3& dir) {
+    return Ray{origin, normalize(dir), 0.0f, kInfinity, 0.0f};
+}
 
 }  // namespace
 
@@ -32,7 +34,8 @@ TEST_CASE("inside a closed glowing sphere the radiance is Le / (1 - rho) (depth 
     for (float rho : {0.5f, 0.8f}) {
         CAPTURE(rho);
         const Scene scene = glowing_sphere(rho, le);
-        for (const Ray& ray : {ray_from_inside({0, 0, 0}, {0, 1, 0}), ray_from_inside({0.3f, -0.5f, 0.2f}, {1, 1, -2})}) {
+        for (const Ray& ray :
+             {ray_from_inside({0, 0, 0}, {0, 1, 0}), ray_from_inside({0.3f, -0.5f, 0.2f}, {1, 1, -2})}) {
             const Stat s = radiance_stats(scene, ray, scaled(rho > 0.6f ? 40000 : 20000), 500);
             CHECK(within(s, le / (1.0f - rho), 4));
         }
@@ -63,7 +66,8 @@ TEST_CASE("with a point light, D = 2 is direct light only; D = 3 adds one bounce
     l.intensity = {3, 3, 3};
     d.lights = {l};
     const Scene scene = build_scene(d);
-    const Ray ray{{0, -2, 1}, normalize(Vec3(0, 2, -1)), 0.0f, kInfinity, 0.0f};  // hits the floor at the origin
+    const Ray ray{
+        {0, -2, 1}, normalize(Vec3(0, 2, -1)), 0.0f, kInfinity, 0.0f};  // hits the floor at the origin
     const float direct = 0.5f * kInvPi * 3.0f * (1.0f / std::sqrt(2.0f)) / 2.0f;
     CHECK(radiance_stats(scene, ray, 16, 1).mean.x == 0.0f);
     const Stat two = radiance_stats(scene, ray, 16, 2);
@@ -86,7 +90,8 @@ TEST_CASE("whitted: direct light, ambient, mirror and glass") {
     {
         const Scene scene = build_scene(d);
         const float d2 = 5.0f, cos = 2.0f / std::sqrt(5.0f);
-        CHECK(estimate_radiance(scene, down, sampler, 2).x == doctest::Approx(0.5f * kInvPi * 4.0f * cos / d2));
+        CHECK(estimate_radiance(scene, down, sampler, 2).x ==
+              doctest::Approx(0.5f * kInvPi * 4.0f * cos / d2));
         CHECK(estimate_radiance(scene, down, sampler, 1).x == 0.0f);
     }
     // Ambient: albedo times the sky in the normal direction.
@@ -101,8 +106,8 @@ TEST_CASE("whitted: direct light, ambient, mirror and glass") {
         g.spheres.push_back({{0, 0, 0}, 1.0f, 1, {0, 0, 0}});
         const Scene scene = build_scene(g);
         for (float x : {0.0f, 0.5f, 0.9f})
-            CHECK(estimate_radiance(scene, Ray{{x, -5, 0.1f}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, sampler, 16).x ==
-                  doctest::Approx(1.0f).epsilon(1e-3));
+            CHECK(estimate_radiance(scene, Ray{{x, -5, 0.1f}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, sampler, 16)
+                      .x == doctest::Approx(1.0f).epsilon(1e-3));
     }
 }
 
@@ -116,7 +121,8 @@ TEST_CASE("inspection integrators: normals and depth") {
     d.render.integrator = IntegratorType::depth;
     CHECK(estimate_radiance(build_scene(d), ray, sampler, 4).x == doctest::Approx(2.0f));
     d.render.integrator = IntegratorType::albedo;
-    CHECK(estimate_radiance(build_scene(d), Ray{{0, 0, 0}, {0, 0, 1}, 0.0f, kInfinity, 0.0f}, sampler, 4) == Rgb(0.3f));
+    CHECK(estimate_radiance(build_scene(d), Ray{{0, 0, 0}, {0, 0, 1}, 0.0f, kInfinity, 0.0f}, sampler, 4) ==
+          Rgb(0.3f));
 }
 
 TEST_CASE("depth of field: a point at the focus distance stays sharp") {
@@ -192,10 +198,12 @@ TEST_CASE("motion blur: the blurred image's mean equals the average of static re
         var += se * se;
     }
     const double statics = sum / kSteps, se_static = std::sqrt(var) / kSteps;
-    CHECK(std::abs(blurred - statics) < 4 * std::sqrt(se_blur * se_blur + se_static * se_static) + 2e-3 * statics);
+    CHECK(std::abs(blurred - statics) <
+          4 * std::sqrt(se_blur * se_blur + se_static * se_static) + 2e-3 * statics);
     // The sphere frozen at the shutter's opening covers a different mean: the test can fail.
     double se0 = 0;
-    CHECK(image_mean(moving_sphere_scene(center, Vec3(0.0f)), &se0) != doctest::Approx(blurred).epsilon(0.02));
+    CHECK(image_mean(moving_sphere_scene(center, Vec3(0.0f)), &se0) !=
+          doctest::Approx(blurred).epsilon(0.02));
 }
 
 TEST_CASE("scene features pick the kernel; forcing turns everything on") {
@@ -213,7 +221,8 @@ TEST_CASE("scene features pick the kernel; forcing turns everything on") {
     CHECK(std::string(path_kernel_name(forced)) == "path<MIS, all materials>");
     // Same scene, general kernel: the same image up to noise.
     const Ray ray{{0, 0, 0}, normalize(Vec3(0.2f, 1, -0.3f)), 0.0f, kInfinity, 0.0f};
-    CHECK(agree(radiance_stats(plain, ray, scaled(4000), 8), radiance_stats(forced, ray, scaled(4000), 8, 2), 4));
+    CHECK(agree(radiance_stats(plain, ray, scaled(4000), 8), radiance_stats(forced, ray, scaled(4000), 8, 2),
+                4));
 
     SceneDesc d = default_scene();
     d.materials.push_back(dielectric(1.5f));

@@ -88,7 +88,8 @@ TEST_CASE("a directional light gives albedo/pi * E cos") {
     const Scene scene = build_scene(d);
     const Rgb floor_expected = albedo * kInvPi * l.irradiance * (1.0f / std::sqrt(2.0f));
     for (const Vec3& p : {Vec3(0, 0, 0), Vec3(2, -3, 0), Vec3(-5, 1, 0)}) {
-        const Stat s = radiance_stats(scene, ray_to(p, p + Vec3(0, 1, 2)), 64, 2);  // D = 2: no light between the planes
+        const Stat s =
+            radiance_stats(scene, ray_to(p, p + Vec3(0, 1, 2)), 64, 2);  // D = 2: no light between the planes
         CHECK(within(s, floor_expected, 3));
     }
     // On the tilted plane the light arrives at normal incidence.
@@ -101,8 +102,8 @@ namespace {
 /// A floor, a rough metal ball, and two sphere lights of very different sizes.
 SceneDesc area_light_scene() {
     SceneDesc d = floor_scene(Rgb(0.7f));
-    d.materials.push_back(emissive({40, 30, 20}));  // 2: small and bright
-    d.materials.push_back(emissive({0.5f, 0.6f, 0.8f}));  // 3: large and dim
+    d.materials.push_back(emissive({40, 30, 20}));           // 2: small and bright
+    d.materials.push_back(emissive({0.5f, 0.6f, 0.8f}));     // 3: large and dim
     d.materials.push_back(metal({0.9f, 0.8f, 0.6f}, 0.4f));  // 4
     d.spheres.push_back({{1, 0, 1.5f}, 0.15f, 2, {0, 0, 0}});
     d.spheres.push_back({{-3, 2, 3}, 2.0f, 3, {0, 0, 0}});
@@ -124,7 +125,8 @@ TEST_CASE("MIS, BSDF sampling only and light sampling only agree with area light
         CAPTURE(t.y);
         const Ray ray = ray_to(t, eye);
         auto stats = [&](LightStrategy st, int n) {  // independent streams per strategy
-            return sample_stats(n, 3 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 6, st); });
+            return sample_stats(n, 3 + uint64_t(st),
+                                [&](Sampler& s) { return path_trace_with(scene, ray, s, 6, st); });
         };
         const Stat mis = stats(LightStrategy::mis, scaled(8000));
         const Stat bsdf = stats(LightStrategy::bsdf_only, scaled(80000));
@@ -182,7 +184,8 @@ TEST_CASE("an emissive triangle is an area light (needs triangles in the acceler
     REQUIRE(prim_kind(hit.prim) == PrimKind::triangle);
     const Ray ray = ray_to({0.1f, 0.1f, 0}, {0, -3, 2});
     auto stats = [&](LightStrategy st, int n) {
-        return sample_stats(n, 9 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 3, st); });
+        return sample_stats(n, 9 + uint64_t(st),
+                            [&](Sampler& s) { return path_trace_with(scene, ray, s, 3, st); });
     };
     const Stat mis = stats(LightStrategy::mis, scaled(8000));
     CHECK(agree(mis, stats(LightStrategy::bsdf_only, scaled(16000)), 4));
@@ -207,7 +210,9 @@ std::shared_ptr<Image> test_envmap() {
             p[3] = 1;
         }
     float* sun = &img->rgba[size_t(2 * 16 + 5) * 4];
-    sun[0] = 500; sun[1] = 400; sun[2] = 300;
+    sun[0] = 500;
+    sun[1] = 400;
+    sun[2] = 300;
     return img;
 }
 
@@ -255,7 +260,8 @@ TEST_CASE("envmap lighting: MIS agrees with BSDF sampling") {
     for (const Vec3& t : {Vec3(0, 0, 0), Vec3(2, 1, 0)}) {
         const Ray ray = ray_to(t, {0, -3, 2});
         auto stats = [&](LightStrategy st, int n) {
-            return sample_stats(n, 13 + uint64_t(st), [&](Sampler& s) { return path_trace_with(scene, ray, s, 4, st); });
+            return sample_stats(n, 13 + uint64_t(st),
+                                [&](Sampler& s) { return path_trace_with(scene, ray, s, 4, st); });
         };
         const Stat mis = stats(LightStrategy::mis, scaled(8000));
         const Stat bsdf = stats(LightStrategy::bsdf_only, scaled(30000));

@@ -18,7 +18,8 @@ TEST_CASE("Fresnel reflectance of a dielectric") {
         // Reciprocity: the same pair of angles from either side reflects the same.
         for (float cos_i : {0.9f, 0.6f, 0.3f}) {
             const float sin_t = std::sqrt(1 - cos_i * cos_i) / n, cos_t = std::sqrt(1 - sin_t * sin_t);
-            CHECK(fresnel_dielectric(cos_t, 1.0f / n) == doctest::Approx(fresnel_dielectric(cos_i, n)).epsilon(1e-5));
+            CHECK(fresnel_dielectric(cos_t, 1.0f / n) ==
+                  doctest::Approx(fresnel_dielectric(cos_i, n)).epsilon(1e-5));
         }
         // Total internal reflection beyond the critical angle, from inside.
         const float cos_critical = std::sqrt(1 - 1 / (n * n));
@@ -53,8 +54,7 @@ Scene sphere_in_furnace(const MaterialDesc& m, Rgb sky) {
 std::vector<Ray> rays_at_sphere() {
     std::vector<Ray> rays;
     for (float x : {0.0f, 0.3f, 0.7f, 0.95f})
-        for (float z : {0.0f, -0.25f})
-            rays.push_back(Ray{{x, -5, z}, {0, 1, 0}, 0.0f, kInfinity, 0.0f});
+        for (float z : {0.0f, -0.25f}) rays.push_back(Ray{{x, -5, z}, {0, 1, 0}, 0.0f, kInfinity, 0.0f});
     return rays;
 }
 
@@ -141,8 +141,10 @@ TEST_CASE("checkerboard albedo is evaluated at the hit point") {
     const Scene scene = build_scene(d);
     CHECK(scene.features.has_textures);
     Sampler s(0);
-    CHECK(estimate_radiance(scene, Ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x == doctest::Approx(0.8f));
-    CHECK(estimate_radiance(scene, Ray{{1.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x == doctest::Approx(0.2f));
+    CHECK(estimate_radiance(scene, Ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x ==
+          doctest::Approx(0.8f));
+    CHECK(estimate_radiance(scene, Ray{{1.5f, 0.5f, 1}, {0, 0, -1}, 0, kInfinity, 0}, s, 4).x ==
+          doctest::Approx(0.2f));
     for (int i = 0; i < 200; ++i) {  // from many directions, the same cell
         const Vec3 target(0.1f + 0.004f * float(i), 0.7f - 0.003f * float(i), 0.0f);
         const Vec3 eye(std::sin(float(i)) * 7.0f, std::cos(float(i)) * 7.0f, 0.5f + 0.037f * float(i));

@@ -108,7 +108,8 @@ std::string mpirun(int ranks, const std::string& extra = "") {
 #if SAHARA_HAVE_MPI
     return "ASAN_OPTIONS=detect_leaks=0 " SAHARA_MPIEXEC
            " --allow-run-as-root --oversubscribe --bind-to none --mca btl_vader_single_copy_mechanism none"
-           " -x ASAN_OPTIONS " + extra + " -np " + std::to_string(ranks) + " ";
+           " -x ASAN_OPTIONS " +
+           extra + " -np " + std::to_string(ranks) + " ";
 #else
     (void)extra;
     FAIL("mpirun with " << ranks << " ranks in a build without MPI");
@@ -126,9 +127,9 @@ int run(const std::string& args, int ranks, const std::string& err_file, double 
 }
 
 const std::vector<std::string> kStateChannels = {
-    "sahara_state.sum_r_hi", "sahara_state.sum_r_lo", "sahara_state.sum_g_hi", "sahara_state.sum_g_lo",
-    "sahara_state.sum_b_hi", "sahara_state.sum_b_lo", "sahara_state.sumsq_hi", "sahara_state.sumsq_lo",
-    "sahara_state.count"};
+    "sahara_state.sum_r_hi", "sahara_state.sum_r_lo", "sahara_state.sum_g_hi",
+    "sahara_state.sum_g_lo", "sahara_state.sum_b_hi", "sahara_state.sum_b_lo",
+    "sahara_state.sumsq_hi", "sahara_state.sumsq_lo", "sahara_state.count"};
 
 /// Decoded pixels and the exact film state (per-pixel double sums, counts) are equal.
 void check_same_render(const std::string& a, const std::string& b) {
@@ -141,7 +142,8 @@ void check_same_render(const std::string& a, const std::string& b) {
     const auto sb = read_extra_channels(b, kStateChannels, &wb, &hb);
     REQUIRE(wa == wb);
     REQUIRE(ha == hb);
-    for (size_t c = 0; c < kStateChannels.size(); ++c) CHECK_MESSAGE(sa[c].values == sb[c].values, kStateChannels[c]);
+    for (size_t c = 0; c < kStateChannels.size(); ++c)
+        CHECK_MESSAGE(sa[c].values == sb[c].values, kStateChannels[c]);
 }
 
 /// MPI tests need an MPI build; say so loudly instead of passing silently.
@@ -227,7 +229,8 @@ TEST_CASE("mpi: a tile rendered as units through the wire format equals the sing
         for (int x = 16; x < 32; ++x) {
             const mpi_work::PixelState& p = w.state[size_t(y - 16) * 16 + size_t(x - 16)];
             same = same && p.count == whole.count(x, y) && p.sum_sq == whole.sum_sq(x, y) &&
-                   p.sum.x == whole.sum(x, y).x && p.sum.y == whole.sum(x, y).y && p.sum.z == whole.sum(x, y).z;
+                   p.sum.x == whole.sum(x, y).x && p.sum.y == whole.sum(x, y).y &&
+                   p.sum.z == whole.sum(x, y).z;
         }
     CHECK(same);
     // A truncated message is refused, not read past its end.
@@ -261,8 +264,9 @@ TEST_CASE("mpi: a rank killed mid-render ends the job; the checkpoint resumes to
     const std::string args = "render " + kWorkshop + " --width 128 --height 96 --threads 1 --spp " +
                              std::to_string(512 / kSlow) + " ";
     const std::string err = dir / "err.txt";
-    const std::string cmd = "SAHARA_MPI_PID_DIR=" + dir.path.string() + " " + mpirun(2, "-x SAHARA_MPI_PID_DIR") +
-                            SAHARA_EXE + " " + args + "--checkpoint 0.3 -o " + (dir / "k.exr") + " 2>" + err;
+    const std::string cmd = "SAHARA_MPI_PID_DIR=" + dir.path.string() + " " +
+                            mpirun(2, "-x SAHARA_MPI_PID_DIR") + SAHARA_EXE + " " + args +
+                            "--checkpoint 0.3 -o " + (dir / "k.exr") + " 2>" + err;
     Job job(cmd);
     // Wait for a checkpoint, then kill rank 1 while the render is still going.
     for (int i = 0; i < 3000 && !(fs::exists(dir / "k.exr") && fs::exists(dir / "rank-1.pid")); ++i)

@@ -27,9 +27,7 @@ fs::path scratch(const std::string& name) {
     return dir;
 }
 
-void write(const fs::path& file, const std::string& text) {
-    std::ofstream(file, std::ios::binary) << text;
-}
+void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
 
 /// Counts what an OBJ file says by reading its lines directly (independent of
 /// the loader): triangles (n - 2 per face) and the box around all `v` lines.
@@ -100,9 +98,12 @@ TEST_CASE("every shared OBJ asset loads with the published counts") {
     // Triangle counts from SOURCES.md; degenerate counts from its notes (ogre 4, spider 56).
     // Materials: newmtl entries (cornell 8, spider 5) or the default one; textures: map_Kd files.
     const Expect expect[] = {
-        {"obj/stanford-bunny/stanford-bunny.obj", 69451, 0, 1, 0}, {"obj/spot/spot.obj", 5856, 0, 1, 0},
-        {"obj/teapot/teapot.obj", 6320, 0, 1, 0},                  {"obj/suzanne/suzanne.obj", 968, 0, 1, 0},
-        {"obj/ogre/ogre.obj", 124008, 4, 1, 0},                    {"obj/cornell-box/CornellBox-Original.obj", 36, 0, 8, 0},
+        {"obj/stanford-bunny/stanford-bunny.obj", 69451, 0, 1, 0},
+        {"obj/spot/spot.obj", 5856, 0, 1, 0},
+        {"obj/teapot/teapot.obj", 6320, 0, 1, 0},
+        {"obj/suzanne/suzanne.obj", 968, 0, 1, 0},
+        {"obj/ogre/ogre.obj", 124008, 4, 1, 0},
+        {"obj/cornell-box/CornellBox-Original.obj", 36, 0, 8, 0},
         {"obj/spider/spider.obj", 1368, 56, 5, 5},
     };
     set_log_quiet(true);
@@ -198,7 +199,7 @@ TEST_CASE("OBJ normals: given ones are kept, missing ones become flat") {
     const fs::path dir = scratch("normals");
     write(dir / "mixed.obj",
           "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nvn 0.3 0.3 0.9\n"
-          "f 1//1 2//1 3//1\n"   // smooth (file normal)
+          "f 1//1 2//1 3//1\n"  // smooth (file normal)
           "f -5 -4 -1\n");      // no normals, relative indices: (0,0,0) (1,0,0) (0,0,1), normal -Y
     const LoadedModel m = load_obj(dir / "mixed.obj");
     REQUIRE(m.meshes.size() == 1);
@@ -216,11 +217,13 @@ TEST_CASE("OBJ normals: given ones are kept, missing ones become flat") {
 
 TEST_CASE("OBJ groups and per-face materials; missing .mtl and textures are warnings") {
     const fs::path dir = scratch("groups");
-    write(dir / "a.mtl", "newmtl red\nKd 1 0 0\nnewmtl tex\nKd 0 1 0\nmap_Kd .\\missing.png\n"
-                         "newmtl cut\nd 1\nmap_d mask.png\n");
-    write(dir / "a.obj", "mtllib a.mtl\nmtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-                         "g one\nusemtl red\nf 1 2 3\nusemtl tex\nf 1 3 4\n"
-                         "g two\nusemtl nosuch\nf 1 2 4\n");
+    write(dir / "a.mtl",
+          "newmtl red\nKd 1 0 0\nnewmtl tex\nKd 0 1 0\nmap_Kd .\\missing.png\n"
+          "newmtl cut\nd 1\nmap_d mask.png\n");
+    write(dir / "a.obj",
+          "mtllib a.mtl\nmtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+          "g one\nusemtl red\nf 1 2 3\nusemtl tex\nf 1 3 4\n"
+          "g two\nusemtl nosuch\nf 1 2 4\n");
     const int warnings_before = warning_count();
     const LoadedModel m = load_obj(dir / "a.obj");
     CHECK(warning_count() - warnings_before >= 3);  // nothere.mtl, missing.png, mask.png (and usemtl nosuch)
@@ -255,7 +258,8 @@ TEST_CASE("bad OBJ input throws InputError naming file and element") {
     CHECK(error_of([&] { load_obj(dir / "range.obj"); }) ==
           (dir / "range.obj").string() + ": face 2: vertex index out of range (the file has 3)");
     write(dir / "rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
-    CHECK(error_of([&] { load_obj(dir / "rel.obj"); }).find("face 1: vertex index out of range") != std::string::npos);
+    CHECK(error_of([&] { load_obj(dir / "rel.obj"); }).find("face 1: vertex index out of range") !=
+          std::string::npos);
     write(dir / "vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n");
     CHECK(error_of([&] { load_obj(dir / "vt.obj"); }).find("face 1: texture coordinate index out of range") !=
           std::string::npos);
@@ -271,7 +275,8 @@ TEST_CASE("bad OBJ input throws InputError naming file and element") {
     CHECK(error_of([&] { load_obj(dir / "zero.obj"); }).find("zero.obj: malformed OBJ") != std::string::npos);
 
     write(dir / "empty.obj", "x\nv 0 0 0\n");
-    CHECK(error_of([&] { load_obj(dir / "empty.obj"); }) == (dir / "empty.obj").string() + ": no faces (is this an OBJ file?)");
+    CHECK(error_of([&] { load_obj(dir / "empty.obj"); }) ==
+          (dir / "empty.obj").string() + ": no faces (is this an OBJ file?)");
 
     write(dir / "junk.png", "this is not a png");
     write(dir / "t.mtl", "newmtl m\nmap_Kd junk.png\n");
@@ -300,9 +305,11 @@ TEST_CASE("OBJ map_d grey masks become alpha; map_Ke textures emission") {
     REQUIRE(out->open((dir / "mask.png").string(), OIIO::ImageSpec(2, 1, 1, OIIO::TypeDesc::UINT8)));
     REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px));
     out->close();
-    write(dir / "m.mtl", "newmtl leaf\nKd 0.2 0.8 0.2\nd 1\nmap_d mask.png\n"
-                         "newmtl lamp\nKe 2 2 2\nmap_Ke mask.png\n");
-    write(dir / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\nusemtl lamp\nf 3 2 1\n");
+    write(dir / "m.mtl",
+          "newmtl leaf\nKd 0.2 0.8 0.2\nd 1\nmap_d mask.png\n"
+          "newmtl lamp\nKe 2 2 2\nmap_Ke mask.png\n");
+    write(dir / "m.obj",
+          "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaf\nf 1 2 3\nusemtl lamp\nf 3 2 1\n");
     const LoadedModel m = load_obj(dir / "m.obj");
     REQUIRE(m.materials.size() == 2);
     const MaterialDesc& leaf = m.materials[0];

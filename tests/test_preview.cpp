@@ -50,7 +50,8 @@ TEST_CASE("preview: display bytes are what an 8-bit output file stores") {
             unsigned char b[3];
             display_bytes(Rgb(rgb[i], rgb[i + 1], rgb[i + 2]), 0.5f, curve, b);
             for (size_t c = 0; c < 3; ++c)
-                CHECK(int(b[c]) == int(std::lround(std::clamp(srgb_encode(mapped[i + c]), 0.0f, 1.0f) * 255.0f)));
+                CHECK(int(b[c]) ==
+                      int(std::lround(std::clamp(srgb_encode(mapped[i + c]), 0.0f, 1.0f) * 255.0f)));
         }
     }
 }
@@ -62,7 +63,8 @@ TEST_CASE("preview: the window's last frame equals the written image (offscreen 
     fs::create_directories(dir);
     const fs::path out = dir / "p.png", dump = dir / "frame.ppm";
     // Leak checking is off for this child only: video drivers keep allocations until exit.
-    const std::string cmd = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0 " + std::string(SAHARA_EXE) +
+    const std::string cmd = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0 " +
+                            std::string(SAHARA_EXE) +
                             " render --width 40 --height 24 --spp 16 --preview --preview-dump " +
                             dump.string() + " -o " + out.string() + " 2>" + (dir / "err.txt").string();
     const int code = run_shell(cmd);
@@ -87,9 +89,9 @@ TEST_CASE("preview: without a display the render still runs, with a warning") {
     const fs::path dir = fs::temp_directory_path() / ("sahara_nodisplay_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const std::string cmd = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER " + std::string(SAHARA_EXE) +
-                            " render --width 16 --height 8 --spp 2 --preview -o " + (dir / "n.png").string() + " 2>" +
-                            (dir / "err.txt").string();
+    const std::string cmd = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER " +
+                            std::string(SAHARA_EXE) + " render --width 16 --height 8 --spp 2 --preview -o " +
+                            (dir / "n.png").string() + " 2>" + (dir / "err.txt").string();
     CHECK(run_shell(cmd) == 0);
     CHECK(fs::exists(dir / "n.png"));
     std::ifstream err(dir / "err.txt");

@@ -30,7 +30,9 @@ constexpr bool kSanitized = false;
 using LD = long double;
 using VL = TVec3<long double>;
 
-Ray make_ray(Vec3 o, Vec3 d, float tmin = 0.0f, float tmax = kInfinity) { return Ray{o, d, tmin, tmax, 0.0f}; }
+Ray make_ray(Vec3 o, Vec3 d, float tmin = 0.0f, float tmax = kInfinity) {
+    return Ray{o, d, tmin, tmax, 0.0f};
+}
 
 /// Independent description of a shape, evaluated in long double straight from
 /// the named parameters (not from the quadric's canonical frame): the oracle.
@@ -41,26 +43,28 @@ struct Oracle {
     VL radii;
     bool capped = false;
     std::array<LD, 10> k{};
-    VL lo, hi;                    ///< general: clip box (pre-transform)
+    VL lo, hi;                                         ///< general: clip box (pre-transform)
     LD rot[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  ///< user rotation
-    VL trans;                     ///< user translation
-    LD scale = 1;                 ///< size of the shape, for tolerances
+    VL trans;                                          ///< user translation
+    LD scale = 1;                                      ///< size of the shape, for tolerances
 
     /// Pre-transform coordinates of world point p (the user transform is rigid).
     VL local(const VL& p) const {
         const VL v = p - trans;
-        return {rot[0][0] * v.x + rot[1][0] * v.y + rot[2][0] * v.z, rot[0][1] * v.x + rot[1][1] * v.y + rot[2][1] * v.z,
+        return {rot[0][0] * v.x + rot[1][0] * v.y + rot[2][0] * v.z,
+                rot[0][1] * v.x + rot[1][1] * v.y + rot[2][1] * v.z,
                 rot[0][2] * v.x + rot[1][2] * v.y + rot[2][2] * v.z};
     }
     VL world_vector(const VL& v) const {
-        return {rot[0][0] * v.x + rot[0][1] * v.y + rot[0][2] * v.z, rot[1][0] * v.x + rot[1][1] * v.y + rot[1][2] * v.z,
+        return {rot[0][0] * v.x + rot[0][1] * v.y + rot[0][2] * v.z,
+                rot[1][0] * v.x + rot[1][1] * v.y + rot[1][2] * v.z,
                 rot[2][0] * v.x + rot[2][1] * v.y + rot[2][2] * v.z};
     }
     LD f(const VL& pw) const {
         const VL q = local(pw);
         if (form == QuadricForm::general)
-            return k[0] * q.x * q.x + k[1] * q.y * q.y + k[2] * q.z * q.z + k[3] * q.x * q.y + k[4] * q.x * q.z +
-                   k[5] * q.y * q.z + k[6] * q.x + k[7] * q.y + k[8] * q.z + k[9];
+            return k[0] * q.x * q.x + k[1] * q.y * q.y + k[2] * q.z * q.z + k[3] * q.x * q.y +
+                   k[4] * q.x * q.z + k[5] * q.y * q.z + k[6] * q.x + k[7] * q.y + k[8] * q.z + k[9];
         const VL v = q - origin;
         if (form == QuadricForm::ellipsoid) {
             const VL u = v / radii;
@@ -68,9 +72,12 @@ struct Oracle {
         }
         const LD h = dot(v, axis), perp2 = dot(v, v) - h * h;
         switch (form) {
-            case QuadricForm::cylinder: return perp2 - radius * radius;
-            case QuadricForm::cone: return perp2 - tan_angle * tan_angle * h * h;
-            case QuadricForm::paraboloid: return perp2 - radius * radius / height * h;
+            case QuadricForm::cylinder:
+                return perp2 - radius * radius;
+            case QuadricForm::cone:
+                return perp2 - tan_angle * tan_angle * h * h;
+            case QuadricForm::paraboloid:
+                return perp2 - radius * radius / height * h;
             default: {
                 const LD half = height / 2;
                 return perp2 - waist * waist - (radius * radius - waist * waist) / (half * half) * h * h;
@@ -81,7 +88,8 @@ struct Oracle {
     VL grad(const VL& p) const {
         const LD e = scale * 1e-4L;
         return VL(f(p + VL(e, 0, 0)) - f(p - VL(e, 0, 0)), f(p + VL(0, e, 0)) - f(p - VL(0, e, 0)),
-                  f(p + VL(0, 0, e)) - f(p - VL(0, 0, e))) / (2 * e);
+                  f(p + VL(0, 0, e)) - f(p - VL(0, 0, e))) /
+               (2 * e);
     }
     /// Distance-like measure of how far p is from f = 0.
     LD surface_error(const VL& p) const { return std::fabs(f(p)) / length(grad(p)); }
@@ -89,20 +97,27 @@ struct Oracle {
     LD clip_margin(const VL& pw) const {
         const VL q = local(pw);
         if (form == QuadricForm::ellipsoid) return 1e30L;
-        if (form == QuadricForm::general)
-            return std::min(min_component(q - lo), min_component(hi - q));
+        if (form == QuadricForm::general) return std::min(min_component(q - lo), min_component(hi - q));
         const LD h = dot(q - origin, axis);
         switch (form) {
             case QuadricForm::cylinder:
-            case QuadricForm::cone: return std::min(h, height - h);
-            case QuadricForm::paraboloid: return height - h;
-            default: return height / 2 - std::fabs(h);
+            case QuadricForm::cone:
+                return std::min(h, height - h);
+            case QuadricForm::paraboloid:
+                return height - h;
+            default:
+                return height / 2 - std::fabs(h);
         }
     }
     int cap_count() const { return capped ? (form == QuadricForm::cylinder ? 2 : 1) : 0; }
     /// Cap i: height along the axis, radius, outward normal (pre-transform).
     void cap(int i, LD& h, LD& r, VL& n) const {
-        if (form == QuadricForm::cylinder && i == 0) { h = 0; r = radius; n = -axis; return; }
+        if (form == QuadricForm::cylinder && i == 0) {
+            h = 0;
+            r = radius;
+            n = -axis;
+            return;
+        }
         h = height;
         r = form == QuadricForm::cone ? height * tan_angle : radius;
         n = axis;
@@ -165,7 +180,12 @@ struct BruteForce {
                 LD a = prev_t, b = t, fa = prev_f;
                 for (int it = 0; it < 80 && a < b; ++it) {
                     const LD m = 0.5L * (a + b), fm = o.f(org + d * m);
-                    if ((fa < 0) == (fm < 0)) { a = m; fa = fm; } else { b = m; }
+                    if ((fa < 0) == (fm < 0)) {
+                        a = m;
+                        fa = fm;
+                    } else {
+                        b = m;
+                    }
                 }
                 const LD tr = 0.5L * (a + b);
                 const VL p = org + d * tr, g = o.grad(p);
@@ -191,9 +211,11 @@ struct BruteForce {
 };
 
 Mat4 random_rigid(Pcg32& rng, float offset) {
-    Mat4 r = Mat4::rotate_euler(Vec3d(Vec3(360.0f * rng.next_float(), 360.0f * rng.next_float(), 360.0f * rng.next_float())));
+    Mat4 r = Mat4::rotate_euler(
+        Vec3d(Vec3(360.0f * rng.next_float(), 360.0f * rng.next_float(), 360.0f * rng.next_float())));
     return Mat4::translate(Vec3d(offset * (2 * rng.next_float() - 1), offset * (2 * rng.next_float() - 1),
-                                 offset * (2 * rng.next_float() - 1))) * r;
+                                 offset * (2 * rng.next_float() - 1))) *
+           r;
 }
 
 Vec3 random_unit(Pcg32& rng) { return sample_uniform_sphere({rng.next_float(), rng.next_float()}); }
@@ -221,7 +243,8 @@ Quadric make_instance(QuadricForm form, Pcg32& rng, float scale, float offset, b
         }
         case QuadricForm::cylinder: {
             const float r = scale * u(0.3f, 1), h = scale * u(0.3f, 1);
-            o.radius = r; o.height = h;
+            o.radius = r;
+            o.height = h;
             return make_cylinder(origin, axis, r, h, capped, user);
         }
         case QuadricForm::cone: {
@@ -232,22 +255,26 @@ Quadric make_instance(QuadricForm form, Pcg32& rng, float scale, float offset, b
         }
         case QuadricForm::paraboloid: {
             const float r = scale * u(0.3f, 1), h = scale * u(0.3f, 1);
-            o.radius = r; o.height = h;
+            o.radius = r;
+            o.height = h;
             return make_paraboloid(origin, axis, r, h, user);
         }
         case QuadricForm::hyperboloid: {
             const float w = scale * u(0.2f, 0.5f), r = w * u(1.2f, 3), h = scale * u(0.5f, 1);
-            o.radius = r; o.waist = w; o.height = h;
+            o.radius = r;
+            o.waist = w;
+            o.height = h;
             return make_hyperboloid(origin, axis, r, w, h, user);
         }
-        case QuadricForm::general: break;
+        case QuadricForm::general:
+            break;
     }
     // General: a few shapes that no named form covers, scaled by `scale`:
     // f(p / s) * s² keeps the second-order terms and scales the others.
     static const std::array<std::array<double, 10>, 3> kShapes = {{
-        {1, -1, 0, 0, 0, 0, 0, 0, -1, 0},          // saddle z = x² - y²
-        {-1, -1, 1, 0, 0, 0, 0, 0, 0, -0.25},      // two-sheet hyperboloid
-        {1, 2, 3, 0.5, 0, 0.7, 0.1, 0, 0, -1},     // tilted ellipsoid with cross terms
+        {1, -1, 0, 0, 0, 0, 0, 0, -1, 0},       // saddle z = x² - y²
+        {-1, -1, 1, 0, 0, 0, 0, 0, 0, -0.25},   // two-sheet hyperboloid
+        {1, 2, 3, 0.5, 0, 0.7, 0.1, 0, 0, -1},  // tilted ellipsoid with cross terms
     }};
     std::array<double, 10> c = kShapes[rng.next_u32() % 3];
     const double s = scale;
@@ -265,14 +292,18 @@ Quadric make_instance(QuadricForm form, Pcg32& rng, float scale, float offset, b
 Ray random_ray(Pcg32& rng, const Bounds3& b, const Oracle& o) {
     const Vec3 c = b.center(), e(max_component(b.extent()));
     auto in_box = [&](float spread) {
-        return c + Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * e * spread;
+        return c +
+               Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * e * spread;
     };
     const Vec3 org = in_box(3.0f);
     Vec3 dir;
     const float kind = rng.next_float();
-    if (kind < 0.25f) dir = random_unit(rng);
-    else if (kind < 0.9f) dir = in_box(1.2f) - org;
-    else dir = Vec3(o.world_vector(o.axis)) * (rng.next_float() < 0.5f ? -1.0f : 1.0f);
+    if (kind < 0.25f)
+        dir = random_unit(rng);
+    else if (kind < 0.9f)
+        dir = in_box(1.2f) - org;
+    else
+        dir = Vec3(o.world_vector(o.axis)) * (rng.next_float() < 0.5f ? -1.0f : 1.0f);
     dir = dir * (0.5f + 1.5f * rng.next_float());
     Ray ray = make_ray(org, dir);
     if (rng.next_float() < 0.1f) ray.tmax = 3.0f * e.x * rng.next_float() / length(dir);
@@ -293,7 +324,8 @@ void check_hit(const Quadric& q, const Oracle& o, const Ray& ray, const QuadricH
     const LD quant = 4 * LD(std::numeric_limits<float>::epsilon()) * LD(max_component(abs(s.p)));
     if (h.part == QuadricPart::side) {
         const VL g = normalize(o.grad(p));
-        if (o.surface_error(p) > tol || o.clip_margin(p) < -tol || o.surface_error(ps) > tol + quant) ++st.off_surface;
+        if (o.surface_error(p) > tol || o.clip_margin(p) < -tol || o.surface_error(ps) > tol + quant)
+            ++st.off_surface;
         if (dot(VL(s.n), g) < 0.9999L || s.front_face != (dot(d, g) < 0)) ++st.bad_normal;
         if (dot(VL(q.normal(s.p)), g) < 0.999L) ++st.bad_normal;
         if (!q.bounds().contains(s.p)) ++st.off_surface;
@@ -338,7 +370,8 @@ FormStats run_brute_force(QuadricForm form, uint64_t seed, int instances, int ra
                                       : LD(1);
                 ok = cosang < 0.01L || std::fabs(o.clip_margin(p)) < 1e-4L * o.scale;
             }
-            if (ok) ++st.explained;
+            if (ok)
+                ++st.explained;
             else if (++st.unexplained <= 5) {
                 MESSAGE("mismatch: form ", int(form), " inst ", inst, " ray ", i, " impl t ", h.t, " part ",
                         int(h.part), " bf t ", double(b.t), " found ", b.found);
@@ -350,12 +383,18 @@ FormStats run_brute_force(QuadricForm form, uint64_t seed, int instances, int ra
 
 const char* form_name(QuadricForm f) {
     switch (f) {
-        case QuadricForm::ellipsoid: return "ellipsoid";
-        case QuadricForm::cylinder: return "cylinder";
-        case QuadricForm::cone: return "cone";
-        case QuadricForm::paraboloid: return "paraboloid";
-        case QuadricForm::hyperboloid: return "hyperboloid";
-        case QuadricForm::general: return "general";
+        case QuadricForm::ellipsoid:
+            return "ellipsoid";
+        case QuadricForm::cylinder:
+            return "cylinder";
+        case QuadricForm::cone:
+            return "cone";
+        case QuadricForm::paraboloid:
+            return "paraboloid";
+        case QuadricForm::hyperboloid:
+            return "hyperboloid";
+        case QuadricForm::general:
+            return "general";
     }
     return "?";
 }
@@ -408,7 +447,8 @@ TEST_CASE("quadric: hand-checked cases") {
         CHECK(ell.intersect(make_ray({1, -10, 3}, {0, 1, 0})).t == doctest::Approx(10.0f));
         CHECK(ell.bounds().contains(Bounds3{{0, 0, 0}, {2, 4, 6}}));
         // Saddle z = x² - y² in [-1,1]³: straight down through (0.5, 0) lands at z = 0.25.
-        const Quadric saddle = make_general_quadric({1, -1, 0, 0, 0, 0, 0, 0, -1, 0}, {{-1, -1, -1}, {1, 1, 1}});
+        const Quadric saddle =
+            make_general_quadric({1, -1, 0, 0, 0, 0, 0, 0, -1, 0}, {{-1, -1, -1}, {1, 1, 1}});
         CHECK(saddle.intersect(make_ray({0.5f, 0, 3}, {0, 0, -1})).t == doctest::Approx(2.75f));
         CHECK_FALSE(saddle.intersect(make_ray({3, 0, 3}, {0, 0, -1})).hit());
     }
@@ -426,7 +466,8 @@ TEST_CASE("quadric: factories reject bad parameters") {
     CHECK_THROWS_AS(make_cone({0, 0, 0}, {0, 0, 1}, 90, 1, false), InputError);
     CHECK_THROWS_AS(make_paraboloid({0, 0, 0}, {0, 0, 1}, 1, 0), InputError);
     CHECK_THROWS_AS(make_hyperboloid({0, 0, 0}, {0, 0, 1}, 0.5f, 1, 1), InputError);
-    CHECK_THROWS_AS(make_general_quadric({0, 0, 0, 0, 0, 0, 0, 0, 0, 1}, {{-1, -1, -1}, {1, 1, 1}}), InputError);
+    CHECK_THROWS_AS(make_general_quadric({0, 0, 0, 0, 0, 0, 0, 0, 0, 1}, {{-1, -1, -1}, {1, 1, 1}}),
+                    InputError);
     CHECK_THROWS_AS(make_general_quadric({1, 1, 1, 0, 0, 0, 0, 0, 0, -1}, Bounds3{}), InputError);
     CHECK_THROWS_AS(make_ellipsoid({0, 0, 0}, {1, 1, 1}, Mat4::scale({1, 0, 1})), InputError);
 }
@@ -448,9 +489,15 @@ void check_against_brute_force(QuadricForm form) {
 
 }  // namespace
 
-TEST_CASE("quadric: ellipsoid agrees with brute-force root finding") { check_against_brute_force(QuadricForm::ellipsoid); }
-TEST_CASE("quadric: cylinder agrees with brute-force root finding") { check_against_brute_force(QuadricForm::cylinder); }
-TEST_CASE("quadric: cone agrees with brute-force root finding") { check_against_brute_force(QuadricForm::cone); }
+TEST_CASE("quadric: ellipsoid agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::ellipsoid);
+}
+TEST_CASE("quadric: cylinder agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::cylinder);
+}
+TEST_CASE("quadric: cone agrees with brute-force root finding") {
+    check_against_brute_force(QuadricForm::cone);
+}
 TEST_CASE("quadric: paraboloid agrees with brute-force root finding") {
     check_against_brute_force(QuadricForm::paraboloid);
 }
@@ -482,16 +529,19 @@ TEST_CASE("quadric: rays spawned from a hit towards either side never re-hit at 
                 const VL p(s.p);
                 // Where two parts meet (cap rims) or at the cone apex a short second hit is real geometry.
                 if (o.capped && o.clip_margin(p) < 0.02L * scale) continue;
-                if (form == QuadricForm::cone && dot(o.local(p) - o.origin, o.axis) < 0.05L * o.height) continue;
+                if (form == QuadricForm::cone && dot(o.local(p) - o.origin, o.axis) < 0.05L * o.height)
+                    continue;
                 for (float side : {1.0f, -1.0f}) {
                     const Vec3 n = s.n * side;
-                    const Vec3 dir = Frame(n).to_world(sample_cosine_hemisphere({rng.next_float(), rng.next_float()}));
+                    const Vec3 dir =
+                        Frame(n).to_world(sample_cosine_hemisphere({rng.next_float(), rng.next_float()}));
                     if (dot(dir, n) < 0.05f) continue;
                     const QuadricHit again = q.intersect(make_ray(offset_ray_origin(s.p, n), dir));
                     ++spawned;
                     if (again.hit() && again.t < 1e-3f * scale) {
                         if (++rehits <= 5)
-                            MESSAGE("re-hit at t ", again.t, " scale ", scale, " side ", side, " part ", int(h.part));
+                            MESSAGE("re-hit at t ", again.t, " scale ", scale, " side ", side, " part ",
+                                    int(h.part));
                     }
                 }
             }
@@ -524,7 +574,8 @@ TEST_CASE("quadric: closed shapes have no holes (every ray from inside hits)") {
         for (int inst = 0; inst < 5; ++inst) {
             Oracle o;
             const float scale = std::pow(10.0f, -2.0f + 5.0f * rng.next_float());
-            const Quadric q = make_instance(QuadricForm::ellipsoid, rng, scale, 100 * scale * rng.next_float(), false, o);
+            const Quadric q =
+                make_instance(QuadricForm::ellipsoid, rng, scale, 100 * scale * rng.next_float(), false, o);
             for (int i = 0; i < per_instance; ++i) {
                 const VL local = o.origin + VL(inside_unit_ball(rng) * 0.999f) * o.radii;
                 const Ray ray = make_ray(to_world(o, local), random_unit(rng));
@@ -547,8 +598,8 @@ TEST_CASE("quadric: closed shapes have no holes (every ray from inside hits)") {
                     const LD h = o.height * (0.02L + 0.96L * LD(rng.next_float()));
                     const LD r_here = form == QuadricForm::cone ? h * o.tan_angle : o.radius;
                     const Vec2 disk = sample_disk_concentric({rng.next_float(), rng.next_float()});
-                    const VL inside = o.origin + o.axis * h +
-                                      VL(frame.to_world(Vec3(disk.x, disk.y, 0))) * (0.9L * r_here);
+                    const VL inside =
+                        o.origin + o.axis * h + VL(frame.to_world(Vec3(disk.x, disk.y, 0))) * (0.9L * r_here);
                     // Target: a point of the top (or, for cylinders, bottom) rim.
                     const float phi = 2 * kPi * rng.next_float();
                     const bool top = form == QuadricForm::cone || rng.next_float() < 0.5f;
@@ -572,7 +623,8 @@ TEST_CASE("quadric: placing a canonical shape by world_from_object equals placin
     const Vec3 base(1.5f, -2, 0.25f), axis = rot.apply_vector({0, 0, 1});
     const Mat4 frame = Mat4::translate(Vec3d(base)) * rot;
     const Quadric pairs[][2] = {
-        {make_cylinder(base, axis, 0.7f, 1.3f, true), make_cylinder({0, 0, 0}, {0, 0, 1}, 0.7f, 1.3f, true, frame)},
+        {make_cylinder(base, axis, 0.7f, 1.3f, true),
+         make_cylinder({0, 0, 0}, {0, 0, 1}, 0.7f, 1.3f, true, frame)},
         {make_cone(base, axis, 25, 1.1f, true), make_cone({0, 0, 0}, {0, 0, 1}, 25, 1.1f, true, frame)},
         {make_paraboloid(base, axis, 0.8f, 0.9f), make_paraboloid({0, 0, 0}, {0, 0, 1}, 0.8f, 0.9f, frame)},
         {make_hyperboloid(base, axis, 1, 0.4f, 2), make_hyperboloid({0, 0, 0}, {0, 0, 1}, 1, 0.4f, 2, frame)},
@@ -581,11 +633,13 @@ TEST_CASE("quadric: placing a canonical shape by world_from_object equals placin
     for (const auto& pair : pairs) {
         for (int i = 0; i < 2000; ++i) {
             const Vec3 org = base + random_unit(rng) * 4.0f;
-            const Vec3 target = base + Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * 2.0f;
+            const Vec3 target =
+                base + Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * 2.0f;
             const Ray ray = make_ray(org, target - org);
             const QuadricHit a = pair[0].intersect(ray), b = pair[1].intersect(ray);
             hits += a.hit();
-            mismatches += a.hit() != b.hit() || (a.hit() && (std::abs(a.t - b.t) > 1e-5f || a.part != b.part));
+            mismatches +=
+                a.hit() != b.hit() || (a.hit() && (std::abs(a.t - b.t) > 1e-5f || a.part != b.part));
         }
     }
     CHECK(hits > 1000);

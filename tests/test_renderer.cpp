@@ -23,7 +23,8 @@ Scene small_scene(int spp, int w = 20, int h = 14) {
 bool same_state(const Film& a, const Film& b) {
     for (int y = 0; y < a.height(); ++y)
         for (int x = 0; x < a.width(); ++x)
-            if (a.count(x, y) != b.count(x, y) || !(a.sum(x, y) == b.sum(x, y)) || a.sum_sq(x, y) != b.sum_sq(x, y))
+            if (a.count(x, y) != b.count(x, y) || !(a.sum(x, y) == b.sum(x, y)) ||
+                a.sum_sq(x, y) != b.sum_sq(x, y))
                 return false;
     return true;
 }

@@ -36,7 +36,9 @@ bool one_per_elementary_interval(const std::vector<Vec2>& pts, int k) {
 }
 
 /// A smooth function on [0,1] with integral 1.
-double smooth1(float u) { return 1.0 + 0.5 * std::cos(2.0 * 3.14159265358979 * double(u)) + (double(u) - 0.5); }
+double smooth1(float u) {
+    return 1.0 + 0.5 * std::cos(2.0 * 3.14159265358979 * double(u)) + (double(u) - 0.5);
+}
 
 /// Smooth integrands over [0,1]^4 with integral 1: within one dimension pair,
 /// and a product across two pairs.
@@ -120,7 +122,11 @@ TEST_CASE("sampler: pixels and dimension pairs are decorrelated") {
     for (int i = 0; i < n; ++i) {
         s.start(2, 2, uint32_t(i));
         const double x = s.next_2d().x, y = s.next_2d().x;
-        sx += x; sy += y; sxy += x * y; sxx += x * x; syy += y * y;
+        sx += x;
+        sy += y;
+        sxy += x * y;
+        sxx += x * x;
+        syy += y * y;
     }
     const double cov = sxy / n - sx / n * sy / n;
     const double corr = cov / std::sqrt((sxx / n - sx / n * sx / n) * (syy / n - sy / n * sy / n));
@@ -148,8 +154,8 @@ TEST_CASE("sobol sampler converges faster than independent on smooth integrands"
     const double sobol_64 = rms_error(smooth_pair, SamplerType::sobol, 64, 200);
     const double indep_64 = rms_error(smooth_pair, SamplerType::independent, 64, 200);
     const double sobol_256 = rms_error(smooth_pair, SamplerType::sobol, 256, 200);
-    MESSAGE("2-D: RMSE at 64 spp: sobol " << sobol_64 << ", independent " << indep_64 << "; sobol at 256: "
-                                          << sobol_256);
+    MESSAGE("2-D: RMSE at 64 spp: sobol " << sobol_64 << ", independent " << indep_64
+                                          << "; sobol at 256: " << sobol_256);
     CHECK(sobol_64 < 0.1 * indep_64);
     // Owen-scrambled nets of a smooth integrand converge at about N^-1.5: x4
     // samples would only halve the error at the Monte Carlo rate.

@@ -26,7 +26,10 @@ TEST_CASE("scene: quadrics sit in the BVH beside spheres and give the quadric's 
         uint32_t best_q = kNoPrim;
         for (uint32_t q = 0; q < scene.quadrics.size(); ++q) {
             const QuadricHit qh = scene.quadrics[q].intersect(ray);
-            if (qh.hit() && qh.t < best) { best = qh.t; best_q = q; }
+            if (qh.hit() && qh.t < best) {
+                best = qh.t;
+                best_q = q;
+            }
         }
         const float floor_t = ray.dir.z < 0 ? -ray.origin.z / ray.dir.z : kInfinity;
         if (best_q != kNoPrim && best < floor_t) {
@@ -72,7 +75,8 @@ TEST_CASE("bvh-cost: the heat map shows more work where there is geometry, and a
 
 TEST_CASE("every shipped scene parses and renders at 1 spp without NaN or Inf samples") {
     int scenes = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(std::string(SAHARA_SOURCE_DIR) + "/scenes")) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::string(SAHARA_SOURCE_DIR) + "/scenes")) {
         if (entry.path().extension() != ".json") continue;
         CAPTURE(entry.path().string());
         SceneDesc d = parse_scene_file(entry.path());

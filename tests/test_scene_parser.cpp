@@ -271,7 +271,8 @@ TEST_CASE("scene parser: every key round-trips into SceneDesc") {
     REQUIRE(fake.model_transforms.size() == 2);
     Mat4 expected = Mat4::translate({0, 1, 0}) * Mat4::rotate_euler({90, 0, 0}) * Mat4::scale({10, 10, 10});
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) CHECK(fake.model_transforms[0].m[i][j] == doctest::Approx(expected.m[i][j]));
+        for (int j = 0; j < 4; ++j)
+            CHECK(fake.model_transforms[0].m[i][j] == doctest::Approx(expected.m[i][j]));
     CHECK(s.lights.size() == 2 + 2);  // the scene's two, then one from each mesh's model
 
     REQUIRE(s.quadrics.size() == 6);
@@ -315,7 +316,8 @@ TEST_CASE("scene parser: every key round-trips into SceneDesc") {
 TEST_CASE("scene parser: the euler camera form") {
     SceneDesc s = parse_scene_json(
         R"({"camera": {"position": [0, 5, -8], "euler": [20, 10, 5], "focal_length": 1.5, "aperture": 0.1},
-            "objects": []})", "e.json");
+            "objects": []})",
+        "e.json");
     CHECK(s.camera.euler_form);
     CHECK(s.camera.position == Vec3(0, 5, -8));
     CHECK(s.camera.euler == Vec3(20, 10, 5));
@@ -332,7 +334,8 @@ TEST_CASE("scene parser: transforms apply scale, then rotate, then translate") {
           "transform": { "scale": [1, 2, 3], "rotate": [90, 0, 0], "translate": [1, 0, 0] } },
         { "type": "ellipsoid", "transform": { "matrix": [0, -1, 0, 4,  1, 0, 0, 5,  0, 0, 1, 6,  0, 0, 0, 1] } },
         { "type": "plane", "point": [0, 0, 1], "normal": [0, 0, 1], "transform": { "rotate": [90, 0, 0] } }
-    ])"), "t.json");
+    ])"),
+                                   "t.json");
     // S: (2,0,0); R about Z by 90: (0,2,0); T: (0,2,5). Any other order lands elsewhere.
     CHECK(near(s.spheres[0].center, Vec3(0, 2, 5)));
     CHECK(s.spheres[0].radius == doctest::Approx(2.0f));
@@ -351,7 +354,8 @@ TEST_CASE("scene parser: transformed boxes stay boxes or become outward-facing m
         { "type": "box", "min": [0, 0, 0], "max": [1, 2, 3], "transform": { "rotate": [0, 0, 90], "translate": [10, 0, 0] } },
         { "type": "box", "min": [0, 0, 0], "max": [1, 2, 3], "transform": { "rotate": [0, 0, 30] } },
         { "type": "box", "min": [0, 0, 0], "max": [1, 2, 3], "transform": { "scale": [-1, 1, 1], "rotate": [10, 0, 0] } }
-    ])"), "b.json");
+    ])"),
+                                   "b.json");
     REQUIRE(s.boxes.size() == 1);
     CHECK(near(s.boxes[0].lo, Vec3(8, 0, 0)));
     CHECK(near(s.boxes[0].hi, Vec3(10, 1, 3)));
@@ -364,7 +368,8 @@ TEST_CASE("scene parser: transformed boxes stay boxes or become outward-facing m
             Vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]],
                  c = m.positions[m.indices[3 * t + 2]];
             Vec3 n = cross(b - a, c - a);
-            CHECK(dot(n, (a + b + c) * (1.0f / 3.0f) - center) > 0.0f);  // counter-clockwise seen from outside
+            CHECK(dot(n, (a + b + c) * (1.0f / 3.0f) - center) >
+                  0.0f);  // counter-clockwise seen from outside
         }
     }
 }
@@ -375,7 +380,8 @@ TEST_CASE("scene parser: quadric canonical forms pass through their named surfac
         { "type": "cone", "apex": [0, 0, 1], "axis": [0, 0, -1], "angle": 30, "height": 2 },
         { "type": "paraboloid", "vertex": [0, 1, 0], "axis": [0, -1, 0.5], "radius": 2, "height": 3 },
         { "type": "hyperboloid", "center": [2, 0, 0], "axis": [0, 1, 0], "radius": 2, "waist": 1, "height": 4 }
-    ])"), "q.json");
+    ])"),
+                                   "q.json");
     REQUIRE(s.quadrics.size() == 4);
     auto eval = [](const QuadricDesc& q, const Vec3& world) {
         Vec3d p(q.local_from_world.apply_point(world));
@@ -383,7 +389,9 @@ TEST_CASE("scene parser: quadric canonical forms pass through their named surfac
         return c[0] * p.x * p.x + c[1] * p.y * p.y + c[2] * p.z * p.z + c[3] * p.x * p.y + c[4] * p.x * p.z +
                c[5] * p.y * p.z + c[6] * p.x + c[7] * p.y + c[8] * p.z + c[9];
     };
-    auto perp = [](const Vec3& axis) { return normalize(cross(axis, std::abs(axis.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 1, 0))); };
+    auto perp = [](const Vec3& axis) {
+        return normalize(cross(axis, std::abs(axis.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
+    };
     auto inside = [](const QuadricDesc& q, const Vec3& world) {
         Bounds3 b = q.local_bounds;
         b.lo -= Vec3(1e-4f);
@@ -395,10 +403,18 @@ TEST_CASE("scene parser: quadric canonical forms pass through their named surfac
         float t = std::tan(q.angle * float(std::numbers::pi) / 180.0f);
         std::vector<Vec3> on;  // points the named form says are on the surface
         switch (q.type) {
-            case QuadricDesc::Type::cylinder: on = {q.origin + n * q.radius, q.origin + a * q.height + n * q.radius}; break;
-            case QuadricDesc::Type::cone: on = {q.origin, q.origin + a * q.height + n * (q.height * t)}; break;
-            case QuadricDesc::Type::paraboloid: on = {q.origin, q.origin + a * q.height + n * q.radius}; break;
-            default: on = {q.origin + n * q.waist, q.origin + a * (0.5f * q.height) + n * q.radius}; break;
+            case QuadricDesc::Type::cylinder:
+                on = {q.origin + n * q.radius, q.origin + a * q.height + n * q.radius};
+                break;
+            case QuadricDesc::Type::cone:
+                on = {q.origin, q.origin + a * q.height + n * (q.height * t)};
+                break;
+            case QuadricDesc::Type::paraboloid:
+                on = {q.origin, q.origin + a * q.height + n * q.radius};
+                break;
+            default:
+                on = {q.origin + n * q.waist, q.origin + a * (0.5f * q.height) + n * q.radius};
+                break;
         }
         for (const Vec3& p : on) {
             CAPTURE(int(q.type));
@@ -423,96 +439,146 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
         {"{" + cam + R"(, "objects": [], "colour": 1})", {"colour: unknown key"}},
         {"{" + cam + R"(, "objects": [], "render": {"width": "640"}})",
          {"render.width: expected an integer in [1, 32768], got \"640\""}},
-        {"{" + cam + R"(, "objects": [], "render": {"width": 0}})", {"render.width: expected an integer in [1, 32768], got 0"}},
-        {"{" + cam + R"(, "objects": [], "render": {"height": 40000}})", {"render.height: expected an integer in [1, 32768]"}},
-        {"{" + cam + R"(, "objects": [], "render": {"width": 640.5}})", {"render.width: expected an integer"}},
-        {"{" + cam + R"(, "objects": [], "render": {"spp": 0}})", {"render.spp: expected an integer >= 1, got 0"}},
-        {"{" + cam + R"(, "objects": [], "render": {"max_depth": 0}})", {"render.max_depth: expected an integer in [1, 1024]"}},
-        {"{" + cam + R"(, "objects": [], "render": {"seed": -1}})", {"render.seed: expected an integer in [0,"}},
+        {"{" + cam + R"(, "objects": [], "render": {"width": 0}})",
+         {"render.width: expected an integer in [1, 32768], got 0"}},
+        {"{" + cam + R"(, "objects": [], "render": {"height": 40000}})",
+         {"render.height: expected an integer in [1, 32768]"}},
+        {"{" + cam + R"(, "objects": [], "render": {"width": 640.5}})",
+         {"render.width: expected an integer"}},
+        {"{" + cam + R"(, "objects": [], "render": {"spp": 0}})",
+         {"render.spp: expected an integer >= 1, got 0"}},
+        {"{" + cam + R"(, "objects": [], "render": {"max_depth": 0}})",
+         {"render.max_depth: expected an integer in [1, 1024]"}},
+        {"{" + cam + R"(, "objects": [], "render": {"seed": -1}})",
+         {"render.seed: expected an integer in [0,"}},
         {"{" + cam + R"(, "objects": [], "render": {"integrator": "raytrace"}})",
          {"render.integrator: expected one of \"path\", \"whitted\"", "got \"raytrace\""}},
-        {"{" + cam + R"(, "objects": [], "render": {"tonemap": "agx"}})", {"render.tonemap: expected one of \"clamp\""}},
-        {"{" + cam + R"(, "objects": [], "render": {"time_limit_s": 0}})", {"render.time_limit_s: expected a number > 0"}},
-        {"{" + cam + R"(, "objects": [], "render": {"exposure": 100}})", {"render.exposure: expected a number in [-64, 64]"}},
+        {"{" + cam + R"(, "objects": [], "render": {"tonemap": "agx"}})",
+         {"render.tonemap: expected one of \"clamp\""}},
+        {"{" + cam + R"(, "objects": [], "render": {"time_limit_s": 0}})",
+         {"render.time_limit_s: expected a number > 0"}},
+        {"{" + cam + R"(, "objects": [], "render": {"exposure": 100}})",
+         {"render.exposure: expected a number in [-64, 64]"}},
         {"{" + cam + R"(, "objects": [], "format": "scene/2"})", {"format: expected one of \"scene/1\""}},
-        {with_objects(R"([{"type": "sphere", "radius": 1e999}])"), {"line 1", "column", "number overflow", "1e999"}},
+        {with_objects(R"([{"type": "sphere", "radius": 1e999}])"),
+         {"line 1", "column", "number overflow", "1e999"}},
         {with_objects(R"([{"type": "sphere", "radius": 1e39}])"),
          {"objects[0].radius: expected a number > 0 that fits a 32-bit float, got 1e+39"}},
-        {with_objects(R"([{"type": "sphere", "center": [0, 1]}])"), {"objects[0].center: expected [x, y, z]: 3 numbers, got [0,1]"}},
-        {with_objects(R"([{"type": "sphere", "center": [0, 1, true]}])"), {"objects[0].center[2]: expected a number, got true"}},
+        {with_objects(R"([{"type": "sphere", "center": [0, 1]}])"),
+         {"objects[0].center: expected [x, y, z]: 3 numbers, got [0,1]"}},
+        {with_objects(R"([{"type": "sphere", "center": [0, 1, true]}])"),
+         {"objects[0].center[2]: expected a number, got true"}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "vfov": 180}, "objects": []})",
          {"camera.vfov: expected a number in (0, 180), got 180"}},
-        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "vfov": 0}, "objects": []})", {"camera.vfov: expected a number in (0, 180)"}},
+        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "vfov": 0}, "objects": []})",
+         {"camera.vfov: expected a number in (0, 180)"}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "euler": [0, 0, 0]}, "objects": []})",
          {"camera: mixes the look-at form (\"look_at\") with the euler form (\"euler\")"}},
-        {R"({"camera": {"position": [0, 0, 0], "up": [0, 1, 0], "focal_length": 1}, "objects": []})", {"camera: mixes the look-at form (\"up\")"}},
+        {R"({"camera": {"position": [0, 0, 0], "up": [0, 1, 0], "focal_length": 1}, "objects": []})",
+         {"camera: mixes the look-at form (\"up\")"}},
         {R"({"camera": {"position": [0, 0, 0]}, "objects": []})", {"camera: missing key \"look_at\""}},
         {R"({"camera": {"look_at": [0, 0, 0]}, "objects": []})", {"camera: missing key \"position\""}},
-        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 0]}, "objects": []})", {"camera.look_at: look_at must differ from position"}},
-        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "up": [0, 2, 0]}, "objects": []})", {"camera.up: up must not be parallel"}},
+        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 0]}, "objects": []})",
+         {"camera.look_at: look_at must differ from position"}},
+        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "up": [0, 2, 0]}, "objects": []})",
+         {"camera.up: up must not be parallel"}},
         {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]}, "objects": []})",
          {"camera.look_at: the viewing direction is parallel to the default up"}},
-        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "shutter": [1, 0]}, "objects": []})", {"camera.shutter: expected [open, close] with open <= close"}},
-        {R"({"camera": {"position": [0, 0, 0], "euler": [0, 0, 0], "focal_length": -1}, "objects": []})", {"camera.focal_length: expected a number > 0"}},
+        {R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "shutter": [1, 0]}, "objects": []})",
+         {"camera.shutter: expected [open, close] with open <= close"}},
+        {R"({"camera": {"position": [0, 0, 0], "euler": [0, 0, 0], "focal_length": -1}, "objects": []})",
+         {"camera.focal_length: expected a number > 0"}},
         {R"({"objects": []})", {"missing key \"camera\""}},
         {"{" + cam + "}", {"missing key \"objects\""}},
         {"{" + cam + R"(, "objects": {}})", {"objects: expected an array, got {}"}},
         {"[1, 2]", {"expected an object, got [1,2]"}},
         {with_objects(R"([{"type": "sphere", "material": "gold"}])", R"({"white": {"type": "lambertian"}})"),
          {"objects[0].material: unknown material \"gold\" (defined: \"default\", \"white\")"}},
-        {with_objects("[]", R"({"white": {"type": "lambertian"}, "white": {"type": "metal"}})"), {"materials.white: duplicate key"}},
-        {with_objects(R"([{"type": "sphere"}, {"type": "sphere", "radius": 1, "radius": 2}])"), {"objects[1].radius: duplicate key"}},
-        {with_objects("[]", R"({"default": {"type": "lambertian"}})"), {"materials.default: the name \"default\" is reserved"}},
+        {with_objects("[]", R"({"white": {"type": "lambertian"}, "white": {"type": "metal"}})"),
+         {"materials.white: duplicate key"}},
+        {with_objects(R"([{"type": "sphere"}, {"type": "sphere", "radius": 1, "radius": 2}])"),
+         {"objects[1].radius: duplicate key"}},
+        {with_objects("[]", R"({"default": {"type": "lambertian"}})"),
+         {"materials.default: the name \"default\" is reserved"}},
         {with_objects("[]", R"({"m": {"type": "metal", "alpha": 0.5}})"), {"materials.m.alpha: unknown key"}},
-        {with_objects("[]", R"({"m": {"type": "plastic"}})"), {"materials.m.type: expected one of \"lambertian\", \"metal\""}},
+        {with_objects("[]", R"({"m": {"type": "plastic"}})"),
+         {"materials.m.type: expected one of \"lambertian\", \"metal\""}},
         {with_objects("[]", R"({"m": {"albedo": [1, 1, 1]}})"), {"materials.m: missing key \"type\""}},
         {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": [0.5, 1.5, 0]}})"),
          {"materials.m.albedo[1]: expected a number in [0, 1], got 1.5"}},
-        {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": {"marble": 1}}})"), {"materials.m.albedo.marble: unknown key"}},
-        {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": "red"}})"), {"materials.m.albedo: expected [r, g, b]"}},
+        {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": {"marble": 1}}})"),
+         {"materials.m.albedo.marble: unknown key"}},
+        {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": "red"}})"),
+         {"materials.m.albedo: expected [r, g, b]"}},
         {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": {"checker": {"scale": 0}}}})"),
          {"materials.m.albedo.checker.scale: expected a number > 0, got 0"}},
-        {with_objects("[]", R"({"m": {"type": "lambertian", "alpha": 2}})"), {"materials.m.alpha: expected a number in [0, 1], got 2"}},
-        {with_objects("[]", R"({"m": {"type": "emissive", "radiance": [1, -1, 1]}})"), {"materials.m.radiance[1]: expected a number >= 0"}},
-        {with_objects("[]", R"({"m": {"type": "metal", "roughness": 2}})"), {"materials.m.roughness: expected a number in [0, 1]"}},
+        {with_objects("[]", R"({"m": {"type": "lambertian", "alpha": 2}})"),
+         {"materials.m.alpha: expected a number in [0, 1], got 2"}},
+        {with_objects("[]", R"({"m": {"type": "emissive", "radiance": [1, -1, 1]}})"),
+         {"materials.m.radiance[1]: expected a number >= 0"}},
+        {with_objects("[]", R"({"m": {"type": "metal", "roughness": 2}})"),
+         {"materials.m.roughness: expected a number in [0, 1]"}},
         {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": {"texture": "textures/nope.png"}}})"),
          {"materials.m.albedo.texture: file not found:", "textures/nope.png"}},
-        {"{" + cam + R"(, "objects": [], "background": {"type": "envmap"}})", {"background: missing key \"file\""}},
-        {"{" + cam + R"(, "objects": [], "background": {"type": "constant", "top": [1, 1, 1]}})", {"background.top: unknown key"}},
+        {"{" + cam + R"(, "objects": [], "background": {"type": "envmap"}})",
+         {"background: missing key \"file\""}},
+        {"{" + cam + R"(, "objects": [], "background": {"type": "constant", "top": [1, 1, 1]}})",
+         {"background.top: unknown key"}},
         {"{" + cam + R"(, "objects": [], "background": {"type": "gradient", "up": [0, 0, 0]}})",
          {"background.up: expected a non-zero vector"}},
-        {with_objects(R"([{"type": "torus"}])"), {"objects[0].type: expected one of \"sphere\"", "got \"torus\""}},
+        {with_objects(R"([{"type": "torus"}])"),
+         {"objects[0].type: expected one of \"sphere\"", "got \"torus\""}},
         {with_objects(R"([{"radius": 1}])"), {"objects[0]: missing key \"type\""}},
         {with_objects(R"([{"type": "sphere", "transform": {"scale": [1, 2, 1]}}])"),
          {"objects[0].transform: a sphere only takes a uniform scale (use an ellipsoid"}},
-        {with_objects(R"([{"type": "sphere", "transform": {"scale": 0}}])"), {"objects[0].transform.scale: expected a non-zero number"}},
-        {with_objects(R"([{"type": "plane", "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "translate": [1, 0, 0]}}])"),
+        {with_objects(R"([{"type": "sphere", "transform": {"scale": 0}}])"),
+         {"objects[0].transform.scale: expected a non-zero number"}},
+        {with_objects(
+             R"([{"type": "plane", "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "translate": [1, 0, 0]}}])"),
          {"objects[0].transform: \"matrix\" excludes"}},
-        {with_objects(R"([{"type": "plane", "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]}}])"),
+        {with_objects(
+             R"([{"type": "plane", "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,1]}}])"),
          {"objects[0].transform.matrix: expected an affine matrix"}},
         {with_objects(R"([{"type": "plane", "transform": {"matrix": [1, 0, 0]}}])"),
          {"objects[0].transform.matrix: expected an array of 16 elements"}},
-        {with_objects(R"([{"type": "plane", "transform": {"skew": 1}}])"), {"objects[0].transform.skew: unknown key"}},
-        {with_objects(R"([{"type": "plane", "normal": [0, 0, 0]}])"), {"objects[0].normal: expected a non-zero vector"}},
-        {with_objects(R"([{"type": "box", "min": [0, 0, 0], "max": [1, 0, 1]}])"), {"objects[0].max: expected max > min"}},
+        {with_objects(R"([{"type": "plane", "transform": {"skew": 1}}])"),
+         {"objects[0].transform.skew: unknown key"}},
+        {with_objects(R"([{"type": "plane", "normal": [0, 0, 0]}])"),
+         {"objects[0].normal: expected a non-zero vector"}},
+        {with_objects(R"([{"type": "box", "min": [0, 0, 0], "max": [1, 0, 1]}])"),
+         {"objects[0].max: expected max > min"}},
         {with_objects(R"([{"type": "mesh"}])"), {"objects[0]: missing key \"file\""}},
-        {with_objects(R"([{"type": "mesh", "file": "meshes/none.obj"}])"), {"objects[0].file: file not found:", "meshes/none.obj"}},
-        {with_objects(R"([{"type": "ellipsoid", "radii": [1, 0, 1]}])"), {"objects[0].radii[1]: expected a number > 0, got 0"}},
+        {with_objects(R"([{"type": "mesh", "file": "meshes/none.obj"}])"),
+         {"objects[0].file: file not found:", "meshes/none.obj"}},
+        {with_objects(R"([{"type": "ellipsoid", "radii": [1, 0, 1]}])"),
+         {"objects[0].radii[1]: expected a number > 0, got 0"}},
         {with_objects(R"([{"type": "ellipsoid", "axis": [1, 0, 0]}])"), {"objects[0].axis: unknown key"}},
-        {with_objects(R"([{"type": "cylinder", "axis": [0, 0, 0]}])"), {"objects[0].axis: expected a non-zero vector"}},
-        {with_objects(R"([{"type": "cylinder", "capped": 1}])"), {"objects[0].capped: expected true or false, got 1"}},
-        {with_objects(R"([{"type": "cone", "angle": 90}])"), {"objects[0].angle: expected a number in (0, 90), got 90"}},
-        {with_objects(R"([{"type": "paraboloid", "height": -2}])"), {"objects[0].height: expected a number > 0, got -2"}},
-        {with_objects(R"([{"type": "hyperboloid", "radius": 1, "waist": 1}])"), {"objects[0].waist: expected waist < radius"}},
-        {with_objects(R"([{"type": "quadric", "bounds": {"min": [0, 0, 0], "max": [1, 1, 1]}}])"), {"objects[0]: missing key \"coefficients\""}},
-        {with_objects(R"([{"type": "quadric", "coefficients": [0, 0, 0, 0, 0, 0, 1, 0, 0, 0], "bounds": {"min": [0, 0, 0], "max": [1, 1, 1]}}])"),
+        {with_objects(R"([{"type": "cylinder", "axis": [0, 0, 0]}])"),
+         {"objects[0].axis: expected a non-zero vector"}},
+        {with_objects(R"([{"type": "cylinder", "capped": 1}])"),
+         {"objects[0].capped: expected true or false, got 1"}},
+        {with_objects(R"([{"type": "cone", "angle": 90}])"),
+         {"objects[0].angle: expected a number in (0, 90), got 90"}},
+        {with_objects(R"([{"type": "paraboloid", "height": -2}])"),
+         {"objects[0].height: expected a number > 0, got -2"}},
+        {with_objects(R"([{"type": "hyperboloid", "radius": 1, "waist": 1}])"),
+         {"objects[0].waist: expected waist < radius"}},
+        {with_objects(R"([{"type": "quadric", "bounds": {"min": [0, 0, 0], "max": [1, 1, 1]}}])"),
+         {"objects[0]: missing key \"coefficients\""}},
+        {with_objects(
+             R"([{"type": "quadric", "coefficients": [0, 0, 0, 0, 0, 0, 1, 0, 0, 0], "bounds": {"min": [0, 0, 0], "max": [1, 1, 1]}}])"),
          {"objects[0].coefficients: expected at least one of A..F"}},
-        {with_objects(R"([{"type": "quadric", "coefficients": [1, 1, 1, 0, 0, 0, 0, 0, 0, -1], "bounds": {"min": [0, 0, 0], "max": [1, -1, 1]}}])"),
+        {with_objects(
+             R"([{"type": "quadric", "coefficients": [1, 1, 1, 0, 0, 0, 0, 0, 0, -1], "bounds": {"min": [0, 0, 0], "max": [1, -1, 1]}}])"),
          {"objects[0].bounds.max: expected max > min"}},
-        {"{" + cam + R"(, "objects": [], "lights": [{"type": "spot"}]})", {"lights[0].type: expected one of \"point\", \"directional\""}},
-        {"{" + cam + R"(, "objects": [], "lights": [{"type": "point", "intensity": [1, 1, -1]}]})", {"lights[0].intensity[2]: expected a number >= 0"}},
-        {"{" + cam + R"(, "objects": [], "lights": [{"type": "point", "direction": [1, 1, 1]}]})", {"lights[0].direction: unknown key"}},
-        {"{" + cam + R"(, "objects": [], "lights": [{"type": "directional", "direction": [0, 0, 0]}]})", {"lights[0].direction: expected a non-zero"}},
+        {"{" + cam + R"(, "objects": [], "lights": [{"type": "spot"}]})",
+         {"lights[0].type: expected one of \"point\", \"directional\""}},
+        {"{" + cam + R"(, "objects": [], "lights": [{"type": "point", "intensity": [1, 1, -1]}]})",
+         {"lights[0].intensity[2]: expected a number >= 0"}},
+        {"{" + cam + R"(, "objects": [], "lights": [{"type": "point", "direction": [1, 1, 1]}]})",
+         {"lights[0].direction: unknown key"}},
+        {"{" + cam + R"(, "objects": [], "lights": [{"type": "directional", "direction": [0, 0, 0]}]})",
+         {"lights[0].direction: expected a non-zero"}},
     };
     for (const Case& c : cases) {
         CAPTURE(c.json);
@@ -521,7 +587,8 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
 }
 
 TEST_CASE("scene parser: broken JSON reports line and column") {
-    check_contains(error_of("{\n  \"camera\": {},\n  \"objects\" []\n}"), {"line 3, column 13", "invalid JSON"});
+    check_contains(error_of("{\n  \"camera\": {},\n  \"objects\" []\n}"),
+                   {"line 3, column 13", "invalid JSON"});
     check_contains(error_of("{\n  \"objects\": [\n"), {"line 3", "invalid JSON", "unexpected end of input"});
     check_contains(error_of(""), {"line 1, column 1", "invalid JSON"});
     check_contains(error_of("{\"objects\": [] // comment\n}"), {"line 1, column 16", "invalid JSON"});
@@ -604,7 +671,8 @@ TEST_CASE("scene parser: workshop.json is the built-in default scene") {
     for (size_t i = 0; i < d.spheres.size(); ++i) {
         CHECK(f.spheres[i].center == d.spheres[i].center);
         CHECK(f.spheres[i].radius == d.spheres[i].radius);
-        CHECK(f.materials[f.spheres[i].material].albedo.color == d.materials[d.spheres[i].material].albedo.color);
+        CHECK(f.materials[f.spheres[i].material].albedo.color ==
+              d.materials[d.spheres[i].material].albedo.color);
     }
     CHECK(f.camera.position == d.camera.position);
     CHECK(f.camera.look_at == d.camera.look_at);

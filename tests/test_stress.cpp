@@ -159,8 +159,8 @@ TEST_CASE("stress: furnace with tiny, huge and far-away spheres") {
         float radius;
         Vec3 center;
     };
-    const Case cases[] = {{1.0f, {0, 0, 0}}, {1e-6f, {0, 0, 0}}, {1e-6f, {1e-3f, 0, 0}}, {1e8f, {0, 0, 0}},
-                          {1e5f, {1e7f, 1e7f, 1e7f}}, {10.0f, {1e5f, 0, 0}}};
+    const Case cases[] = {{1.0f, {0, 0, 0}}, {1e-6f, {0, 0, 0}},         {1e-6f, {1e-3f, 0, 0}},
+                          {1e8f, {0, 0, 0}}, {1e5f, {1e7f, 1e7f, 1e7f}}, {10.0f, {1e5f, 0, 0}}};
     for (const Case& c : cases) {
         INFO("radius " << c.radius << " at " << c.center.x);
         SceneDesc d = furnace(0.5f);
@@ -215,7 +215,8 @@ TEST_CASE("stress: the default scene renders the same scaled by 1e-4 and 1e4 and
         float scale;
         Vec3 offset;
     };
-    const Case cases[] = {{1e-4f, {0, 0, 0}}, {1e4f, {0, 0, 0}}, {1.0f, {1e5f, 0, 0}}, {1.0f, {0, -1e5f, 1e5f}}};
+    const Case cases[] = {
+        {1e-4f, {0, 0, 0}}, {1e4f, {0, 0, 0}}, {1.0f, {1e5f, 0, 0}}, {1.0f, {0, -1e5f, 1e5f}}};
     for (const Case& c : cases) {
         INFO("scale " << c.scale << " offset " << c.offset.x << "," << c.offset.y << "," << c.offset.z);
         const Rendered img = render(transformed_default(c.scale, c.offset));
@@ -227,7 +228,8 @@ TEST_CASE("stress: the default scene renders the same scaled by 1e-4 and 1e4 and
         for (size_t i = 0; i < ref.std_error.size(); ++i) {
             const float a = luminance({ref.rgb[3 * i], ref.rgb[3 * i + 1], ref.rgb[3 * i + 2]});
             const float b = luminance({img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]});
-            const double sigma = std::sqrt(ref.std_error[i] * ref.std_error[i] + img.std_error[i] * img.std_error[i]);
+            const double sigma =
+                std::sqrt(ref.std_error[i] * ref.std_error[i] + img.std_error[i] * img.std_error[i]);
             outliers += std::abs(double(a - b)) > 4.0 * sigma + 1e-3;
             diff_sum += double(b - a);
             ref_sum += double(a);
@@ -279,7 +281,8 @@ TEST_CASE("stress: extreme depth, albedo and image sizes") {
     SceneDesc d = furnace(1.0f);
     d.spheres.push_back({{0, 0, 0}, 1, 0, {0, 0, 0}});
     look(d, {0, -3, 0}, {0, 0, 0}, 50);
-    const size_t centre = (size_t(d.render.height / 2) * size_t(d.render.width) + size_t(d.render.width / 2)) * 3;
+    const size_t centre =
+        (size_t(d.render.height / 2) * size_t(d.render.width) + size_t(d.render.width / 2)) * 3;
     SUBCASE("albedo 1 reflects everything, albedo 0 nothing") {
         d.render.max_depth = 1000;
         check_furnace(render(d), d, 1.0f);

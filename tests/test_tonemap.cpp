@@ -14,7 +14,9 @@ namespace {
 constexpr Tonemap kCurves[] = {Tonemap::clamp, Tonemap::reinhard, Tonemap::aces, Tonemap::filmic};
 
 /// IEC 61966-2-1 encoding, written out in double as the standard states it.
-double srgb_reference(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
+double srgb_reference(double v) {
+    return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
 
 }  // namespace
 
@@ -38,8 +40,8 @@ TEST_CASE("tonemap: every curve maps 0 to 0, is monotone and stays in [0,1]") {
         }
         CHECK(decreases == 0);
         CHECK(out_of_range == 0);
-        CHECK(tonemap_value(1e-6f, curve) > 0.0f);        // not flattened to black
-        CHECK(tonemap_value(1e4f, curve) > 0.95f);        // bright goes (nearly) white
+        CHECK(tonemap_value(1e-6f, curve) > 0.0f);  // not flattened to black
+        CHECK(tonemap_value(1e4f, curve) > 0.95f);  // bright goes (nearly) white
         CHECK(tonemap_value(0.18f, curve) < tonemap_value(1.0f, curve));
     }
     CHECK(tonemap_value(0.5f, Tonemap::clamp) == 0.5f);
@@ -52,7 +54,8 @@ TEST_CASE("tonemap: every curve maps 0 to 0, is monotone and stays in [0,1]") {
         return (x * (0.15 * x + 0.05) + 0.004) / (x * (0.15 * x + 0.5) + 0.06) - 0.02 / 0.3;
     };
     for (double v : {0.05, 0.18, 1.0, 3.0})
-        CHECK(double(tonemap_value(float(v), Tonemap::filmic)) == doctest::Approx(hable(2 * v) / hable(11.2)).epsilon(1e-5));
+        CHECK(double(tonemap_value(float(v), Tonemap::filmic)) ==
+              doctest::Approx(hable(2 * v) / hable(11.2)).epsilon(1e-5));
     // ACES equals Narkowicz's fit.
     CHECK(double(tonemap_value(1.0f, Tonemap::aces)) == doctest::Approx(2.54 / 3.16).epsilon(1e-6));
 }

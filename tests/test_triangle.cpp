@@ -70,8 +70,9 @@ TEST_CASE("watertight: rays from inside a closed icosphere at vertices and edge 
     std::vector<Vec3> targets = m.positions;
     for (size_t i = 0; i < m.indices.size(); i += 3)
         for (int k = 0; k < 3; ++k)
-            targets.push_back((m.positions[m.indices[i + size_t(k)]] + m.positions[m.indices[i + size_t((k + 1) % 3)]]) *
-                              0.5f);
+            targets.push_back(
+                (m.positions[m.indices[i + size_t(k)]] + m.positions[m.indices[i + size_t((k + 1) % 3)]]) *
+                0.5f);
     const int rays = 1000000 / kSanitizerDivisor;
     std::mt19937 rng(17);
     std::uniform_real_distribution<float> u(-0.6f, 0.6f);

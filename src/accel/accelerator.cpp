@@ -43,7 +43,8 @@ PrimitiveList collect_primitives(const Scene& scene) {
     for (uint32_t i = 0; i < scene.spheres.size(); ++i)
         list.add(scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
                  make_prim_id(PrimKind::sphere, i));
-    for (uint32_t i = 0; i < scene.boxes.size(); ++i) list.add(scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+    for (uint32_t i = 0; i < scene.boxes.size(); ++i)
+        list.add(scene.boxes[i].box, make_prim_id(PrimKind::box, i));
     for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
         list.add(scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
@@ -78,10 +79,14 @@ const char* bvh_layout_name(BvhLayout layout) {
 }
 
 bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
-    if (text == "wide4") out = BvhLayout::wide4;
-    else if (text == "wide4-slots") out = BvhLayout::wide4_slots;
-    else if (text == "pairs") out = BvhLayout::pairs;
-    else return false;
+    if (text == "wide4")
+        out = BvhLayout::wide4;
+    else if (text == "wide4-slots")
+        out = BvhLayout::wide4_slots;
+    else if (text == "pairs")
+        out = BvhLayout::pairs;
+    else
+        return false;
     return true;
 }
 
@@ -94,7 +99,8 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
     BvhBuildParams params = options.params;
     if (options.layout == BvhLayout::wide4) params.intersection_cost *= options.wide4_leaf_cost_scale;
-    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params) : single_leaf_bvh(prims);
+    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
+                      : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
     slots_.resize(slots);
@@ -105,7 +111,8 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
         slots_[s].tri = TriangleVerts{};
         if (prim_kind(id) == PrimKind::triangle) {
             const uint32_t* v = &soup.indices[3 * size_t(prim_index(id))];
-            slots_[s].tri = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
+            slots_[s].tri =
+                TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
         }
     }
     layout_ = options.layout;
@@ -131,10 +138,13 @@ void Accelerator::make_leaf_blocks() {
                 const uint32_t slot = s + uint32_t(l);
                 const bool in_leaf = slot < first + count;
                 const bool tri = in_leaf && prim_kind(slots_[slot].id) == PrimKind::triangle;
-                b.slot[l] = !in_leaf ? TriangleBlock4::kEmptyLane : tri ? slot : slot | TriangleBlock4::kOtherKind;
+                b.slot[l] = !in_leaf ? TriangleBlock4::kEmptyLane
+                            : tri    ? slot
+                                     : slot | TriangleBlock4::kOtherKind;
                 for (int v = 0; v < 3; ++v)
                     for (int a = 0; a < 3; ++a)
-                        b.p[v][a][l] = tri ? slots_[slot].tri.p[v][a] : std::numeric_limits<float>::quiet_NaN();
+                        b.p[v][a][l] =
+                            tri ? slots_[slot].tri.p[v][a] : std::numeric_limits<float>::quiet_NaN();
             }
             blocks_.push_back(b);
         }
@@ -156,10 +166,12 @@ size_t Accelerator::bytes() const {
            bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
 }
 
-/// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in `hit`.
+/// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in
+/// `hit`.
 template <bool kAnyHit>
-__attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
-                             Hit& hit) const {
+__attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr,
+                                                                   uint32_t first, uint32_t count,
+                                                                   float& tmax, Hit& hit) const {
     bool found = false;
     for (uint32_t s = first; s < first + count; ++s) {
         const uint32_t id = slots_[s].id;
@@ -206,15 +218,18 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 /// The BVH4 traversal; trace_wide_avx2 is the same code compiled for AVX2
 /// (both inline this body, so each gets its own instruction selection).
 template <bool kAnyHit, bool kBlocks, class Counters>
-__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const {
+__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit,
+                                                                        Counters& counters) const {
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
     const bool found = traverse_bvh4<kAnyHit>(
         wide_, br,
         [&](uint32_t first, uint32_t count, float& tmax) {
-            if constexpr (kBlocks) return test_blocks<kAnyHit>(ray, tr, first, count, tmax, best);
-            else return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
+            if constexpr (kBlocks)
+                return test_blocks<kAnyHit>(ray, tr, first, count, tmax, best);
+            else
+                return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
         },
         counters);
     if (found && !kAnyHit) {
@@ -230,7 +245,8 @@ bool Accelerator::trace_wide(Ray& ray, Hit& hit, Counters& counters) const {
 }
 
 template <bool kAnyHit, bool kBlocks, class Counters>
-__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const {
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
+                                                                  Counters& counters) const {
     return trace_wide_body<kAnyHit, kBlocks>(ray, hit, counters);
 }
 
@@ -238,8 +254,8 @@ __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit&
 /// time, other kinds through test_slots; the closest hit lowers `tmax`.
 template <bool kAnyHit>
 __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
-                                                                    uint32_t first, uint32_t count, float& tmax,
-                                                                    Hit& hit) const {
+                                                                    uint32_t first, uint32_t count,
+                                                                    float& tmax, Hit& hit) const {
     bool found = false;
     for (uint32_t b = first; b < first + (count + 3) / 4; ++b) {
         const TriangleBlock4& block = blocks_[b];
@@ -257,7 +273,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             found = true;
         }
         // Sign bits of the slots: lanes of other kinds (and padding, skipped).
-        const int other = _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+        const int other =
+            _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
         for (int m = other; m; m &= m - 1) {
             const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
             if (slot == TriangleBlock4::kEmptyLane) continue;
@@ -274,7 +291,8 @@ template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
     const bool avx2 = active_simd_path() == SimdPath::avx2;
     if (layout_ == BvhLayout::wide4)
-        return avx2 ? trace_wide_avx2<kAnyHit, true>(ray, hit, counters) : trace_wide<kAnyHit, true>(ray, hit, counters);
+        return avx2 ? trace_wide_avx2<kAnyHit, true>(ray, hit, counters)
+                    : trace_wide<kAnyHit, true>(ray, hit, counters);
     if (layout_ == BvhLayout::wide4_slots)
         return avx2 ? trace_wide_avx2<kAnyHit, false>(ray, hit, counters)
                     : trace_wide<kAnyHit, false>(ray, hit, counters);

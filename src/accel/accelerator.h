@@ -34,7 +34,7 @@ inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
 /// Traversal structure built from the binary SAH tree.
 enum class BvhLayout : uint8_t {
-    wide4,        ///< 4-wide BVH (accel/bvh4.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h); the default
+    wide4,  ///< 4-wide BVH (accel/bvh4.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h); the default
     wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
     pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
 };
@@ -61,7 +61,7 @@ struct AcceleratorOptions {
 };
 
 class Accelerator {
-public:
+   public:
     explicit Accelerator(const Scene& scene, const AcceleratorOptions& options = {});
 
     /// Nearest hit with t in (ray.tmin, ray.tmax); on a hit, ray.tmax becomes hit.t.
@@ -93,7 +93,7 @@ public:
     /// Bytes of the traversal tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
-private:
+   private:
     template <bool kAnyHit, class Counters>
     bool trace(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kBlocks, class Counters>
@@ -110,9 +110,9 @@ private:
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
 
-    Bvh bvh_;          ///< canonical tree (statistics, validation)
-    BvhPairs pairs_;   ///< the same tree in pair layout (layout_ == pairs)
-    Bvh4 wide_;        ///< the same tree collapsed to 4-wide nodes (wide layouts)
+    Bvh bvh_;                             ///< canonical tree (statistics, validation)
+    BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
+    Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide layouts)
     std::vector<TriangleBlock4> blocks_;  ///< wide4 layout: each leaf's slots in blocks of four
     BvhLayout layout_ = BvhLayout::wide4;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
@@ -121,10 +121,10 @@ private:
         TriangleVerts tri;  ///< 36 bytes; zero for other kinds
         uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
     };
-    std::vector<Slot> slots_;                ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
-    std::vector<Sphere> spheres_;            ///< copy of Scene::spheres (indexed by sphere index)
-    std::vector<Bounds3> boxes_;             ///< copy of Scene::boxes (indexed by box index)
-    std::vector<Quadric> quadrics_;          ///< copy of Scene::quadrics (indexed by quadric index)
+    std::vector<Slot> slots_;        ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
+    std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
+    std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
     Bounds3 bounds_;
     bool uses_tree_ = false;
     double build_ms_ = 0;

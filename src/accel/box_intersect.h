@@ -20,9 +20,12 @@ inline bool intersect_box(const Ray& ray, const Bounds3& box, float tmin, float 
         t1 = min_ignore_nan(t1, tf);
     }
     if (!(t0 <= t1)) return false;
-    if (t0 > tmin && t0 < tmax) t_hit = t0;
-    else if (t1 > tmin && t1 < tmax) t_hit = t1;
-    else return false;
+    if (t0 > tmin && t0 < tmax)
+        t_hit = t0;
+    else if (t1 > tmin && t1 < tmax)
+        t_hit = t1;
+    else
+        return false;
     return true;
 }
 

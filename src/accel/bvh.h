@@ -30,9 +30,12 @@ struct BvhNode {
     bool is_leaf() const { return count != 0; }
     Bounds3 box() const { return {{bounds[0], bounds[2], bounds[4]}, {bounds[1], bounds[3], bounds[5]}}; }
     void set_box(const Bounds3& b) {
-        bounds[0] = b.lo.x; bounds[1] = b.hi.x;
-        bounds[2] = b.lo.y; bounds[3] = b.hi.y;
-        bounds[4] = b.lo.z; bounds[5] = b.hi.z;
+        bounds[0] = b.lo.x;
+        bounds[1] = b.hi.x;
+        bounds[2] = b.lo.y;
+        bounds[3] = b.hi.y;
+        bounds[4] = b.lo.z;
+        bounds[5] = b.hi.z;
     }
 };
 static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");

@@ -10,7 +10,8 @@ namespace sahara {
 namespace {
 
 float half_area(const BvhNode& n) {
-    const float dx = n.bounds[1] - n.bounds[0], dy = n.bounds[3] - n.bounds[2], dz = n.bounds[5] - n.bounds[4];
+    const float dx = n.bounds[1] - n.bounds[0], dy = n.bounds[3] - n.bounds[2],
+                dz = n.bounds[5] - n.bounds[4];
     return dx < 0.0f ? 0.0f : dx * dy + dy * dz + dz * dx;
 }
 
@@ -37,9 +38,12 @@ int gather_children(const Bvh& bvh, uint32_t inner, uint32_t out[4]) {
 }
 
 void set_child(Bvh4Node& p, int c, const BvhNode& child) {
-    p.lo_x[c] = child.bounds[0]; p.hi_x[c] = child.bounds[1];
-    p.lo_y[c] = child.bounds[2]; p.hi_y[c] = child.bounds[3];
-    p.lo_z[c] = child.bounds[4]; p.hi_z[c] = child.bounds[5];
+    p.lo_x[c] = child.bounds[0];
+    p.hi_x[c] = child.bounds[1];
+    p.lo_y[c] = child.bounds[2];
+    p.hi_y[c] = child.bounds[3];
+    p.lo_z[c] = child.bounds[4];
+    p.hi_z[c] = child.bounds[5];
     p.count[c] = child.count;
     p.child[c] = child.count ? child.index : kNoNode;  // inner: patched when its node is placed
 }

@@ -86,8 +86,8 @@ struct Bvh4Ray {
 /// Tests the four children of `n`; bit c of the result is set when child c is
 /// hit, and lane c of t_near is then its entry distance. Same answers as
 /// intersect_bvh_node per child.
-__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin, float tmax,
-                                                         __m128& t_near) {
+__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin,
+                                                         float tmax, __m128& t_near) {
     // _mm_max_ps(x, acc) and _mm_min_ps(x, acc) return acc when x is NaN (the NaN-ignoring order).
     __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
     const char* base = reinterpret_cast<const char*>(&n);

@@ -30,9 +30,10 @@ static_assert(sizeof(TriangleBlock4) == 160, "40 bytes per triangle, like a leaf
 
 /// Tests the four lanes of `b`; returns the mask of lanes hit in (tmin, tmax)
 /// and their distances and barycentrics.
-__attribute__((always_inline)) inline int intersect_triangle_block4(const TriangleRay& tr, const TriangleBlock4& b,
-                                                                   float tmin, float tmax, float t_out[4],
-                                                                   float u_out[4], float v_out[4]) {
+__attribute__((always_inline)) inline int intersect_triangle_block4(const TriangleRay& tr,
+                                                                    const TriangleBlock4& b, float tmin,
+                                                                    float tmax, float t_out[4],
+                                                                    float u_out[4], float v_out[4]) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m128 ox = _mm_set1_ps(tr.org[kx]), oy = _mm_set1_ps(tr.org[ky]), oz = _mm_set1_ps(tr.org[kz]);
     const __m128 sx = _mm_set1_ps(tr.sx), sy = _mm_set1_ps(tr.sy), sz = _mm_set1_ps(tr.sz);
@@ -48,10 +49,12 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
     const __m128 v = _mm_sub_ps(_mm_mul_ps(x[0], y[2]), _mm_mul_ps(y[0], x[2]));
     const __m128 w = _mm_sub_ps(_mm_mul_ps(x[1], y[0]), _mm_mul_ps(y[1], x[0]));
     const __m128 zero = _mm_setzero_ps();
-    const int exact_zero =
-        _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
-    const __m128 any_neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-    const __m128 any_pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+    const int exact_zero = _mm_movemask_ps(
+        _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
+    const __m128 any_neg =
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+    const __m128 any_pos =
+        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
     const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
     const __m128 t_scaled =
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, z[0]), _mm_mul_ps(v, z[1])), _mm_mul_ps(w, z[2]));

@@ -18,8 +18,8 @@ namespace {
 
 /// The chosen partition of a node's range.
 struct Split {
-    int axis = -1;       ///< -1: no valid split found
-    uint32_t pos = 0;    ///< binned: first bin of the right side; sweep: primitives on the left
+    int axis = -1;           ///< -1: no valid split found
+    uint32_t pos = 0;        ///< binned: first bin of the right side; sweep: primitives on the left
     float cost = kInfinity;  ///< unnormalised: traversal * A + intersection * sum(A_child * n_child)
 };
 
@@ -30,7 +30,7 @@ struct Bin {
 };
 
 class BvhBuildJob {
-public:
+   public:
     BvhBuildJob(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params, Bvh& out)
         : in_(input), builder_(builder), params_(params), out_(out) {}
 
@@ -48,7 +48,7 @@ public:
         if (out_.nodes.size() > 1) out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
     }
 
-private:
+   private:
     /// Step 1 of every node: bounds of the boxes and of the centroids in the range.
     void range_bounds(uint32_t begin, uint32_t end, Bounds3& box, Bounds3& centroids) const {
         for (uint32_t i = begin; i < end; ++i) {
@@ -91,7 +91,7 @@ private:
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return may_be_leaf ? begin : median_split(begin, end, centroids);
         const Split split = builder_ == BvhBuilder::binned ? find_binned_split(begin, end, centroids)
-                                                          : find_sweep_split(begin, end, centroids);
+                                                           : find_sweep_split(begin, end, centroids);
         if (split.axis < 0) return may_be_leaf ? begin : median_split(begin, end, centroids);
         const float area = box.surface_area();
         const float leaf_cost = params_.intersection_cost * float(n) * area;
@@ -161,10 +161,11 @@ private:
     // ---- exact sweep SAH -------------------------------------------------
 
     void sort_range(uint32_t begin, uint32_t end, int axis) {
-        std::sort(out_.prim_indices.begin() + begin, out_.prim_indices.begin() + end, [&](uint32_t a, uint32_t b) {
-            const float ca = in_.centers[a][axis], cb = in_.centers[b][axis];
-            return ca < cb || (ca == cb && a < b);
-        });
+        std::sort(out_.prim_indices.begin() + begin, out_.prim_indices.begin() + end,
+                  [&](uint32_t a, uint32_t b) {
+                      const float ca = in_.centers[a][axis], cb = in_.centers[b][axis];
+                      return ca < cb || (ca == cb && a < b);
+                  });
     }
 
     Split find_sweep_split(uint32_t begin, uint32_t end, const Bounds3& centroids) {
@@ -233,12 +234,17 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
 }
 
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
-    if (text == "binned") out = BvhBuilder::binned;
-    else if (text == "sweep") out = BvhBuilder::sweep;
-    else return false;
+    if (text == "binned")
+        out = BvhBuilder::binned;
+    else if (text == "sweep")
+        out = BvhBuilder::sweep;
+    else
+        return false;
     return true;
 }
 
-const char* bvh_builder_name(BvhBuilder builder) { return builder == BvhBuilder::binned ? "binned" : "sweep"; }
+const char* bvh_builder_name(BvhBuilder builder) {
+    return builder == BvhBuilder::binned ? "binned" : "sweep";
+}
 
 }  // namespace sahara

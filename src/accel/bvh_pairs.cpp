@@ -5,9 +5,12 @@ namespace sahara {
 namespace {
 
 void set_child(BvhPairNode& p, int c, const BvhNode& child) {
-    p.x[c] = child.bounds[0]; p.x[c + 2] = child.bounds[1];
-    p.y[c] = child.bounds[2]; p.y[c + 2] = child.bounds[3];
-    p.z[c] = child.bounds[4]; p.z[c + 2] = child.bounds[5];
+    p.x[c] = child.bounds[0];
+    p.x[c + 2] = child.bounds[1];
+    p.y[c] = child.bounds[2];
+    p.y[c + 2] = child.bounds[3];
+    p.z[c] = child.bounds[4];
+    p.z[c + 2] = child.bounds[5];
     p.count[c] = child.count;
     p.index[c] = child.count ? child.index : kNoNode;  // inner: patched when the child's pair is placed
 }
@@ -39,7 +42,8 @@ BvhPairs make_bvh_pairs(const Bvh& bvh) {
         out.nodes.push_back(p);
         // Push the right child first so the left subtree follows its parent in memory.
         for (int c = 1; c >= 0; --c)
-            if (!bvh.nodes[n.index + uint32_t(c)].is_leaf()) stack.push_back({n.index + uint32_t(c), pair, c});
+            if (!bvh.nodes[n.index + uint32_t(c)].is_leaf())
+                stack.push_back({n.index + uint32_t(c), pair, c});
     }
     return out;
 }

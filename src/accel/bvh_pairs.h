@@ -59,7 +59,8 @@ inline int intersect_bvh_pair(const BvhPairNode& n, const BvhRay& r, float t_nea
     acc = _mm_max_ps(_mm_xor_ps(axis(n.x, r.org[0], r.inv_dir[0], r.neg[0]), negate_far), acc);
     acc = _mm_max_ps(_mm_xor_ps(axis(n.y, r.org[1], r.inv_dir[1], r.neg[1]), negate_far), acc);
     acc = _mm_max_ps(_mm_xor_ps(axis(n.z, r.org[2], r.inv_dir[2], r.neg[2]), negate_far), acc);
-    const __m128 far = _mm_mul_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-kRobustFarScale));
+    const __m128 far =
+        _mm_mul_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-kRobustFarScale));
     alignas(16) float out[4];
     _mm_store_ps(out, acc);
     t_near[0] = out[0];

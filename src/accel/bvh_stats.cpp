@@ -68,7 +68,8 @@ std::string validate_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes) {
                 ++slot_seen[s];
                 ++prim_seen[p];
                 if (!prim_boxes[p].empty() && !box.contains(prim_boxes[p]))
-                    return "leaf " + std::to_string(it.node) + " does not contain primitive " + std::to_string(p);
+                    return "leaf " + std::to_string(it.node) + " does not contain primitive " +
+                           std::to_string(p);
             }
             continue;
         }
@@ -82,7 +83,8 @@ std::string validate_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes) {
         }
     }
     for (size_t i = 0; i < n; ++i) {
-        if (slot_seen[i] != 1) return "slot " + std::to_string(i) + " in " + std::to_string(slot_seen[i]) + " leaves";
+        if (slot_seen[i] != 1)
+            return "slot " + std::to_string(i) + " in " + std::to_string(slot_seen[i]) + " leaves";
         if (prim_seen[i] != 1)
             return "primitive " + std::to_string(i) + " in " + std::to_string(prim_seen[i]) + " leaves";
     }

@@ -13,8 +13,8 @@ struct BvhStats {
     size_t primitives = 0;
     size_t nodes = 0;  ///< reachable nodes (the padding node not counted)
     size_t leaves = 0;
-    int max_depth = 0;            ///< root = depth 0
-    double mean_leaf_depth = 0;   ///< averaged over leaves
+    int max_depth = 0;           ///< root = depth 0
+    double mean_leaf_depth = 0;  ///< averaged over leaves
     /// leaf_size_histogram[k] = number of leaves holding k primitives.
     std::vector<size_t> leaf_size_histogram;
     /// SAH cost normalised by the root's surface area:
@@ -29,7 +29,8 @@ BvhStats compute_bvh_stats(const Bvh& bvh, const BvhBuildParams& params = {});
 /// Checks the invariants of a built tree against the boxes it was built from:
 /// every primitive in exactly one leaf, every node reached once, every child's
 /// bounds inside its parent's, every leaf's bounds around its primitives, depth
-/// below kBvhMaxDepth, sibling pairs at even indices. Returns an empty string when valid, else the first violation.
+/// below kBvhMaxDepth, sibling pairs at even indices. Returns an empty string when valid, else the first
+/// violation.
 std::string validate_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes);
 
 }  // namespace sahara

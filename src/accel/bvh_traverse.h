@@ -31,7 +31,9 @@ struct BvhRay {
 
     explicit BvhRay(const Ray& r) : tmin(r.tmin), tmax(r.tmax) {
         const float d[3] = {r.dir.x, r.dir.y, r.dir.z};
-        org[0] = r.origin.x; org[1] = r.origin.y; org[2] = r.origin.z;
+        org[0] = r.origin.x;
+        org[1] = r.origin.y;
+        org[2] = r.origin.z;
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.0f / d[a];  // +-inf for +-0: handled in intersect_bvh_node
             neg[a] = std::signbit(d[a]) ? 1 : 0;

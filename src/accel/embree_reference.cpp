@@ -32,7 +32,8 @@ struct EmbreeReference::Impl {
 
 bool EmbreeReference::available() { return true; }
 
-EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust)
+EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices,
+                                 bool robust)
     : impl_(std::make_unique<Impl>()) {
     const auto start = std::chrono::steady_clock::now();
     impl_->device = rtcNewDevice(nullptr);
@@ -47,14 +48,15 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
         v[3 * i + 1] = positions[i].y;
         v[3 * i + 2] = positions[i].z;
     }
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), indices.size() / 3));
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), indices.size() / 3));
     if (!indices.empty()) std::memcpy(idx, indices.data(), indices.size() * sizeof(uint32_t));
     rtcCommitGeometry(geom);
     rtcAttachGeometry(impl_->scene, geom);
     rtcReleaseGeometry(geom);
     rtcCommitScene(impl_->scene);
-    if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE) throw std::runtime_error("embree: scene build failed");
+    if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE)
+        throw std::runtime_error("embree: scene build failed");
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -62,8 +64,12 @@ EmbreeReference::~EmbreeReference() = default;
 
 namespace {
 void fill_ray(RTCRay& r, const Ray& ray) {
-    r.org_x = ray.origin.x; r.org_y = ray.origin.y; r.org_z = ray.origin.z;
-    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
     r.tnear = ray.tmin;
     r.tfar = ray.tmax;
     r.time = ray.time;

@@ -13,7 +13,7 @@
 namespace sahara {
 
 class EmbreeReference {
-public:
+   public:
     /// Whether this build has Embree.
     static bool available();
     /// Builds an Embree scene over the indexed triangles. `robust` sets
@@ -30,7 +30,7 @@ public:
     bool occluded(const Ray& ray) const;
     double build_ms() const { return build_ms_; }
 
-private:
+   private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     double build_ms_ = 0;

@@ -20,7 +20,8 @@ uint64_t splitmix64(uint64_t x) {
 /// Counter-based uniform floats in [0, 1): stream (seed, set, index) -> values.
 struct IndexRng {
     uint64_t state;
-    IndexRng(uint64_t seed, uint64_t set, uint64_t index) : state(splitmix64(seed ^ splitmix64(set * 0x1000003ull + index))) {}
+    IndexRng(uint64_t seed, uint64_t set, uint64_t index)
+        : state(splitmix64(seed ^ splitmix64(set * 0x1000003ull + index))) {}
     float next() {
         state = splitmix64(state);
         return float(state >> 40) * 0x1p-24f;
@@ -71,7 +72,8 @@ BenchRaySets make_bench_rays(const TriangleMesh& mesh, const Accelerator& accel,
     sets.primary.resize(count);
     for (size_t i = 0; i < count; ++i) {
         const auto x = float(i % size_t(width)), y = float(i / size_t(width));
-        const float sx = (2.0f * (x + 0.5f) / float(width) - 1.0f) * f.tan_half_fov * float(width) / float(height);
+        const float sx =
+            (2.0f * (x + 0.5f) / float(width) - 1.0f) * f.tan_half_fov * float(width) / float(height);
         const float sy = (1.0f - 2.0f * (y + 0.5f) / float(height)) * f.tan_half_fov;
         sets.primary[i] = Ray{f.eye, normalize(f.forward + f.right * sx + f.up * sy)};
     }
@@ -94,7 +96,8 @@ BenchRaySets make_bench_rays(const TriangleMesh& mesh, const Accelerator& accel,
         if (valid[i]) points.push_back(per_pixel[i]);
     if (points.empty()) return sets;
     // A square light of side `radius`, 1.5 radii above the top of the bounds.
-    const Vec3 light_corner(b.center().x - 0.5f * radius, b.hi.y + 1.5f * radius, b.center().z - 0.5f * radius);
+    const Vec3 light_corner(b.center().x - 0.5f * radius, b.hi.y + 1.5f * radius,
+                            b.center().z - 0.5f * radius);
     sets.diffuse.resize(count);
     sets.shadow.resize(count);
     for (size_t i = 0; i < count; ++i) {

@@ -62,8 +62,9 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& accel, const EmbreeReference* embree, const std::vector<Ray>& rays,
-                         bool occlusion, const BenchOptions& opt) {
+nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& accel,
+                                 const EmbreeReference* embree, const std::vector<Ray>& rays, bool occlusion,
+                                 const BenchOptions& opt) {
     std::vector<double> ours, theirs, ours_cpu, theirs_cpu;
     RayAnswers a, b;
     for (int k = 0; k < opt.repeat; ++k) {
@@ -102,20 +103,25 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     aopt.layout = opt.layout;
     const Accelerator accel(scene, aopt);
     std::unique_ptr<EmbreeReference> embree;
-    if (opt.embree && EmbreeReference::available()) embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices);
+    if (opt.embree && EmbreeReference::available())
+        embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices);
     const BenchRaySets rays = make_bench_rays(mesh, accel, opt.size, opt.size);
-    nlohmann::ordered_json j = {{"mesh", opt.mesh},
-                        {"primitives", accel.primitive_count()},
-                        {"threads", opt.threads},
-                        {"builder", bvh_builder_name(opt.builder)},
-                        {"layout", bvh_layout_name(opt.layout)},
-                        {"simd", simd_path_name(active_simd_path())},
-                        {"tree_bytes_per_primitive", double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
-                        {"build_ms", accel.build_ms()},
-                        {"build_cpu_ms", accel.build_cpu_ms()}};
+    nlohmann::ordered_json j = {
+        {"mesh", opt.mesh},
+        {"primitives", accel.primitive_count()},
+        {"threads", opt.threads},
+        {"builder", bvh_builder_name(opt.builder)},
+        {"layout", bvh_layout_name(opt.layout)},
+        {"simd", simd_path_name(active_simd_path())},
+        {"tree_bytes_per_primitive",
+         double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
+        {"build_ms", accel.build_ms()},
+        {"build_cpu_ms", accel.build_cpu_ms()}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
     for (const std::string& set : opt.sets) {
-        const std::vector<Ray>& r = set == "primary" ? rays.primary : set == "diffuse" ? rays.diffuse : rays.shadow;
+        const std::vector<Ray>& r = set == "primary"   ? rays.primary
+                                    : set == "diffuse" ? rays.diffuse
+                                                       : rays.shadow;
         j["rays"][set] = bench_set(mesh, accel, embree.get(), r, set == "shadow", opt);
     }
     return j;
@@ -128,23 +134,25 @@ void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
                 j["build_cpu_ms"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms")) std::printf(", Embree %.1f ms", j["embree_build_ms"].get<double>());
-    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n", j["tree_bytes_per_primitive"].get<double>());
+    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n",
+                j["tree_bytes_per_primitive"].get<double>());
     const bool embree = j.contains("embree_build_ms");
     if (!embree)
-        std::printf("Embree      %s\n", embree_wanted ? "not available (sahara was built without Embree 3)" : "skipped");
+        std::printf("Embree      %s\n",
+                    embree_wanted ? "not available (sahara was built without Embree 3)" : "skipped");
     std::printf("%-8s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
     if (embree)
         std::printf(" %8s %8s %6s %6s %6s %5s %9s", "Embree", "(CPU)", "ratio", "(CPU)", "disagr", "ties",
                     "confirmed");
     std::printf("\n");
     for (const auto& [name, r] : j["rays"].items()) {
-        std::printf("%-8s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(), r["hit_rate"].get<double>(),
-                    r["mrays_s"].get<double>(), r["mrays_cpu_s"].get<double>());
+        std::printf("%-8s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
+                    r["hit_rate"].get<double>(), r["mrays_s"].get<double>(), r["mrays_cpu_s"].get<double>());
         if (embree)
             std::printf(" %8.2f %8.2f %6.2f %6.2f %6zu %5zu %9zu", r["embree_mrays_s"].get<double>(),
-                        r["embree_mrays_cpu_s"].get<double>(), r["ratio"].get<double>(), r["ratio_cpu"].get<double>(),
-                        r["disagreements"].get<size_t>(), r["ties"].get<size_t>(),
-                        r["confirmed_for_sahara"].get<size_t>());
+                        r["embree_mrays_cpu_s"].get<double>(), r["ratio"].get<double>(),
+                        r["ratio_cpu"].get<double>(), r["disagreements"].get<size_t>(),
+                        r["ties"].get<size_t>(), r["confirmed_for_sahara"].get<size_t>());
         std::printf("\n");
     }
 }
@@ -167,12 +175,15 @@ int run_small_scenes() {
                 if (kind == 0) {
                     scene.spheres.push_back(Sphere{c, 0.05f + 0.1f * rnd()});
                 } else {
-                    for (int k = 0; k < 3; ++k) scene.triangles.positions.push_back(c + Vec3(rnd(), rnd(), rnd()) * 0.2f);
+                    for (int k = 0; k < 3; ++k)
+                        scene.triangles.positions.push_back(c + Vec3(rnd(), rnd(), rnd()) * 0.2f);
                     for (uint32_t k = 0; k < 3; ++k) scene.triangles.indices.push_back(3 * i + k);
                 }
             }
             std::vector<Ray> rays(200000);
-            for (Ray& r : rays) r = Ray{Vec3(rnd(), rnd(), rnd()) * 3.0f - Vec3(1.0f), Vec3(rnd(), rnd(), rnd()) - Vec3(0.5f)};
+            for (Ray& r : rays)
+                r = Ray{Vec3(rnd(), rnd(), rnd()) * 3.0f - Vec3(1.0f),
+                        Vec3(rnd(), rnd(), rnd()) - Vec3(0.5f)};
             AcceleratorOptions flat, tree;
             flat.flat_loop_max_prims = 1000;
             tree.flat_loop_max_prims = 0;
@@ -183,9 +194,11 @@ int run_small_scenes() {
                 ta.push_back(trace_sahara(a, rays, false, 1, true, answers).cpu_s);
                 tb.push_back(trace_sahara(b, rays, false, 1, true, answers).cpu_s);
             }
-            const double fa = median(ta) / double(rays.size()) * 1e9, fb = median(tb) / double(rays.size()) * 1e9;
+            const double fa = median(ta) / double(rays.size()) * 1e9,
+                         fb = median(tb) / double(rays.size()) * 1e9;
             // (CPU time of the single tracing thread: steady on shared cores.)
-            std::printf("%-6u %-9s %12.1f %12.1f %8.2f\n", n, kind ? "triangles" : "spheres", fa, fb, fa / fb);
+            std::printf("%-6u %-9s %12.1f %12.1f %8.2f\n", n, kind ? "triangles" : "spheres", fa, fb,
+                        fa / fb);
         }
     }
     return 0;
@@ -204,11 +217,15 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--repeat must be a positive integer";
     if (!parse_bvh_builder(args.value_or("--builder", "binned"), opt.builder))
         return "--builder must be binned or sweep";
-    if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout)) return "--layout must be wide4, wide4-slots or pairs";
+    if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout))
+        return "--layout must be wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");
-    if (sets == "all") opt.sets = {"primary", "diffuse", "shadow"};
-    else if (sets == "primary" || sets == "diffuse" || sets == "shadow") opt.sets = {sets};
-    else return "--rays must be primary, diffuse, shadow or all";
+    if (sets == "all")
+        opt.sets = {"primary", "diffuse", "shadow"};
+    else if (sets == "primary" || sets == "diffuse" || sets == "shadow")
+        opt.sets = {sets};
+    else
+        return "--rays must be primary, diffuse, shadow or all";
     opt.embree = !args.switches.count("--no-embree");
     opt.json = args.switches.count("--json") != 0;
     return "";
@@ -218,8 +235,9 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
 
 int run_bench_command(int argc, char** argv) {
     ToolArgs args;
-    std::string err = parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat"},
-                                      {"--json", "--no-embree", "--small-scenes"}, args);
+    std::string err =
+        parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat"},
+                        {"--json", "--no-embree", "--small-scenes"}, args);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     if (args.help) {
         std::fputs(kBenchUsage, stdout);
@@ -231,8 +249,10 @@ int run_bench_command(int argc, char** argv) {
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     try {
         const nlohmann::ordered_json j = run_bench(opt);
-        if (opt.json) std::printf("%s\n", j.dump().c_str());
-        else print_text(j, opt.embree);
+        if (opt.json)
+            std::printf("%s\n", j.dump().c_str());
+        else
+            print_text(j, opt.embree);
     } catch (const InputError& e) {
         std::fprintf(stderr, "sahara bench: %s\n", e.what());
         return 2;

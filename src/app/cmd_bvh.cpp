@@ -45,7 +45,9 @@ TraversalCounters count_work(const Accelerator& accel, const std::vector<Ray>& r
 
 nlohmann::ordered_json work_json(const TraversalCounters& c, size_t rays) {
     const double n = rays ? double(rays) : 1.0;
-    return {{"count", rays}, {"nodes_visited", double(c.nodes_visited) / n}, {"prims_tested", double(c.prims_tested) / n}};
+    return {{"count", rays},
+            {"nodes_visited", double(c.nodes_visited) / n},
+            {"prims_tested", double(c.prims_tested) / n}};
 }
 
 nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, int size) {
@@ -60,25 +62,26 @@ nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, i
     const BvhStats s = compute_bvh_stats(accel.bvh(), built);
     const BenchRaySets rays = make_bench_rays(mesh, accel, size, size);
     const size_t prims = accel.primitive_count();
-    nlohmann::ordered_json j = {{"mesh", file},
-                        {"builder", bvh_builder_name(builder)},
-                        {"primitives", prims},
-                        {"nodes", s.nodes},
-                        {"leaves", s.leaves},
-                        {"max_depth", s.max_depth},
-                        {"mean_leaf_depth", s.mean_leaf_depth},
-                        {"leaf_size_histogram", s.leaf_size_histogram},
-                        {"sah_cost", s.sah_cost},
-                        {"traversal_cost", opt.params.traversal_cost},
-                        {"intersection_cost", built.intersection_cost},
-                        {"layout", bvh_layout_name(accel.layout())},
-                        {"wide4_nodes", accel.bvh4().nodes.size()},
-                        {"build_ms", accel.build_ms()},
-                        {"build_cpu_ms", accel.build_cpu_ms()},
-                        {"mprims_s", accel.build_ms() > 0 ? double(prims) / (accel.build_ms() * 1e3) : 0.0},
-                        {"bytes", accel.bytes()},
-                        {"tree_bytes", s.bytes},
-                        {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
+    nlohmann::ordered_json j = {
+        {"mesh", file},
+        {"builder", bvh_builder_name(builder)},
+        {"primitives", prims},
+        {"nodes", s.nodes},
+        {"leaves", s.leaves},
+        {"max_depth", s.max_depth},
+        {"mean_leaf_depth", s.mean_leaf_depth},
+        {"leaf_size_histogram", s.leaf_size_histogram},
+        {"sah_cost", s.sah_cost},
+        {"traversal_cost", opt.params.traversal_cost},
+        {"intersection_cost", built.intersection_cost},
+        {"layout", bvh_layout_name(accel.layout())},
+        {"wide4_nodes", accel.bvh4().nodes.size()},
+        {"build_ms", accel.build_ms()},
+        {"build_cpu_ms", accel.build_cpu_ms()},
+        {"mprims_s", accel.build_ms() > 0 ? double(prims) / (accel.build_ms() * 1e3) : 0.0},
+        {"bytes", accel.bytes()},
+        {"tree_bytes", s.bytes},
+        {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
     j["rays"]["primary"] = work_json(count_work(accel, rays.primary), rays.primary.size());
     j["rays"]["diffuse"] = work_json(count_work(accel, rays.diffuse), rays.diffuse.size());
     return j;
@@ -89,21 +92,25 @@ void print_text(const nlohmann::ordered_json& j) {
     std::printf("builder           %s\n", j["builder"].get<std::string>().c_str());
     std::printf("primitives        %zu\n", j["primitives"].get<size_t>());
     std::printf("nodes             %zu (%zu leaves)\n", j["nodes"].get<size_t>(), j["leaves"].get<size_t>());
-    std::printf("leaf depth        max %d, mean %.2f\n", j["max_depth"].get<int>(), j["mean_leaf_depth"].get<double>());
+    std::printf("leaf depth        max %d, mean %.2f\n", j["max_depth"].get<int>(),
+                j["mean_leaf_depth"].get<double>());
     std::printf("leaf sizes        ");
     const auto hist = j["leaf_size_histogram"].get<std::vector<size_t>>();
     for (size_t k = 1; k < hist.size(); ++k)
         if (hist[k]) std::printf("%zu:%zu ", k, hist[k]);
-    std::printf("\nSAH cost          %.3f (traversal %g, intersection %g, root area = 1)\n", j["sah_cost"].get<double>(),
-                j["traversal_cost"].get<double>(), j["intersection_cost"].get<double>());
+    std::printf("\nSAH cost          %.3f (traversal %g, intersection %g, root area = 1)\n",
+                j["sah_cost"].get<double>(), j["traversal_cost"].get<double>(),
+                j["intersection_cost"].get<double>());
     std::printf("build             %.1f ms (%.2f Mprims/s), CPU time %.1f ms\n", j["build_ms"].get<double>(),
                 j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>());
-    std::printf("memory            %zu bytes (%.1f per primitive; tree %zu, leaf-ordered primitives the rest)\n",
-                j["bytes"].get<size_t>(), j["bytes_per_primitive"].get<double>(), j["tree_bytes"].get<size_t>());
+    std::printf(
+        "memory            %zu bytes (%.1f per primitive; tree %zu, leaf-ordered primitives the rest)\n",
+        j["bytes"].get<size_t>(), j["bytes_per_primitive"].get<double>(), j["tree_bytes"].get<size_t>());
     for (const char* set : {"primary", "diffuse"}) {
         const auto& r = j["rays"][set];
         std::printf("%-7s rays      %zu: %.1f nodes visited, %.2f primitives tested per ray\n", set,
-                    r["count"].get<size_t>(), r["nodes_visited"].get<double>(), r["prims_tested"].get<double>());
+                    r["count"].get<size_t>(), r["nodes_visited"].get<double>(),
+                    r["prims_tested"].get<double>());
     }
 }
 
@@ -126,8 +133,10 @@ int run_bvh_command(int argc, char** argv) {
         return usage_error("bvh", "--size must be a positive integer", kBvhUsage);
     try {
         const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, size);
-        if (args.switches.count("--json")) std::printf("%s\n", j.dump().c_str());
-        else print_text(j);
+        if (args.switches.count("--json"))
+            std::printf("%s\n", j.dump().c_str());
+        else
+            print_text(j);
     } catch (const InputError& e) {
         std::fprintf(stderr, "sahara bvh: %s\n", e.what());
         return 2;

@@ -40,7 +40,8 @@ const char* const kConvergeUsage =
     "  --max-spp N          stop the series at N samples per pixel (default 65536)\n"
     "  -o, --output PREFIX  output prefix (default 'converge')\n"
     "  --compare \"L=FLAGS\"  measure a configuration labelled L with extra render flags,\n"
-    "                       e.g. --compare \"sobol=--sampler sobol\" --compare \"random=--sampler independent\"\n"
+    "                       e.g. --compare \"sobol=--sampler sobol\" --compare \"random=--sampler "
+    "independent\"\n"
     "  --threads N          worker threads (default: all)\n"
     "  --width W, --height H, --max-depth D, --seed S, --sampler NAME, ...: as for render\n"
     "  -h, --help           this text\n";
@@ -83,11 +84,14 @@ struct Series {
     double slope = 0;
 };
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 /// A configuration being measured.
 struct Run {
-    std::unique_ptr<Scene> scene;  ///< on the heap: a Scene must not move after build (its accelerator points to it)
+    std::unique_ptr<Scene>
+        scene;  ///< on the heap: a Scene must not move after build (its accelerator points to it)
     std::unique_ptr<Film> film;
     Series series;
     double elapsed = 0;
@@ -98,11 +102,14 @@ struct Run {
 /// Renders the doubling series of every configuration within the budget. The
 /// configurations take turns, one doubling each, so that a change in machine
 /// load over the run affects them alike (equal-time comparisons stay fair).
-std::vector<Series> measure_all(const std::vector<SceneDesc>& descs, const std::vector<ConvergeConfig>& configs,
-                                const ConvergeArgs& a, int threads) {
+std::vector<Series> measure_all(const std::vector<SceneDesc>& descs,
+                                const std::vector<ConvergeConfig>& configs, const ConvergeArgs& a,
+                                int threads) {
     std::vector<Run> runs;
     for (size_t i = 0; i < descs.size(); ++i) {
-        Run r{std::unique_ptr<Scene>(new Scene(build_scene(descs[i]))), std::make_unique<Film>(descs[i].render.width, descs[i].render.height), {}};
+        Run r{std::unique_ptr<Scene>(new Scene(build_scene(descs[i]))),
+              std::make_unique<Film>(descs[i].render.width, descs[i].render.height),
+              {}};
         r.series.label = configs[i].label;
         runs.push_back(std::move(r));
     }
@@ -120,7 +127,9 @@ std::vector<Series> measure_all(const std::vector<SceneDesc>& descs, const std::
             r.series.points.push_back({r.done, r.elapsed, r.film->to_rgb(), {}});
             // The next doubling costs about as much as everything so far.
             r.finished = 2 * r.elapsed > a.budget_s || r.done * 2 > a.max_spp;
-            if (tty) std::fprintf(stderr, "\r  %-12s %7d spp  %8.2f s   ", r.series.label.c_str(), r.done, r.elapsed);
+            if (tty)
+                std::fprintf(stderr, "\r  %-12s %7d spp  %8.2f s   ", r.series.label.c_str(), r.done,
+                             r.elapsed);
         }
     }
     if (tty) std::fprintf(stderr, "\n");
@@ -147,8 +156,10 @@ std::vector<float> render_reference(SceneDesc desc, const ConvergeArgs& a, const
     const int cap = std::max(largest * 2, int(8 * a.budget_s / per_spp));
     if (spp > cap) spp = cap;
     desc.render.seed = desc.render.seed * 0x9e3779b97f4a7c15ull + 0x7261726566ull;
-    std::fprintf(stderr, "sahara converge: no --reference given: rendering one at %d spp (%s settings, another seed, "
-                         "about %.0f s)\n", spp, basis.label.c_str(), per_spp * spp);
+    std::fprintf(stderr,
+                 "sahara converge: no --reference given: rendering one at %d spp (%s settings, another seed, "
+                 "about %.0f s)\n",
+                 spp, basis.label.c_str(), per_spp * spp);
     if (spp < 16 * largest)
         log_warning("reference capped at " + std::to_string(spp) + " spp (< 16x the largest measured " +
                     std::to_string(largest) + "): its own noise inflates the smallest errors");
@@ -161,8 +172,9 @@ std::vector<float> render_reference(SceneDesc desc, const ConvergeArgs& a, const
     }
     const std::string file = a.prefix + "-reference.exr";
     std::vector<float> rgb = film.to_rgb();
-    write_image(file, film.width(), film.height(), rgb,
-                {{"scene", desc.source}, {"spp", std::to_string(spp)}, {"seed", std::to_string(desc.render.seed)}});
+    write_image(
+        file, film.width(), film.height(), rgb,
+        {{"scene", desc.source}, {"spp", std::to_string(spp)}, {"seed", std::to_string(desc.render.seed)}});
     std::fprintf(stderr, "sahara converge: reference written to %s\n", file.c_str());
     return rgb;
 }
@@ -170,8 +182,9 @@ std::vector<float> render_reference(SceneDesc desc, const ConvergeArgs& a, const
 std::vector<float> load_reference(const std::string& file, int width, int height) {
     const auto img = read_image(file, false);
     if (img->width != width || img->height != height)
-        throw input_error(file, "", "reference is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
-                                        " but the render is " + std::to_string(width) + "x" + std::to_string(height));
+        throw input_error(file, "",
+                          "reference is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                              " but the render is " + std::to_string(width) + "x" + std::to_string(height));
     std::vector<float> rgb(size_t(width) * size_t(height) * 3);
     for (size_t i = 0; i < size_t(width) * size_t(height); ++i)
         for (size_t c = 0; c < 3; ++c) rgb[3 * i + c] = img->rgba[4 * i + c];
@@ -197,8 +210,8 @@ void write_csv(const std::string& file, const std::vector<Series>& all) {
     char line[256];
     for (const Series& s : all)
         for (const Point& p : s.points) {
-            std::snprintf(line, sizeof line, ",%d,%.6g,%.6g,%.6g,%.6g\n", p.spp, p.seconds,
-                          p.error.rmse, p.error.relmse, 1.0 / (p.error.relmse * p.seconds));
+            std::snprintf(line, sizeof line, ",%d,%.6g,%.6g,%.6g,%.6g\n", p.spp, p.seconds, p.error.rmse,
+                          p.error.relmse, 1.0 / (p.error.relmse * p.seconds));
             out << csv_field(s.label) << line;
         }
     if (!out) throw input_error(file, "", "write failed");
@@ -206,7 +219,7 @@ void write_csv(const std::string& file, const std::vector<Series>& all) {
 
 void write_plot(const std::string& file, const std::vector<Series>& all, const std::string& scene_name) {
     static const Rgb kColors[] = {{0.05f, 0.2f, 0.8f}, {0.8f, 0.08f, 0.05f}, {0.05f, 0.5f, 0.1f},
-                                  {0.9f, 0.45f, 0.0f}, {0.45f, 0.1f, 0.6f}, {0.0f, 0.55f, 0.6f}};
+                                  {0.9f, 0.45f, 0.0f}, {0.45f, 0.1f, 0.6f},  {0.0f, 0.55f, 0.6f}};
     LogLogPlot plot;
     plot.title = "RMSE vs render time: " + scene_name;
     plot.x_label = "render time (seconds)";
@@ -239,23 +252,29 @@ void write_plot(const std::string& file, const std::vector<Series>& all, const s
 }
 
 void print_summary(const std::vector<Series>& all) {
-    std::printf("%-14s %8s %10s %12s %12s %12s\n", "config", "spp", "seconds", "RMSE", "relMSE", "efficiency");
+    std::printf("%-14s %8s %10s %12s %12s %12s\n", "config", "spp", "seconds", "RMSE", "relMSE",
+                "efficiency");
     for (const Series& s : all)
         for (const Point& p : s.points)
-            std::printf("%-14s %8d %10.3f %12.5g %12.5g %12.5g\n", s.label.c_str(), p.spp, p.seconds, p.error.rmse,
-                        p.error.relmse, 1.0 / (p.error.relmse * p.seconds));
+            std::printf("%-14s %8d %10.3f %12.5g %12.5g %12.5g\n", s.label.c_str(), p.spp, p.seconds,
+                        p.error.rmse, p.error.relmse, 1.0 / (p.error.relmse * p.seconds));
     double t = INFINITY;
     for (const Series& s : all) t = std::min(t, s.points.back().seconds);
     std::printf("\nfitted slope of log RMSE against log seconds (ideal Monte Carlo: -0.50):\n");
     for (const Series& s : all) {
-        if (s.points.size() < 2) std::printf("  %-14s n/a (one point: raise --budget)\n", s.label.c_str());
-        else std::printf("  %-14s %6.3f\n", s.label.c_str(), s.slope);
+        if (s.points.size() < 2)
+            std::printf("  %-14s n/a (one point: raise --budget)\n", s.label.c_str());
+        else
+            std::printf("  %-14s %6.3f\n", s.label.c_str(), s.slope);
     }
     std::printf("equal-time comparison at %.3f s (log-log interpolation):\n", t);
     double base = 0;
     for (const Series& s : all) {
         std::vector<double> x, y;
-        for (const Point& p : s.points) { x.push_back(p.seconds); y.push_back(p.error.relmse); }
+        for (const Point& p : s.points) {
+            x.push_back(p.seconds);
+            y.push_back(p.error.relmse);
+        }
         const double relmse = loglog_interpolate(x, y, t);
         if (base == 0) base = relmse;
         std::printf("  %-14s relMSE %.5g  (x%.3f of %s)\n", s.label.c_str(), relmse, relmse / base,
@@ -276,9 +295,9 @@ int run(const ConvergeArgs& a) {
         descs.push_back(std::move(d));
     }
     std::vector<Series> all = measure_all(descs, configs, a, threads);
-    const std::vector<float> reference = a.reference
-                                             ? load_reference(*a.reference, base.render.width, base.render.height)
-                                             : render_reference(descs[0], a, all, threads);
+    const std::vector<float> reference =
+        a.reference ? load_reference(*a.reference, base.render.width, base.render.height)
+                    : render_reference(descs[0], a, all, threads);
     for (Series& s : all) {
         std::vector<double> x, y;
         for (Point& p : s.points) {
@@ -301,17 +320,28 @@ ConvergeArgs parse_converge_args(const std::vector<std::string>& args) {
     ConvergeArgs r;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "-h" || a == "--help") r.help = true;
-        else if (a == "-o" || a == "--output") r.prefix = flag_value(args, i);
-        else if (a == "--reference") r.reference = flag_value(args, i);
-        else if (a == "--budget") r.budget_s = parse_real_value(a, flag_value(args, i), 0.001, 1e6);
-        else if (a == "--max-spp") r.max_spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
-        else if (a == "--threads") r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
-        else if (a == "--compare") r.configs.push_back(parse_config(flag_value(args, i)));
-        else if (parse_override_flag(args, i, r.overrides)) continue;
-        else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
-        else if (r.scene) throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
-        else r.scene = a;
+        if (a == "-h" || a == "--help")
+            r.help = true;
+        else if (a == "-o" || a == "--output")
+            r.prefix = flag_value(args, i);
+        else if (a == "--reference")
+            r.reference = flag_value(args, i);
+        else if (a == "--budget")
+            r.budget_s = parse_real_value(a, flag_value(args, i), 0.001, 1e6);
+        else if (a == "--max-spp")
+            r.max_spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
+        else if (a == "--threads")
+            r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
+        else if (a == "--compare")
+            r.configs.push_back(parse_config(flag_value(args, i)));
+        else if (parse_override_flag(args, i, r.overrides))
+            continue;
+        else if (!a.empty() && a[0] == '-')
+            throw UsageError("unknown option '" + a + "'");
+        else if (r.scene)
+            throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
+        else
+            r.scene = a;
     }
     return r;
 }
@@ -337,7 +367,10 @@ double fit_loglog_slope(const std::vector<double>& x, const std::vector<double>&
     for (size_t i = 0; i < std::min(x.size(), y.size()); ++i) {
         if (!(x[i] > 0) || !(y[i] > 0)) continue;
         const double lx = std::log(x[i]), ly = std::log(y[i]);
-        sx += lx; sy += ly; sxx += lx * lx; sxy += lx * ly;
+        sx += lx;
+        sy += ly;
+        sxx += lx * lx;
+        sxy += lx * ly;
         ++n;
     }
     const double den = n * sxx - sx * sx;

@@ -27,8 +27,8 @@ struct ConvergeArgs {
     std::string prefix = "converge";
     int threads = 0;
     bool help = false;
-    RenderOverrides overrides;             ///< applied to every configuration
-    std::vector<ConvergeConfig> configs;   ///< from --compare; empty: one "render"
+    RenderOverrides overrides;            ///< applied to every configuration
+    std::vector<ConvergeConfig> configs;  ///< from --compare; empty: one "render"
 };
 
 /// Parses the arguments after `converge`. Throws UsageError.

@@ -59,10 +59,14 @@ SceneDesc load_input(const std::optional<std::string>& input) {
 
 const char* material_type_name(MaterialType t) {
     switch (t) {
-        case MaterialType::lambertian: return "lambertian";
-        case MaterialType::metal: return "metal";
-        case MaterialType::dielectric: return "dielectric";
-        case MaterialType::emissive: return "emissive";
+        case MaterialType::lambertian:
+            return "lambertian";
+        case MaterialType::metal:
+            return "metal";
+        case MaterialType::dielectric:
+            return "dielectric";
+        case MaterialType::emissive:
+            return "emissive";
     }
     return "?";
 }
@@ -82,7 +86,8 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
     s.add_count("Objects", "Triangles", scene.triangles.size());
     s.add_count("Objects", "Vertices", scene.triangles.positions.size());
     s.add_count("Materials", "Total", d.materials.size());
-    for (MaterialType t : {MaterialType::lambertian, MaterialType::metal, MaterialType::dielectric, MaterialType::emissive})
+    for (MaterialType t :
+         {MaterialType::lambertian, MaterialType::metal, MaterialType::dielectric, MaterialType::emissive})
         s.add_count("Materials", material_type_name(t),
                     uint64_t(std::count_if(d.materials.begin(), d.materials.end(),
                                            [t](const MaterialDesc& m) { return m.type == t; })));
@@ -90,21 +95,24 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
     for (size_t i = 0; i < d.textures.size(); ++i) {
         const TextureDesc& t = d.textures[i];
         const int w = t.image ? t.image->width : 0, h = t.image ? t.image->height : 0;
-        const std::string text = std::to_string(w) + "x" + std::to_string(h) + ", " + format_bytes(texture_bytes(t));
+        const std::string text =
+            std::to_string(w) + "x" + std::to_string(h) + ", " + format_bytes(texture_bytes(t));
         std::string label("[");  // built piecewise: gcc 12 warns falsely (-Wrestrict) on a + chain here
         label.append(std::to_string(i)).append("] ").append(fs::path(t.path).filename().string());
         s.add("Textures", label, text,
               {{"path", t.path}, {"width", w}, {"height", h}, {"bytes", texture_bytes(t)}});
     }
-    s.add_count("Lights", "Point", uint64_t(std::count_if(d.lights.begin(), d.lights.end(), [](const LightDesc& l) {
-                    return l.type == LightDesc::Type::point;
-                })));
-    s.add_count("Lights", "Directional", uint64_t(std::count_if(d.lights.begin(), d.lights.end(), [](const LightDesc& l) {
+    s.add_count("Lights", "Point",
+                uint64_t(std::count_if(d.lights.begin(), d.lights.end(),
+                                       [](const LightDesc& l) { return l.type == LightDesc::Type::point; })));
+    s.add_count("Lights", "Directional",
+                uint64_t(std::count_if(d.lights.begin(), d.lights.end(), [](const LightDesc& l) {
                     return l.type == LightDesc::Type::directional;
                 })));
     s.add_count("Lights", "Emissive materials",
-                uint64_t(std::count_if(d.materials.begin(), d.materials.end(),
-                                       [](const MaterialDesc& m) { return m.type == MaterialType::emissive; })));
+                uint64_t(std::count_if(d.materials.begin(), d.materials.end(), [](const MaterialDesc& m) {
+                    return m.type == MaterialType::emissive;
+                })));
     const Bounds3 b = scene.bounds();
     if (scene.primitive_count() > scene.planes.size()) {
         s.add("Bounds", "Min", vec_text(b.lo), {b.lo.x, b.lo.y, b.lo.z});
@@ -147,19 +155,23 @@ int run_info_command(const std::vector<std::string>& args) {
             std::fputs(kInfoUsage, stdout);
             return 0;
         }
-        if (a == "--json") json = true;
+        if (a == "--json")
+            json = true;
         else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "sahara info: unknown option '%s'\n\n%s", a.c_str(), kInfoUsage);
             return 2;
         } else if (input) {
             std::fprintf(stderr, "sahara info: more than one input given\n\n%s", kInfoUsage);
             return 2;
-        } else input = a;
+        } else
+            input = a;
     }
     try {
         const StatsReport s = scene_info(input);
-        if (json) std::printf("%s\n", s.to_json().dump(2).c_str());
-        else s.print(stdout);
+        if (json)
+            std::printf("%s\n", s.to_json().dump(2).c_str());
+        else
+            s.print(stdout);
         return 0;
     } catch (const InputError& e) {
         std::fprintf(stderr, "sahara: error: %s\n", e.what());

@@ -66,11 +66,13 @@ void write_snapshot(RenderJob& job, const SnapshotFn& snapshot, double elapsed, 
     RenderResult partial;
     partial.spp_done = int(min_sample_count(copy));
     partial.stop = StopReason::interrupted;
-    write_render(file, job.scene, copy, render_metadata(job.scene, copy, partial, job.previous_seconds + elapsed));
+    write_render(file, job.scene, copy,
+                 render_metadata(job.scene, copy, partial, job.previous_seconds + elapsed));
 }
 
 void write_snapshot(RenderJob& job, RenderSession& session, const fs::path& file) {
-    write_snapshot(job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds(), file);
+    write_snapshot(
+        job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds(), file);
 }
 
 /// --checkpoint: the output (and the resumable OUT.partial.exr) every so often.
@@ -88,13 +90,15 @@ void on_tick(RenderJob& job, RenderSession& session) {
         if (job.preview->take_stop_request()) session.request_stop(StopReason::interrupted);
         if (job.preview->take_snapshot_request()) {
             const fs::path out(job.args.output);
-            const fs::path snap = out.parent_path() / (out.stem().string() + ".snapshot-" +
-                                                       std::to_string(++job.snapshots) + out.extension().string());
+            const fs::path snap =
+                out.parent_path() / (out.stem().string() + ".snapshot-" + std::to_string(++job.snapshots) +
+                                     out.extension().string());
             write_snapshot(job, session, snap);
             log_info("snapshot written to " + snap.string());
         }
     }
-    maybe_checkpoint(job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds());
+    maybe_checkpoint(
+        job, [&session](Film& f) { session.snapshot(f); }, session.elapsed_seconds());
 }
 
 // --- MPI: one image across ranks (see app/mpi_render.h) ----------------------
@@ -109,12 +113,14 @@ RenderResult render_distributed(RenderJob& job, const RenderOptions& local) {
     options.progress = local.progress;
     options.stop = local.stop;
     options.on_tick = [&job](DistributedRender& d) {
-        maybe_checkpoint(job, [&d](Film& f) { d.snapshot(f); }, d.elapsed_seconds());
+        maybe_checkpoint(
+            job, [&d](Film& f) { d.snapshot(f); }, d.elapsed_seconds());
     };
     DistributedRender render(*job.mpi, job.scene, job.film, options);
     const RenderResult r = render.run();
     if (render.lost_ranks() > 0) job.mpi->abort_at_exit(kExitInterrupted);
-    if (job.args.stats) std::fprintf(stderr, "Ranks (%d):\n%s", job.mpi->size(), render.rank_report().c_str());
+    if (job.args.stats)
+        std::fprintf(stderr, "Ranks (%d):\n%s", job.mpi->size(), render.rank_report().c_str());
     return r;
 }
 
@@ -125,7 +131,8 @@ bool ranks_agree(const MpiSession& mpi, const Scene& scene) {
     for (const auto& [k, v] : render_identity(scene)) id += k + "=" + v + ";";
     id += "spp=" + std::to_string(scene.render.spp) + ";sampler=" + std::to_string(int(scene.render.sampler));
     const bool same = mpi.broadcast(id) == id;
-    if (!same) std::fprintf(stderr, "sahara: rank %d: the scene or settings differ from rank 0's\n", mpi.rank());
+    if (!same)
+        std::fprintf(stderr, "sahara: rank %d: the scene or settings differ from rank 0's\n", mpi.rank());
     return mpi.all_ok(same);
 }
 
@@ -140,10 +147,12 @@ std::string final_line(const RenderJob& job, const RenderResult& r, double est_e
         spp += " spp";
     }
     if (r.stop != StopReason::complete && r.stop != StopReason::converged)
-        spp += " (" + std::string(stop_reason_name(r.stop)) + "; " + std::to_string(job.scene.render.spp) + " requested)";
+        spp += " (" + std::string(stop_reason_name(r.stop)) + "; " + std::to_string(job.scene.render.spp) +
+               " requested)";
     std::string error;
     if (job.scene.render.target_error) {
-        std::snprintf(buf, sizeof buf, ", est. error %.4g (target %.4g%s)", est_error, *job.scene.render.target_error,
+        std::snprintf(buf, sizeof buf, ", est. error %.4g (target %.4g%s)", est_error,
+                      *job.scene.render.target_error,
                       r.stop == StopReason::converged ? ", reached" : ", not reached");
         error = buf;
     }
@@ -152,8 +161,8 @@ std::string final_line(const RenderJob& job, const RenderResult& r, double est_e
         error += buf;
     }
     const double rate = r.seconds > 0 ? double(r.samples) / r.seconds / 1e6 : 0.0;
-    std::snprintf(buf, sizeof buf, "sahara: %dx%d, %s%s, %.2f s, %.2f Msamples/s -> %s", f.width(), f.height(),
-                  spp.c_str(), error.c_str(), r.seconds, rate, job.args.output.c_str());
+    std::snprintf(buf, sizeof buf, "sahara: %dx%d, %s%s, %.2f s, %.2f Msamples/s -> %s", f.width(),
+                  f.height(), spp.c_str(), error.c_str(), r.seconds, rate, job.args.output.c_str());
     return buf;
 }
 
@@ -187,10 +196,13 @@ void print_stats(const RenderJob& job, const RenderResult& r) {
 
 /// The bvh-cost inspection image: one primary ray per pixel, no sampling.
 int write_bvh_cost(const RenderArgs& a, const Scene& scene) {
-    const BvhCostImage img = render_bvh_cost(scene, scene.render.width, scene.render.height, a.threads > 0 ? a.threads : omp_get_max_threads());
-    write_image(a.output, img.width, img.height, img.rgb, {{"integrator", "bvh-cost"}, {"version", SAHARA_VERSION}});
+    const BvhCostImage img = render_bvh_cost(scene, scene.render.width, scene.render.height,
+                                             a.threads > 0 ? a.threads : omp_get_max_threads());
+    write_image(a.output, img.width, img.height, img.rgb,
+                {{"integrator", "bvh-cost"}, {"version", SAHARA_VERSION}});
     if (!a.quiet)
-        std::fprintf(stderr, "sahara: bvh-cost %dx%d: mean %.1f, max %.0f nodes + primitives per primary ray -> %s\n",
+        std::fprintf(stderr,
+                     "sahara: bvh-cost %dx%d: mean %.1f, max %.0f nodes + primitives per primary ray -> %s\n",
                      scene.render.width, scene.render.height, img.mean_cost, img.max_cost, a.output.c_str());
     return 0;
 }
@@ -203,10 +215,12 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
         const auto img = read_image(*a.reference, false);
         if (img->width != job.film.width() || img->height != job.film.height())
             throw input_error(*a.reference, "", "reference size differs from the render");
-        for (size_t i = 0; i < img->rgba.size(); i += 4) reference.insert(reference.end(), &img->rgba[i], &img->rgba[i + 3]);
+        for (size_t i = 0; i < img->rgba.size(); i += 4)
+            reference.insert(reference.end(), &img->rgba[i], &img->rgba[i + 3]);
     }
     if (a.preview)
-        job.preview = Preview::open(job.film.width(), job.film.height(), job.scene.render.exposure, job.scene.render.tonemap);
+        job.preview = Preview::open(job.film.width(), job.film.height(), job.scene.render.exposure,
+                                    job.scene.render.tonemap);
     RenderOptions options;
     options.threads = a.threads;
     options.progress = !a.quiet && Progress::stderr_is_tty();
@@ -232,8 +246,10 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     const bool unfinished = result.stop == StopReason::interrupted || result.stop == StopReason::time_limit;
     std::error_code ec;
     if (out.extension() != ".exr") {
-        if (unfinished) write_render(partial_path(out), job.scene, job.film, meta);
-        else if (a.checkpoint_s) fs::remove(partial_path(out), ec);
+        if (unfinished)
+            write_render(partial_path(out), job.scene, job.film, meta);
+        else if (a.checkpoint_s)
+            fs::remove(partial_path(out), ec);
     }
     job.times.write = seconds_since(t_write);
     const std::string line = final_line(job, result, est_error, true_error);
@@ -243,7 +259,9 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     }
     if (!a.quiet) {
         std::fprintf(stderr, "%s\n", line.c_str());
-        if (exposure) std::fprintf(stderr, "sahara: automatic exposure %+.2f stops (set one with --exposure)\n", double(*exposure));
+        if (exposure)
+            std::fprintf(stderr, "sahara: automatic exposure %+.2f stops (set one with --exposure)\n",
+                         double(*exposure));
         if (clipped > 0)
             std::fprintf(stderr, "sahara: %zu pixels (%.2f%%) clipped by the '%s' tone curve\n", clipped,
                          100.0 * double(clipped) / (double(job.film.width()) * double(job.film.height())),
@@ -252,7 +270,8 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
             std::fprintf(stderr, "sahara: resume with --resume %s\n",
                          (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());
     }
-    if (result.nonfinite > 0) log_warning(std::to_string(result.nonfinite) + " non-finite samples were discarded");
+    if (result.nonfinite > 0)
+        log_warning(std::to_string(result.nonfinite) + " non-finite samples were discarded");
     if (a.stats) print_stats(job, result);
     return signal_stop.load() ? kExitInterrupted : 0;
 }
@@ -278,8 +297,8 @@ namespace {
 
 /// Loads, builds and renders one image: the whole job in one process, or
 /// rank `mpi.rank()`'s part of it when `distributed`.
-int render_one(const RenderArgs& a, const std::function<SceneDesc()>& load_scene, MpiSession& mpi, bool distributed,
-               const std::atomic<bool>& signal_stop) {
+int render_one(const RenderArgs& a, const std::function<SceneDesc()>& load_scene, MpiSession& mpi,
+               bool distributed, const std::atomic<bool>& signal_stop) {
     const bool root = !distributed || mpi.rank() == 0;
     bool agreed = false;
     try {

@@ -40,7 +40,9 @@ std::vector<Ray> read_ray_file(const std::string& path) {
     if (!in) throw input_error(path, "", "cannot open ray file");
     const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (bytes.size() % 32 != 0)
-        throw input_error(path, "", "size " + std::to_string(bytes.size()) + " is not a multiple of 32 bytes (8 float32 per ray)");
+        throw input_error(
+            path, "",
+            "size " + std::to_string(bytes.size()) + " is not a multiple of 32 bytes (8 float32 per ray)");
     std::vector<Ray> rays(bytes.size() / 32);
     for (size_t i = 0; i < rays.size(); ++i) {
         float f[8];

@@ -12,7 +12,8 @@ namespace sahara {
 namespace {
 
 const char* const kViewUsage =
-    "usage: sahara view MODEL [-o OUT.png] [--spp N] [--size WxH] [--up y|z] [--gltf-camera N] [render options]\n"
+    "usage: sahara view MODEL [-o OUT.png] [--spp N] [--size WxH] [--up y|z] [--gltf-camera N] [render "
+    "options]\n"
     "\n"
     "Renders a downloaded model (.obj with its .mtl, .gltf, .glb) with no scene file: a camera\n"
     "framing it from a three-quarter view, a ground plane under it, the sky and a sun.\n"
@@ -88,9 +89,8 @@ int run_view_command(const std::vector<std::string>& args) {
         return 0;
     }
     const std::string model = *v.render.scene;
-    return run_render(v.render, [&] {
-        return make_view_scene(load_model(model), is_gltf_file(model), v.view, model);
-    });
+    return run_render(v.render,
+                      [&] { return make_view_scene(load_model(model), is_gltf_file(model), v.view, model); });
 }
 
 }  // namespace sahara

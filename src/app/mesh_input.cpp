@@ -18,7 +18,8 @@ TriangleMesh read_obj_triangles(const std::filesystem::path& file) {
     config.vertex_color = false;
     config.mtl_search_path = file.parent_path().string();
     tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(name, config)) throw input_error(name, "", "cannot parse OBJ: " + reader.Error());
+    if (!reader.ParseFromFile(name, config))
+        throw input_error(name, "", "cannot parse OBJ: " + reader.Error());
     const tinyobj::attrib_t& attrib = reader.GetAttrib();
     TriangleMesh mesh;
     mesh.name = name;

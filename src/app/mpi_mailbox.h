@@ -27,7 +27,7 @@ inline int resolve_threads(int threads) { return threads > 0 ? threads : omp_get
 /// kept alive until complete: two ranks sending each other large (rendezvous)
 /// messages with blocking MPI_Send would deadlock.
 class Mailbox {
-public:
+   public:
     void send(int dest, int tag, std::vector<char> bytes) {
         auto& s = sends_.emplace_back();
         s.bytes = std::move(bytes);
@@ -52,14 +52,15 @@ public:
         int count = 0;
         MPI_Get_count(&status, MPI_BYTE, &count);
         bytes.resize(size_t(count));
-        MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD,
+                 MPI_STATUS_IGNORE);
         source = status.MPI_SOURCE;
         tag = status.MPI_TAG;
         return true;
     }
     uint64_t bytes_sent() const { return bytes_sent_; }
 
-private:
+   private:
     struct Pending {
         MPI_Request request = MPI_REQUEST_NULL;
         std::vector<char> bytes;
@@ -72,7 +73,7 @@ private:
 /// core from the render threads; a few hundred microseconds of latency is
 /// hidden by the unit each rank holds in reserve.
 class Backoff {
-public:
+   public:
     /// `sending`: messages are still going out; poll soon so MPI can move them on.
     void idle(bool sending) {
         std::this_thread::sleep_for(std::chrono::microseconds(us_));
@@ -80,11 +81,12 @@ public:
     }
     void busy() { us_ = 50; }
 
-private:
+   private:
     int us_ = 50;
 };
 
-template <class T> inline std::vector<char> bytes_of(const T& v) {
+template <class T>
+inline std::vector<char> bytes_of(const T& v) {
     Writer w;
     w.put(v);
     return std::move(w.bytes);

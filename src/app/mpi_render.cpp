@@ -42,18 +42,23 @@ struct Unit {
 
 struct DistributedRender::Impl {
     Impl(const MpiSession& m, const Scene& s, Film& f, DistributedOptions o)
-        : mpi(m), scene(s), film(f), options(std::move(o)), threads(resolve_threads(options.threads)),
+        : mpi(m),
+          scene(s),
+          film(f),
+          options(std::move(o)),
+          threads(resolve_threads(options.threads)),
           camera(s.camera, f.width(), f.height()) {
         for (int y0 = 0; y0 < f.height(); y0 += kTileSize)
             for (int x0 = 0; x0 < f.width(); x0 += kTileSize)
-                tiles.push_back({x0, y0, std::min(x0 + kTileSize, f.width()), std::min(y0 + kTileSize, f.height())});
+                tiles.push_back(
+                    {x0, y0, std::min(x0 + kTileSize, f.width()), std::min(y0 + kTileSize, f.height())});
         busy.assign(tiles.size(), 0);
         peers.resize(size_t(mpi.size()));
     }
 
     struct Peer {
-        uint32_t slots = 0;                 ///< units it may hold (2 per thread + 1)
-        std::map<uint32_t, Unit> holding;   ///< tile -> unit sent and not returned
+        uint32_t slots = 0;                ///< units it may hold (2 per thread + 1)
+        std::map<uint32_t, Unit> holding;  ///< tile -> unit sent and not returned
         bool stop_sent = false, done = false, left = false;
         WorkerReport report;
     };
@@ -159,7 +164,7 @@ struct DistributedRender::Impl {
     std::vector<Peer> peers;
     Mailbox mail;
     int lost = 0;
-    WorkerReport local_report;      ///< rank 0's own render threads
+    WorkerReport local_report;       ///< rank 0's own render threads
     double coordinator_seconds = 0;  ///< rank 0's time handling messages (decode, apply, encode)
     uint64_t messages = 0;
 };
@@ -253,7 +258,8 @@ void DistributedRender::Impl::handle(int source, int tag, const std::vector<char
         cv.notify_all();
     } else if (tag == kTagLeave) {
         if (!stopping && !(options.stop && options.stop->load()))
-            log_warning("rank " + std::to_string(source) + " was stopped; the other ranks take over its tiles");
+            log_warning("rank " + std::to_string(source) +
+                        " was stopped; the other ranks take over its tiles");
         p.left = true;
         if (!p.stop_sent) mail.send(source, kTagStop, {});
         p.stop_sent = true;
@@ -286,8 +292,10 @@ void DistributedRender::Impl::begin_stop(StopReason why) {
 /// One round of the coordinating loop; false when the render is over.
 bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
     if (!stopping) {
-        if (options.stop && options.stop->load()) begin_stop(StopReason::interrupted);
-        else if (scene.render.time_limit_s && seconds_between(start, Clock::now()) >= *scene.render.time_limit_s)
+        if (options.stop && options.stop->load())
+            begin_stop(StopReason::interrupted);
+        else if (scene.render.time_limit_s &&
+                 seconds_between(start, Clock::now()) >= *scene.render.time_limit_s)
             begin_stop(StopReason::time_limit);
     }
     int source = 0, tag = 0;
@@ -332,8 +340,10 @@ bool DistributedRender::Impl::coordinate_step(Backoff& backoff) {
             return false;
         }
     }
-    if (progressed) backoff.busy();
-    else backoff.idle(!sends_done);
+    if (progressed)
+        backoff.busy();
+    else
+        backoff.idle(!sends_done);
     return true;
 }
 
@@ -348,13 +358,15 @@ RenderResult DistributedRender::Impl::result() const {
             r.spp_max = std::max(r.spp_max, int(film.count(x, y)));
             total += film.count(x, y);
         }
-    r.spp_mean = double(total) / double(std::max<uint64_t>(uint64_t(film.width()) * uint64_t(film.height()), 1));
+    r.spp_mean =
+        double(total) / double(std::max<uint64_t>(uint64_t(film.width()) * uint64_t(film.height()), 1));
     r.nonfinite = film.nonfinite_samples();
     r.stop = reason;
     return r;
 }
 
-DistributedRender::DistributedRender(const MpiSession& mpi, const Scene& scene, Film& film, DistributedOptions options)
+DistributedRender::DistributedRender(const MpiSession& mpi, const Scene& scene, Film& film,
+                                     DistributedOptions options)
     : impl_(std::make_unique<Impl>(mpi, scene, film, std::move(options))) {}
 
 DistributedRender::~DistributedRender() = default;
@@ -399,7 +411,8 @@ void DistributedRender::snapshot(Film& out) {
     std::lock_guard lock(impl_->m);
     const Film& f = impl_->film;
     for (int y = 0; y < f.height(); ++y)
-        for (int x = 0; x < f.width(); ++x) out.set_pixel_state(x, y, f.sum(x, y), f.sum_sq(x, y), f.count(x, y));
+        for (int x = 0; x < f.width(); ++x)
+            out.set_pixel_state(x, y, f.sum(x, y), f.sum_sq(x, y), f.count(x, y));
     out.add_nonfinite(f.nonfinite_samples() - out.nonfinite_samples());
 }
 
@@ -413,17 +426,21 @@ std::string DistributedRender::rank_report() const {
     char line[256];
     const auto add = [&](int rank, const WorkerReport& r, int threads) {
         const double per_unit = r.units ? 1e3 / double(r.units) : 0.0;
-        std::snprintf(line, sizeof line,
-                      "rank %d: %d threads, %llu units, render %.3f s (%.2f ms/unit), waiting for units %.3f s "
-                      "(%.3f ms/unit)\n",
-                      rank, threads, static_cast<unsigned long long>(r.units), r.render_seconds,
-                      r.render_seconds * per_unit, r.wait_seconds, r.wait_seconds * per_unit);
+        std::snprintf(
+            line, sizeof line,
+            "rank %d: %d threads, %llu units, render %.3f s (%.2f ms/unit), waiting for units %.3f s "
+            "(%.3f ms/unit)\n",
+            rank, threads, static_cast<unsigned long long>(r.units), r.render_seconds,
+            r.render_seconds * per_unit, r.wait_seconds, r.wait_seconds * per_unit);
         out += line;
     };
     add(0, s.local_report, s.threads);
-    for (int r = 1; r < s.mpi.size(); ++r) add(r, s.peers[size_t(r)].report, int(s.peers[size_t(r)].report.threads));
-    std::snprintf(line, sizeof line, "rank 0 coordinator: %llu messages, %.3f s handling them, %.2f MB sent\n",
-                  static_cast<unsigned long long>(s.messages), s.coordinator_seconds, double(s.mail.bytes_sent()) / 1e6);
+    for (int r = 1; r < s.mpi.size(); ++r)
+        add(r, s.peers[size_t(r)].report, int(s.peers[size_t(r)].report.threads));
+    std::snprintf(line, sizeof line,
+                  "rank 0 coordinator: %llu messages, %.3f s handling them, %.2f MB sent\n",
+                  static_cast<unsigned long long>(s.messages), s.coordinator_seconds,
+                  double(s.mail.bytes_sent()) / 1e6);
     out += line;
     return out;
 }

@@ -39,7 +39,7 @@ struct DistributedOptions {
 
 /// Rank 0's side of a distributed render. The other ranks run serve_distributed_render.
 class DistributedRender {
-public:
+   public:
     DistributedRender(const MpiSession& mpi, const Scene& scene, Film& film, DistributedOptions options);
     ~DistributedRender();
 
@@ -54,7 +54,7 @@ public:
     /// Per-rank work and communication figures of the finished render, one line per rank.
     std::string rank_report() const;
 
-private:
+   private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
@@ -62,6 +62,7 @@ private:
 /// Ranks > 0: renders the units rank 0 sends, with `threads` threads (0 = all),
 /// until rank 0 says stop, or this rank's `stop` flag is raised (it then
 /// returns its partial tiles and leaves the job; rank 0 re-issues the rest).
-void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int threads, const std::atomic<bool>& stop);
+void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int threads,
+                              const std::atomic<bool>& stop);
 
 }  // namespace sahara

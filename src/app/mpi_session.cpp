@@ -57,8 +57,9 @@ MpiSession::MpiSession() {
     }
     const char* tasks = std::getenv("SLURM_NTASKS");
     if (size_ == 1 && tasks && std::atoi(tasks) > 1)
-        log_warning("Slurm started " + std::string(tasks) +
-                    " tasks but MPI sees only this one: every task renders the whole image (use srun --mpi=pmix)");
+        log_warning(
+            "Slurm started " + std::string(tasks) +
+            " tasks but MPI sees only this one: every task renders the whole image (use srun --mpi=pmix)");
 }
 
 MpiSession::~MpiSession() {
@@ -96,7 +97,8 @@ bool mpi_built() { return false; }
 
 MpiSession::MpiSession() {
     if (launched_by_mpi())
-        log_warning("started by an MPI launcher, but this sahara was built without MPI: every rank renders alone");
+        log_warning(
+            "started by an MPI launcher, but this sahara was built without MPI: every rank renders alone");
 }
 
 MpiSession::~MpiSession() = default;

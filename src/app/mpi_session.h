@@ -16,7 +16,7 @@ bool launched_by_mpi();
 /// MPI, finalised on destruction (aborting the whole job if an exception is
 /// unwinding, so the other ranks do not wait forever).
 class MpiSession {
-public:
+   public:
     MpiSession();
     ~MpiSession();
     MpiSession(const MpiSession&) = delete;
@@ -37,7 +37,7 @@ public:
     /// process then ends with MPI_Abort(code) in the destructor.
     void abort_at_exit(int code) { abort_code_ = code; }
 
-private:
+   private:
     int rank_ = 0, size_ = 1;
     bool initialised_ = false;
     int abort_code_ = -1;

@@ -73,24 +73,28 @@ inline void render_work(const Scene& scene, const Camera& camera, TileWork& w,
         for (int x = 0; x < tw && !stop.load(std::memory_order_relaxed); ++x) {
             const uint32_t begin = film.count(x, y), end = w.targets[size_t(y) * size_t(tw) + size_t(x)];
             if (end <= begin) continue;
-            render_pixel_samples(scene, camera, film, sampler, w.rect.x0 + x, w.rect.y0 + y, x, y, begin, end);
+            render_pixel_samples(scene, camera, film, sampler, w.rect.x0 + x, w.rect.y0 + y, x, y, begin,
+                                 end);
             w.samples += end - begin;
         }
     for (int y = 0; y < th; ++y)
         for (int x = 0; x < tw; ++x)
-            w.state[size_t(y) * size_t(tw) + size_t(x)] = {film.sum(x, y), film.sum_sq(x, y), film.count(x, y), 0};
+            w.state[size_t(y) * size_t(tw) + size_t(x)] = {film.sum(x, y), film.sum_sq(x, y),
+                                                           film.count(x, y), 0};
     w.nonfinite = film.nonfinite_samples();
 }
 
 /// Appends trivially copyable values to a byte buffer.
 class Writer {
-public:
-    template <class T> void put(const T& v) {
+   public:
+    template <class T>
+    void put(const T& v) {
         const size_t at = bytes.size();
         bytes.resize(at + sizeof(T));
         std::memcpy(bytes.data() + at, &v, sizeof(T));
     }
-    template <class T> void put_all(const std::vector<T>& v) {
+    template <class T>
+    void put_all(const std::vector<T>& v) {
         const size_t at = bytes.size();
         bytes.resize(at + v.size() * sizeof(T));
         if (!v.empty()) std::memcpy(bytes.data() + at, v.data(), v.size() * sizeof(T));
@@ -100,20 +104,22 @@ public:
 
 /// Reads what Writer wrote; throws std::runtime_error on a short message.
 class Reader {
-public:
+   public:
     explicit Reader(const std::vector<char>& b) : bytes_(b) {}
-    template <class T> T get() {
+    template <class T>
+    T get() {
         T v;
         take(&v, sizeof(T));
         return v;
     }
-    template <class T> void get_all(std::vector<T>& v, size_t n) {
+    template <class T>
+    void get_all(std::vector<T>& v, size_t n) {
         v.resize(n);
         take(v.data(), n * sizeof(T));
     }
     bool at_end() const { return pos_ == bytes_.size(); }
 
-private:
+   private:
     void take(void* out, size_t n) {
         if (n > bytes_.size() - pos_) throw std::runtime_error("sahara: truncated MPI message");
         if (n) std::memcpy(out, bytes_.data() + pos_, n);
@@ -137,7 +143,8 @@ inline TileWork decode_work(const std::vector<char>& bytes) {
     TileWork w;
     w.tile = in.get<uint32_t>();
     w.rect = in.get<TileRect>();
-    if (w.rect.x1 < w.rect.x0 || w.rect.y1 < w.rect.y0) throw std::runtime_error("sahara: bad tile in MPI message");
+    if (w.rect.x1 < w.rect.x0 || w.rect.y1 < w.rect.y0)
+        throw std::runtime_error("sahara: bad tile in MPI message");
     in.get_all(w.targets, w.pixels());
     in.get_all(w.state, w.pixels());
     if (!in.at_end()) throw std::runtime_error("sahara: oversized MPI work message");

@@ -80,8 +80,10 @@ void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int thr
         while (mail.receive(source, tag, bytes)) {
             progressed = true;
             std::lock_guard lock(w.m);
-            if (tag == kTagWork) w.todo.push_back(decode_work(bytes));
-            else if (tag == kTagStop) stopped = w.quit = true;
+            if (tag == kTagWork)
+                w.todo.push_back(decode_work(bytes));
+            else if (tag == kTagStop)
+                stopped = w.quit = true;
             w.cv.notify_all();
         }
         if (stopped) w.stop.store(true);  // rank 0 stopped the job (or finished it)
@@ -109,8 +111,10 @@ void serve_distributed_render(const MpiSession& mpi, const Scene& scene, int thr
         }
         const bool sends_done = mail.progress();
         if (!renderers.joinable() && sends_done) break;
-        if (progressed) backoff.busy();
-        else backoff.idle(!sends_done);
+        if (progressed)
+            backoff.busy();
+        else
+            backoff.idle(!sends_done);
     }
 }
 

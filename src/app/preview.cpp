@@ -45,9 +45,12 @@ constexpr double kTitleSeconds = 0.25;
 std::string format_duration(double s) {
     char buf[32];
     if (s < 0) return "?";
-    if (s < 100) std::snprintf(buf, sizeof buf, "%.1f s", s);
-    else if (s < 6000) std::snprintf(buf, sizeof buf, "%d min %02d s", int(s) / 60, int(s) % 60);
-    else std::snprintf(buf, sizeof buf, "%d h %02d min", int(s) / 3600, (int(s) / 60) % 60);
+    if (s < 100)
+        std::snprintf(buf, sizeof buf, "%.1f s", s);
+    else if (s < 6000)
+        std::snprintf(buf, sizeof buf, "%d min %02d s", int(s) / 60, int(s) % 60);
+    else
+        std::snprintf(buf, sizeof buf, "%d h %02d min", int(s) / 3600, (int(s) / 60) % 60);
     return buf;
 }
 
@@ -79,8 +82,10 @@ struct Preview::Impl {
     void present() {
         SDL_Surface* target = SDL_GetWindowSurface(window);
         if (!target) return;
-        if (target->w == image->w && target->h == image->h) SDL_BlitSurface(image, nullptr, target, nullptr);
-        else SDL_BlitScaled(image, nullptr, target, nullptr);
+        if (target->w == image->w && target->h == image->h)
+            SDL_BlitSurface(image, nullptr, target, nullptr);
+        else
+            SDL_BlitScaled(image, nullptr, target, nullptr);
         SDL_UpdateWindowSurface(window);
     }
 
@@ -88,18 +93,24 @@ struct Preview::Impl {
         char title[160];
         std::snprintf(title, sizeof title, "sahara - %d/%d spp%s - %s - ETA %s", session.spp_complete(),
                       session.spp_target(), session.pass_target() > 0 ? "" : " (adaptive)",
-                      format_duration(session.elapsed_seconds()).c_str(), format_duration(session.eta_seconds()).c_str());
+                      format_duration(session.elapsed_seconds()).c_str(),
+                      format_duration(session.eta_seconds()).c_str());
         SDL_SetWindowTitle(window, title);
     }
 
     void poll_events() {
         SDL_Event e;
         while (SDL_PollEvent(&e)) {
-            if (e.type == SDL_QUIT) stop = true;
-            else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_CLOSE) stop = true;
-            else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_EXPOSED) present();
-            else if (e.type == SDL_KEYDOWN && e.key.keysym.sym == SDLK_ESCAPE) stop = true;
-            else if (e.type == SDL_KEYDOWN && e.key.keysym.sym == SDLK_s) snapshot = true;
+            if (e.type == SDL_QUIT)
+                stop = true;
+            else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_CLOSE)
+                stop = true;
+            else if (e.type == SDL_WINDOWEVENT && e.window.event == SDL_WINDOWEVENT_EXPOSED)
+                present();
+            else if (e.type == SDL_KEYDOWN && e.key.keysym.sym == SDLK_ESCAPE)
+                stop = true;
+            else if (e.type == SDL_KEYDOWN && e.key.keysym.sym == SDLK_s)
+                snapshot = true;
         }
     }
 };
@@ -110,13 +121,15 @@ Preview::~Preview() = default;
 std::unique_ptr<Preview> Preview::open(int width, int height, float exposure, Tonemap curve) {
     const char* driver = std::getenv("SDL_VIDEODRIVER");
     if (!driver && !std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY")) {
-        log_warning("--preview: no display (DISPLAY and WAYLAND_DISPLAY are unset); rendering without a window");
+        log_warning(
+            "--preview: no display (DISPLAY and WAYLAND_DISPLAY are unset); rendering without a window");
         return nullptr;
     }
     // sahara's own SIGINT/SIGTERM handling (stop and save) must stay in charge.
     SDL_SetHint(SDL_HINT_NO_SIGNAL_HANDLERS, "1");
     if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) {
-        log_warning(std::string("--preview: cannot open a window (") + SDL_GetError() + "); rendering without it");
+        log_warning(std::string("--preview: cannot open a window (") + SDL_GetError() +
+                    "); rendering without it");
         return nullptr;
     }
     auto impl = std::make_unique<Impl>();
@@ -130,10 +143,14 @@ std::unique_ptr<Preview> Preview::open(int width, int height, float exposure, To
     if (SDL_GetDisplayUsableBounds(0, &usable) == 0 && usable.w > 0 && usable.h > 0)
         scale = std::min({1.0, 0.9 * usable.w / width, 0.9 * usable.h / height});
     const int ww = std::max(1, int(width * scale)), wh = std::max(1, int(height * scale));
-    impl->window = SDL_CreateWindow("sahara", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, ww, wh, SDL_WINDOW_SHOWN);
-    impl->image = impl->window ? SDL_CreateRGBSurfaceWithFormat(0, width, height, 32, SDL_PIXELFORMAT_XRGB8888) : nullptr;
+    impl->window =
+        SDL_CreateWindow("sahara", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, ww, wh, SDL_WINDOW_SHOWN);
+    impl->image = impl->window
+                      ? SDL_CreateRGBSurfaceWithFormat(0, width, height, 32, SDL_PIXELFORMAT_XRGB8888)
+                      : nullptr;
     if (!impl->window || !impl->image) {
-        log_warning(std::string("--preview: cannot open a window (") + SDL_GetError() + "); rendering without it");
+        log_warning(std::string("--preview: cannot open a window (") + SDL_GetError() +
+                    "); rendering without it");
         return nullptr;
     }
     SDL_FillRect(impl->image, nullptr, SDL_MapRGB(impl->image->format, 0, 0, 0));
@@ -147,7 +164,8 @@ void Preview::update(RenderSession& session) {
     const auto start = Clock::now();
     if (start >= p.next_title) {
         p.set_title(session);
-        p.next_title = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTitleSeconds));
+        p.next_title =
+            start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTitleSeconds));
     }
     if (start < p.next_frame) return;
     const Film* film = nullptr;
@@ -160,8 +178,8 @@ void Preview::update(RenderSession& session) {
     });
     if (changed) p.present();
     const double cost = std::chrono::duration<double>(Clock::now() - start).count();
-    p.next_frame = start + std::chrono::duration_cast<Clock::duration>(
-                               std::chrono::duration<double>(std::max(kMinFrameSeconds, kBudgetDivisor * cost)));
+    p.next_frame = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                               std::max(kMinFrameSeconds, kBudgetDivisor * cost)));
 }
 
 void Preview::show_final(const Film& film, const std::string& title) {
@@ -183,7 +201,8 @@ void Preview::dump(const std::filesystem::path& file) const {
     std::ofstream out(file, std::ios::binary);
     out << "P6\n" << rgb->w << " " << rgb->h << "\n255\n";
     for (int y = 0; y < rgb->h; ++y)
-        out.write(static_cast<const char*>(rgb->pixels) + size_t(y) * size_t(rgb->pitch), std::streamsize(rgb->w) * 3);
+        out.write(static_cast<const char*>(rgb->pixels) + size_t(y) * size_t(rgb->pitch),
+                  std::streamsize(rgb->w) * 3);
     SDL_FreeSurface(rgb);
     if (!out) throw input_error(file.string(), "", "cannot write the preview dump");
 }

@@ -14,7 +14,7 @@
 namespace sahara {
 
 class Preview {
-public:
+   public:
     /// Opens a window for a width x height image. Returns nullptr after a
     /// one-line warning when no window can be shown (no display, no SDL2).
     static std::unique_ptr<Preview> open(int width, int height, float exposure, Tonemap curve);
@@ -34,7 +34,7 @@ public:
 
     struct Impl;
 
-private:
+   private:
     explicit Preview(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };

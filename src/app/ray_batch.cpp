@@ -46,8 +46,8 @@ PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceO
 
 }  // namespace
 
-PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
-                    RayAnswers& out) {
+PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads,
+                      bool ftz, RayAnswers& out) {
     return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
         if (occlusion) {
             if (accel.occluded(rays[i])) t = 0.0f, prim = 0;
@@ -59,8 +59,8 @@ PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bo
     });
 }
 
-PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
-                    bool ftz, RayAnswers& out) {
+PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion,
+                      int threads, bool ftz, RayAnswers& out) {
     return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
         if (occlusion) {
             if (embree.occluded(rays[i])) t = 0.0f, prim = 0;
@@ -83,7 +83,8 @@ double nearest_hit_double(const Ray& ray, const TriangleMesh& mesh) {
         if (det == 0.0) continue;
         const Vec3d tv = o - p[0], q = cross(tv, e1);
         const double u = dot(tv, pv) / det, v = dot(d, q) / det, t = dot(e2, q) / det;
-        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > double(ray.tmin) && t < double(ray.tmax) && t < best) best = t;
+        if (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > double(ray.tmin) && t < double(ray.tmax) && t < best)
+            best = t;
     }
     return best;
 }
@@ -110,14 +111,16 @@ Disagreements compare_answers(const RayAnswers& a, const RayAnswers& b, const st
         if (!ha && !hb) continue;
         const float diff = std::fabs(a.t[i] - b.t[i]), scale = std::max(std::fabs(a.t[i]), std::fabs(b.t[i]));
         const Ray& r = rays[i];
-        const float tol = 1e-4f * (std::isinf(scale) ? 0.0f : scale) + 1e-6f * max_component(abs(r.origin)) / length(r.dir);
+        const float tol =
+            1e-4f * (std::isinf(scale) ? 0.0f : scale) + 1e-6f * max_component(abs(r.origin)) / length(r.dir);
         if (ha == hb && a.prim[i] == b.prim[i] && diff <= tol) continue;
         if (ha == hb && a.prim[i] != b.prim[i] && diff <= 1e-6f * scale) {
             ++d.ties;
             continue;
         }
         if (arbitrations++ < kMaxArbitrations &&
-            agrees_with_double(a.t[i], a.prim[i], nearest_hit_double(r, mesh), tol + 1e-4f * std::fabs(a.t[i])))
+            agrees_with_double(a.t[i], a.prim[i], nearest_hit_double(r, mesh),
+                               tol + 1e-4f * std::fabs(a.t[i])))
             ++d.confirmed_for_a;
         else
             ++d.total;

@@ -25,11 +25,11 @@ struct PassTime {
 };
 
 /// Traces `rays` with sahara on `threads` threads (FTZ/DAZ as given).
-PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads, bool ftz,
-                      RayAnswers& out);
-/// The same with Embree's rtcIntersect1 / rtcOccluded1.
-PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion, int threads,
+PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads,
                       bool ftz, RayAnswers& out);
+/// The same with Embree's rtcIntersect1 / rtcOccluded1.
+PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion,
+                      int threads, bool ftz, RayAnswers& out);
 
 struct Disagreements {
     size_t total = 0;  ///< hit/miss differ, t differs beyond tolerance, or another primitive at a different t

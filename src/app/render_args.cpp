@@ -101,7 +101,8 @@ std::string frame_output_name(const std::string& pattern, int frame) {
     if (hash != std::string::npos) {
         const size_t run = pattern.find_first_not_of('#', hash);
         const size_t width = (run == std::string::npos ? pattern.size() : run) - hash;
-        const std::string padded = std::string(width > number.size() ? width - number.size() : 0, '0') + number;
+        const std::string padded =
+            std::string(width > number.size() ? width - number.size() : 0, '0') + number;
         return pattern.substr(0, hash) + padded + pattern.substr(hash + width);
     }
     // %d or %0Nd, parsed here rather than handed to printf (a file name is no format string).
@@ -112,32 +113,44 @@ std::string frame_output_name(const std::string& pattern, int frame) {
         while (q < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[q])) && width < 100)
             width = width * 10 + size_t(pattern[q++] - '0');
         if (q < pattern.size() && pattern[q] == 'd') {
-            const std::string padded = std::string(width > number.size() ? width - number.size() : 0, '0') + number;
+            const std::string padded =
+                std::string(width > number.size() ? width - number.size() : 0, '0') + number;
             return pattern.substr(0, p) + padded + pattern.substr(q + 1);
         }
     }
-    throw UsageError("--frames: the output name '" + pattern + "' needs # or %04d where the frame number goes");
+    throw UsageError("--frames: the output name '" + pattern +
+                     "' needs # or %04d where the frame number goes");
 }
 
 bool parse_override_flag(const std::vector<std::string>& args, size_t& i, RenderOverrides& o) {
     const std::string& a = args[i];
-    if (a == "--spp") o.spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
-    else if (a == "--width") o.width = int(parse_int_value(a, flag_value(args, i), 1, 32768));
-    else if (a == "--height") o.height = int(parse_int_value(a, flag_value(args, i), 1, 32768));
-    else if (a == "--max-depth") o.max_depth = int(parse_int_value(a, flag_value(args, i), 0, 100000));
-    else if (a == "--seed") o.seed = uint64_t(parse_int_value(a, flag_value(args, i), 0, (1LL << 62)));
-    else if (a == "--integrator") o.integrator = parse_integrator_name(a, flag_value(args, i));
-    else if (a == "--time") o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
-    else if (a == "--target-error") o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
-    else if (a == "--sampler") o.sampler = parse_sampler_name(a, flag_value(args, i));
-    else if (a == "--exposure") o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
+    if (a == "--spp")
+        o.spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
+    else if (a == "--width")
+        o.width = int(parse_int_value(a, flag_value(args, i), 1, 32768));
+    else if (a == "--height")
+        o.height = int(parse_int_value(a, flag_value(args, i), 1, 32768));
+    else if (a == "--max-depth")
+        o.max_depth = int(parse_int_value(a, flag_value(args, i), 0, 100000));
+    else if (a == "--seed")
+        o.seed = uint64_t(parse_int_value(a, flag_value(args, i), 0, (1LL << 62)));
+    else if (a == "--integrator")
+        o.integrator = parse_integrator_name(a, flag_value(args, i));
+    else if (a == "--time")
+        o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
+    else if (a == "--target-error")
+        o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
+    else if (a == "--sampler")
+        o.sampler = parse_sampler_name(a, flag_value(args, i));
+    else if (a == "--exposure")
+        o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
     else if (a == "--tonemap") {
         const std::string& v = flag_value(args, i);
         const std::optional<Tonemap> t = tonemap_from_name(v);
         if (!t) throw UsageError(a + ": expected clamp|reinhard|aces|filmic, got '" + v + "'");
         o.tonemap = *t;
-    }
-    else return false;
+    } else
+        return false;
     return true;
 }
 
@@ -159,24 +172,40 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
     RenderArgs r;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "-h" || a == "--help") r.help = true;
-        else if (a == "-o" || a == "--output") r.output = flag_value(args, i);
-        else if (a == "--threads") r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
-        else if (a == "--quiet" || a == "-q") r.quiet = true;
-        else if (a == "--stats") r.stats = true;
-        else if (a == "--checkpoint") r.checkpoint_s = parse_real_value(a, flag_value(args, i), 0.1, 1e9);
-        else if (a == "--resume") r.resume = flag_value(args, i);
-        else if (a == "--reference") r.reference = flag_value(args, i);
-        else if (a == "--preview") r.preview = true;
-        else if (a == "--preview-dump") r.preview_dump = flag_value(args, i);
-        else if (a == "--frames") r.frames = parse_frame_range(a, flag_value(args, i));
-        else if (parse_override_flag(args, i, r.overrides)) continue;
-        else if (!a.empty() && a[0] == '-') throw UsageError("unknown option '" + a + "'");
-        else if (r.scene) throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
-        else r.scene = a;
+        if (a == "-h" || a == "--help")
+            r.help = true;
+        else if (a == "-o" || a == "--output")
+            r.output = flag_value(args, i);
+        else if (a == "--threads")
+            r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
+        else if (a == "--quiet" || a == "-q")
+            r.quiet = true;
+        else if (a == "--stats")
+            r.stats = true;
+        else if (a == "--checkpoint")
+            r.checkpoint_s = parse_real_value(a, flag_value(args, i), 0.1, 1e9);
+        else if (a == "--resume")
+            r.resume = flag_value(args, i);
+        else if (a == "--reference")
+            r.reference = flag_value(args, i);
+        else if (a == "--preview")
+            r.preview = true;
+        else if (a == "--preview-dump")
+            r.preview_dump = flag_value(args, i);
+        else if (a == "--frames")
+            r.frames = parse_frame_range(a, flag_value(args, i));
+        else if (parse_override_flag(args, i, r.overrides))
+            continue;
+        else if (!a.empty() && a[0] == '-')
+            throw UsageError("unknown option '" + a + "'");
+        else if (r.scene)
+            throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
+        else
+            r.scene = a;
     }
     if (r.frames) {
-        if (r.resume) throw UsageError("--frames and --resume cannot be combined (resume one frame at a time)");
+        if (r.resume)
+            throw UsageError("--frames and --resume cannot be combined (resume one frame at a time)");
         frame_output_name(r.output, r.frames->first);  // checks the pattern now
     }
     return r;

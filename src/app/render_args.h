@@ -36,12 +36,12 @@ struct RenderArgs {
     bool quiet = false;
     bool stats = false;
     bool help = false;
-    std::optional<double> checkpoint_s;      ///< --checkpoint: write the partial image this often
-    std::optional<std::string> resume;       ///< --resume: continue the render stored in this EXR
-    std::optional<std::string> reference;    ///< --reference: report the true error against this image
-    bool auto_exposure = false;              ///< pick the exposure from the image (sahara view)
-    bool preview = false;                    ///< --preview: live window
-    std::optional<std::string> preview_dump; ///< --preview-dump: write the window's last frame here
+    std::optional<double> checkpoint_s;       ///< --checkpoint: write the partial image this often
+    std::optional<std::string> resume;        ///< --resume: continue the render stored in this EXR
+    std::optional<std::string> reference;     ///< --reference: report the true error against this image
+    bool auto_exposure = false;               ///< pick the exposure from the image (sahara view)
+    bool preview = false;                     ///< --preview: live window
+    std::optional<std::string> preview_dump;  ///< --preview-dump: write the window's last frame here
     RenderOverrides overrides;
     // --- sequences (distributed over MPI ranks when launched by mpirun) ---
     std::optional<std::pair<int, int>> frames;  ///< --frames A..B: render frames A to B (inclusive)

@@ -14,20 +14,27 @@ namespace {
 
 const char* integrator_name(IntegratorType t) {
     switch (t) {
-        case IntegratorType::path: return "path";
-        case IntegratorType::whitted: return "whitted";
-        case IntegratorType::albedo: return "albedo";
-        case IntegratorType::normals: return "normals";
-        case IntegratorType::depth: return "depth";
-        case IntegratorType::bvh_cost: return "bvh-cost";
+        case IntegratorType::path:
+            return "path";
+        case IntegratorType::whitted:
+            return "whitted";
+        case IntegratorType::albedo:
+            return "albedo";
+        case IntegratorType::normals:
+            return "normals";
+        case IntegratorType::depth:
+            return "depth";
+        case IntegratorType::bvh_cost:
+            return "bvh-cost";
     }
     return "?";
 }
 
 /// State channel names; a double is stored as its high and low 32 bits.
-const char* const kStateChannels[] = {"sahara_state.sum_r_hi", "sahara_state.sum_r_lo", "sahara_state.sum_g_hi",
-                                      "sahara_state.sum_g_lo", "sahara_state.sum_b_hi", "sahara_state.sum_b_lo",
-                                      "sahara_state.sumsq_hi", "sahara_state.sumsq_lo", "sahara_state.count"};
+const char* const kStateChannels[] = {
+    "sahara_state.sum_r_hi", "sahara_state.sum_r_lo", "sahara_state.sum_g_hi",
+    "sahara_state.sum_g_lo", "sahara_state.sum_b_hi", "sahara_state.sum_b_lo",
+    "sahara_state.sumsq_hi", "sahara_state.sumsq_lo", "sahara_state.count"};
 constexpr size_t kStateChannelCount = sizeof(kStateChannels) / sizeof(kStateChannels[0]);
 
 uint64_t bits_of(double v) {
@@ -71,10 +78,14 @@ const std::string* find_key(const ImageMetadata& meta, const std::string& key) {
 
 const char* stop_reason_name(StopReason r) {
     switch (r) {
-        case StopReason::complete: return "complete";
-        case StopReason::converged: return "converged";
-        case StopReason::time_limit: return "time limit";
-        case StopReason::interrupted: return "interrupted";
+        case StopReason::complete:
+            return "complete";
+        case StopReason::converged:
+            return "converged";
+        case StopReason::time_limit:
+            return "time limit";
+        case StopReason::interrupted:
+            return "interrupted";
     }
     return "?";
 }
@@ -135,22 +146,25 @@ size_t write_render(const std::filesystem::path& file, const Scene& scene, const
 double resume_film(const std::filesystem::path& file, const Scene& scene, Film& film) {
     const std::string name = file.string();
     const ImageMetadata meta = read_image_metadata(file);
-    if (!find_key(meta, "version")) throw input_error(name, "", "not an image written by sahara (no sahara metadata)");
+    if (!find_key(meta, "version"))
+        throw input_error(name, "", "not an image written by sahara (no sahara metadata)");
     for (const auto& [key, want] : render_identity(scene)) {
         const std::string* have = find_key(meta, key);
         if (!have || *have != want)
             throw input_error(name, key,
-                              "cannot resume: the file was rendered with " + (have ? *have : std::string("(none)")) +
-                                  ", this render uses " + want);
+                              "cannot resume: the file was rendered with " +
+                                  (have ? *have : std::string("(none)")) + ", this render uses " + want);
     }
     std::vector<std::string> names(kStateChannels, kStateChannels + kStateChannelCount);
     int w = 0, h = 0;
     const std::vector<ExtraChannel> ch = read_extra_channels(file, names, &w, &h);
-    if (w != film.width() || h != film.height()) throw input_error(name, "", "image size differs from the render");
+    if (w != film.width() || h != film.height())
+        throw input_error(name, "", "image size differs from the render");
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
-            const Vec3d sum(double_of(ch[0].values[i], ch[1].values[i]), double_of(ch[2].values[i], ch[3].values[i]),
+            const Vec3d sum(double_of(ch[0].values[i], ch[1].values[i]),
+                            double_of(ch[2].values[i], ch[3].values[i]),
                             double_of(ch[4].values[i], ch[5].values[i]));
             film.set_pixel_state(x, y, sum, double_of(ch[6].values[i], ch[7].values[i]), ch[8].values[i]);
         }

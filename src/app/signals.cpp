@@ -19,7 +19,8 @@ extern "C" void on_stop_signal(int) {
         remove_pending_file();
         ::_exit(kExitInterrupted);
     }
-    static const char msg[] = "\nsahara: stopping after the samples in flight (again to quit without saving)\n";
+    static const char msg[] =
+        "\nsahara: stopping after the samples in flight (again to quit without saving)\n";
     [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, msg, sizeof(msg) - 1);
 }
 

@@ -12,7 +12,7 @@ inline constexpr int kRayKinds = 3;
 
 /// Counters one thread accumulates.
 struct Counters {
-    uint64_t rays[kRayKinds] = {};  ///< camera rays; closest-hit queries; occlusion (shadow) queries
+    uint64_t rays[kRayKinds] = {};   ///< camera rays; closest-hit queries; occlusion (shadow) queries
     uint64_t bvh_nodes_visited = 0;  ///< filled by the BVH when it records traversal steps
     uint64_t bvh_primitive_tests = 0;
     uint64_t bvh_leaves_visited = 0;

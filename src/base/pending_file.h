@@ -8,7 +8,7 @@ namespace sahara {
 
 /// Registers `path` as the file in progress for the lifetime of this object.
 class PendingFile {
-public:
+   public:
     explicit PendingFile(const std::string& path);
     ~PendingFile();
     PendingFile(const PendingFile&) = delete;

@@ -15,7 +15,9 @@ inline constexpr uint32_t kNoPrim = 0xFFFFFFFFu;
 enum class PrimKind : uint32_t { triangle = 0, sphere = 1, box = 2, plane = 3, quadric = 4 };
 inline constexpr int kPrimKindShift = 29;
 inline constexpr uint32_t kPrimIndexMask = (1u << kPrimKindShift) - 1u;
-constexpr uint32_t make_prim_id(PrimKind kind, uint32_t index) { return (uint32_t(kind) << kPrimKindShift) | index; }
+constexpr uint32_t make_prim_id(PrimKind kind, uint32_t index) {
+    return (uint32_t(kind) << kPrimKindShift) | index;
+}
 constexpr PrimKind prim_kind(uint32_t id) { return PrimKind(id >> kPrimKindShift); }
 constexpr uint32_t prim_index(uint32_t id) { return id & kPrimIndexMask; }
 

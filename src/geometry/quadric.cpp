@@ -44,7 +44,8 @@ Vec3d point_to(const Mat4& m, const Vec3d& p) {
             m.m[2][0] * p.x + m.m[2][1] * p.y + m.m[2][2] * p.z + m.m[2][3]};
 }
 Vec3d vector_to(const Mat4& m, const Vec3d& v) {
-    return {m.m[0][0] * v.x + m.m[0][1] * v.y + m.m[0][2] * v.z, m.m[1][0] * v.x + m.m[1][1] * v.y + m.m[1][2] * v.z,
+    return {m.m[0][0] * v.x + m.m[0][1] * v.y + m.m[0][2] * v.z,
+            m.m[1][0] * v.x + m.m[1][1] * v.y + m.m[1][2] * v.z,
             m.m[2][0] * v.x + m.m[2][1] * v.y + m.m[2][2] * v.z};
 }
 
@@ -91,7 +92,8 @@ float accept_t(double t_unit, double inv_len, const Ray& ray) {
 Vec3d reference_point(const Quadric& q) {
     Vec3d c(0.0);
     for (int k = 0; k < 3; ++k)
-        if (std::isfinite(q.clip_lo[k]) && std::isfinite(q.clip_hi[k])) c[k] = 0.5 * (q.clip_lo[k] + q.clip_hi[k]);
+        if (std::isfinite(q.clip_lo[k]) && std::isfinite(q.clip_hi[k]))
+            c[k] = 0.5 * (q.clip_lo[k] + q.clip_hi[k]);
     return c;
 }
 
@@ -105,7 +107,8 @@ double Quadric::eval(const Vec3d& p) const {
 
 Vec3d Quadric::gradient(const Vec3d& p) const {
     const auto& k = coeffs;
-    return {2.0 * k[0] * p.x + k[3] * p.y + k[4] * p.z + k[6], 2.0 * k[1] * p.y + k[3] * p.x + k[5] * p.z + k[7],
+    return {2.0 * k[0] * p.x + k[3] * p.y + k[4] * p.z + k[6],
+            2.0 * k[1] * p.y + k[3] * p.x + k[5] * p.z + k[7],
             2.0 * k[2] * p.z + k[4] * p.x + k[5] * p.y + k[8]};
 }
 
@@ -121,7 +124,8 @@ QuadricHit Quadric::intersect(const Ray& ray) const {
     const double shift = dot(solve_origin - o, d);
     o = o + d * shift;
     const auto& k = coeffs;
-    const double a = d.x * (k[0] * d.x + k[3] * d.y + k[4] * d.z) + d.y * (k[1] * d.y + k[5] * d.z) + k[2] * d.z * d.z;
+    const double a =
+        d.x * (k[0] * d.x + k[3] * d.y + k[4] * d.z) + d.y * (k[1] * d.y + k[5] * d.z) + k[2] * d.z * d.z;
     const double b = dot(gradient(o), d);
     const double c = eval(o);
     double roots[2];
@@ -130,7 +134,10 @@ QuadricHit Quadric::intersect(const Ray& ray) const {
     for (int i = 0; i < n; ++i) {  // ascending: the first accepted root is the nearest
         if (!inside_clip(*this, o + d * roots[i])) continue;
         const float t = accept_t(shift + roots[i], inv_len, ray);
-        if (t >= 0.0f) { best = {t, QuadricPart::side}; break; }
+        if (t >= 0.0f) {
+            best = {t, QuadricPart::side};
+            break;
+        }
     }
     if ((cap_bottom || cap_top) && d.z != 0.0) {
         for (int side = 0; side < 2; ++side) {
@@ -200,24 +207,35 @@ namespace {
 /// Object-frame box around the clipped surface (finite for every form).
 void object_box(const Quadric& q, Vec3d& lo, Vec3d& hi) {
     switch (q.form) {
-        case QuadricForm::ellipsoid: lo = Vec3d(-1.0); hi = Vec3d(1.0); return;
+        case QuadricForm::ellipsoid:
+            lo = Vec3d(-1.0);
+            hi = Vec3d(1.0);
+            return;
         case QuadricForm::cylinder:
         case QuadricForm::cone:
-        case QuadricForm::paraboloid: lo = {-1, -1, 0}; hi = {1, 1, 1}; return;
+        case QuadricForm::paraboloid:
+            lo = {-1, -1, 0};
+            hi = {1, 1, 1};
+            return;
         case QuadricForm::hyperboloid: {
             const double r = std::sqrt(1.0 - q.coeffs[2]);  // radius at z = +-1
-            lo = {-r, -r, -1}; hi = {r, r, 1};
+            lo = {-r, -r, -1};
+            hi = {r, r, 1};
             return;
         }
-        case QuadricForm::general: lo = q.clip_lo; hi = q.clip_hi; return;
+        case QuadricForm::general:
+            lo = q.clip_lo;
+            hi = q.clip_hi;
+            return;
     }
 }
 
 /// Grows a box by a relative margin and rounds it outwards to float, so that
 /// float slab tests never cut off a point of the exact surface.
 Bounds3 padded_bounds(const Vec3d& lo, const Vec3d& hi) {
-    const double margin = 1e-6 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, std::abs(lo.x), std::abs(hi.x),
-                                           std::abs(lo.y), std::abs(hi.y), std::abs(lo.z), std::abs(hi.z)});
+    const double margin =
+        1e-6 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, std::abs(lo.x), std::abs(hi.x),
+                         std::abs(lo.y), std::abs(hi.y), std::abs(lo.z), std::abs(hi.z)});
     Bounds3 b;
     for (int k = 0; k < 3; ++k) {
         b.lo[k] = std::nextafter(float(lo[k] - margin), -kInfinity);
@@ -235,7 +253,8 @@ void Quadric::finalize() {
     if (form == QuadricForm::ellipsoid) {
         // The image of the unit sphere under M extends sqrt(sum_j M_ij²) along world axis i.
         Vec3d c(m[0][3], m[1][3], m[2][3]), e;
-        for (int i = 0; i < 3; ++i) e[i] = std::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2]);
+        for (int i = 0; i < 3; ++i)
+            e[i] = std::sqrt(m[i][0] * m[i][0] + m[i][1] * m[i][1] + m[i][2] * m[i][2]);
         world_bounds = padded_bounds(c - e, c + e);
         return;
     }
@@ -290,8 +309,8 @@ Mat4 rotate_z_to(const Vec3& axis_f) {
 }
 
 /// A named surface of revolution about +z: placement = user * T(origin) * R(axis) * S(rxy, rxy, sz).
-Quadric make_revolved(QuadricForm form, const std::array<double, 10>& coeffs, const Vec3& origin, const Vec3& axis,
-                      double rxy, double sz, const Mat4& world_from_object) {
+Quadric make_revolved(QuadricForm form, const std::array<double, 10>& coeffs, const Vec3& origin,
+                      const Vec3& axis, double rxy, double sz, const Mat4& world_from_object) {
     require_transform(world_from_object);
     Quadric q;
     q.form = form;
@@ -320,8 +339,8 @@ Quadric make_cylinder(const Vec3& base, const Vec3& axis, float radius, float he
                       const Mat4& world_from_object) {
     require_positive("radius", double(radius));
     require_positive("height", double(height));
-    Quadric q = make_revolved(QuadricForm::cylinder, {1, 1, 0, 0, 0, 0, 0, 0, 0, -1}, base, axis, radius, height,
-                              world_from_object);
+    Quadric q = make_revolved(QuadricForm::cylinder, {1, 1, 0, 0, 0, 0, 0, 0, 0, -1}, base, axis, radius,
+                              height, world_from_object);
     q.clip_lo.z = 0.0;
     q.clip_hi.z = 1.0;
     q.cap_bottom = q.cap_top = capped;
@@ -348,8 +367,8 @@ Quadric make_paraboloid(const Vec3& vertex, const Vec3& axis, float radius, floa
                         const Mat4& world_from_object) {
     require_positive("radius", double(radius));
     require_positive("height", double(height));
-    Quadric q = make_revolved(QuadricForm::paraboloid, {1, 1, 0, 0, 0, 0, 0, 0, -1, 0}, vertex, axis, radius, height,
-                              world_from_object);
+    Quadric q = make_revolved(QuadricForm::paraboloid, {1, 1, 0, 0, 0, 0, 0, 0, -1, 0}, vertex, axis, radius,
+                              height, world_from_object);
     q.clip_hi.z = 1.0;  // x² + y² = z >= 0 already bounds it below
     q.finalize();
     return q;
@@ -363,8 +382,8 @@ Quadric make_hyperboloid(const Vec3& center, const Vec3& axis, float radius, flo
         throw InputError("radius: expected a number >= waist (" + number_text(double(waist)) + "), got " +
                          number_text(double(radius)));
     const double ratio = double(radius) / double(waist);
-    Quadric q = make_revolved(QuadricForm::hyperboloid, {1, 1, -(ratio * ratio - 1.0), 0, 0, 0, 0, 0, 0, -1}, center,
-                              axis, waist, 0.5 * double(height), world_from_object);
+    Quadric q = make_revolved(QuadricForm::hyperboloid, {1, 1, -(ratio * ratio - 1.0), 0, 0, 0, 0, 0, 0, -1},
+                              center, axis, waist, 0.5 * double(height), world_from_object);
     q.clip_lo.z = -1.0;
     q.clip_hi.z = 1.0;
     q.finalize();

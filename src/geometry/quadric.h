@@ -39,9 +39,9 @@ struct QuadricHit {
 
 /// Shading-independent data at an accepted hit.
 struct QuadricSurface {
-    Vec3 p;                  ///< world-space point, projected onto the surface
-    Vec3 n;                  ///< outward unit geometric normal (not flipped towards the ray)
-    Vec2 uv;                 ///< cylinder/cone/paraboloid/hyperboloid: (angle, height); ellipsoid: spherical; caps: planar
+    Vec3 p;   ///< world-space point, projected onto the surface
+    Vec3 n;   ///< outward unit geometric normal (not flipped towards the ray)
+    Vec2 uv;  ///< cylinder/cone/paraboloid/hyperboloid: (angle, height); ellipsoid: spherical; caps: planar
     bool front_face = true;  ///< the ray arrived from the outward side
 };
 

@@ -23,8 +23,10 @@ struct Sphere {
     Bounds3 bounds(float t0 = 0, float t1 = 0) const {
         Bounds3 b;
         Vec3 r(radius);
-        b.extend(center_at(t0) - r); b.extend(center_at(t0) + r);
-        b.extend(center_at(t1) - r); b.extend(center_at(t1) + r);
+        b.extend(center_at(t0) - r);
+        b.extend(center_at(t0) + r);
+        b.extend(center_at(t1) - r);
+        b.extend(center_at(t1) + r);
         return b;
     }
 };

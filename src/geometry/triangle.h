@@ -20,18 +20,24 @@ namespace sahara {
 /// Per-ray constants of the watertight test (computed once per ray).
 struct TriangleRay {
     float org[3];
-    int kx = 0, ky = 1, kz = 2;  ///< axis permutation: kz = dominant direction axis
+    int kx = 0, ky = 1, kz = 2;    ///< axis permutation: kz = dominant direction axis
     float sx = 0, sy = 0, sz = 1;  ///< shear constants
 
     explicit TriangleRay(const Ray& ray) {
-        org[0] = ray.origin.x; org[1] = ray.origin.y; org[2] = ray.origin.z;
+        org[0] = ray.origin.x;
+        org[1] = ray.origin.y;
+        org[2] = ray.origin.z;
         const Vec3 a = abs(ray.dir);
         kz = max_dimension(a);
         kx = kz == 2 ? 0 : kz + 1;
         ky = kx == 2 ? 0 : kx + 1;
         // Swapping kx and ky for a negative dominant component preserves the
         // winding, so the sign of the determinant tells the side that was hit.
-        if (ray.dir[kz] < 0.0f) { int t = kx; kx = ky; ky = t; }
+        if (ray.dir[kz] < 0.0f) {
+            int t = kx;
+            kx = ky;
+            ky = t;
+        }
         sx = ray.dir[kx] / ray.dir[kz];
         sy = ray.dir[ky] / ray.dir[kz];
         sz = 1.0f / ray.dir[kz];
@@ -67,9 +73,12 @@ inline bool intersect_triangle(const TriangleRay& tr, const TriangleVerts& tri, 
                                TriangleHit& out) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     // Vertices relative to the ray origin.
-    const float a_x = tri.p[0][kx] - tr.org[kx], a_y = tri.p[0][ky] - tr.org[ky], a_z = tri.p[0][kz] - tr.org[kz];
-    const float b_x = tri.p[1][kx] - tr.org[kx], b_y = tri.p[1][ky] - tr.org[ky], b_z = tri.p[1][kz] - tr.org[kz];
-    const float c_x = tri.p[2][kx] - tr.org[kx], c_y = tri.p[2][ky] - tr.org[ky], c_z = tri.p[2][kz] - tr.org[kz];
+    const float a_x = tri.p[0][kx] - tr.org[kx], a_y = tri.p[0][ky] - tr.org[ky],
+                a_z = tri.p[0][kz] - tr.org[kz];
+    const float b_x = tri.p[1][kx] - tr.org[kx], b_y = tri.p[1][ky] - tr.org[ky],
+                b_z = tri.p[1][kz] - tr.org[kz];
+    const float c_x = tri.p[2][kx] - tr.org[kx], c_y = tri.p[2][ky] - tr.org[ky],
+                c_z = tri.p[2][kz] - tr.org[kz];
     // Shear so the ray becomes the +z axis.
     const float ax = a_x - tr.sx * a_z, ay = a_y - tr.sy * a_z;
     const float bx = b_x - tr.sx * b_z, by = b_y - tr.sy * b_z;
@@ -106,7 +115,8 @@ inline Vec3 triangle_geometric_normal(const Vec3& p0, const Vec3& p1, const Vec3
 /// and `indices` (TriangleMesh, TriangleSoup); zero for a degenerate triangle.
 template <class Mesh>
 Vec3 triangle_geometric_normal(const Mesh& mesh, size_t i) {
-    const Vec3 n = triangle_geometric_normal(mesh.positions[mesh.indices[3 * i]], mesh.positions[mesh.indices[3 * i + 1]],
+    const Vec3 n = triangle_geometric_normal(mesh.positions[mesh.indices[3 * i]],
+                                             mesh.positions[mesh.indices[3 * i + 1]],
                                              mesh.positions[mesh.indices[3 * i + 2]]);
     const float len = length(n);
     return len > 0.0f ? n / len : Vec3(0.0f);
@@ -125,7 +135,8 @@ template <class Mesh>
 Vec3 triangle_shading_normal(const Mesh& mesh, size_t i, float u, float v) {
     if (mesh.normals.empty()) return triangle_geometric_normal(mesh, i);
     const uint32_t* id = &mesh.indices[3 * i];
-    const Vec3 n = barycentric_interpolate(mesh.normals[id[0]], mesh.normals[id[1]], mesh.normals[id[2]], u, v);
+    const Vec3 n =
+        barycentric_interpolate(mesh.normals[id[0]], mesh.normals[id[1]], mesh.normals[id[2]], u, v);
     const float len = length(n);
     return len > 0.0f ? n / len : triangle_geometric_normal(mesh, i);
 }

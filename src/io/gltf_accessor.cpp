@@ -14,22 +14,37 @@ namespace {
 
 int component_size(int type) {
     switch (type) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-        case TINYGLTF_COMPONENT_TYPE_SHORT: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-        default: return 0;  // INT and DOUBLE are not legal in glTF 2.0 accessors
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return 2;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return 4;
+        default:
+            return 0;  // INT and DOUBLE are not legal in glTF 2.0 accessors
     }
 }
 
 int component_count(int type) {
     switch (type) {
-        case TINYGLTF_TYPE_SCALAR: return 1;
-        case TINYGLTF_TYPE_VEC2: return 2;
-        case TINYGLTF_TYPE_VEC3: return 3;
-        case TINYGLTF_TYPE_VEC4: case TINYGLTF_TYPE_MAT2: return 4;
-        case TINYGLTF_TYPE_MAT3: return 9;
-        case TINYGLTF_TYPE_MAT4: return 16;
-        default: return 0;
+        case TINYGLTF_TYPE_SCALAR:
+            return 1;
+        case TINYGLTF_TYPE_VEC2:
+            return 2;
+        case TINYGLTF_TYPE_VEC3:
+            return 3;
+        case TINYGLTF_TYPE_VEC4:
+        case TINYGLTF_TYPE_MAT2:
+            return 4;
+        case TINYGLTF_TYPE_MAT3:
+            return 9;
+        case TINYGLTF_TYPE_MAT4:
+            return 16;
+        default:
+            return 0;
     }
 }
 
@@ -37,24 +52,30 @@ int component_count(int type) {
 double decode(const unsigned char* p, int type, bool normalized) {
     switch (type) {
         case TINYGLTF_COMPONENT_TYPE_BYTE: {
-            int8_t v; std::memcpy(&v, p, 1);
+            int8_t v;
+            std::memcpy(&v, p, 1);
             return normalized ? std::max(v / 127.0, -1.0) : v;
         }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return normalized ? p[0] / 255.0 : p[0];
         case TINYGLTF_COMPONENT_TYPE_SHORT: {
-            int16_t v; std::memcpy(&v, p, 2);
+            int16_t v;
+            std::memcpy(&v, p, 2);
             return normalized ? std::max(v / 32767.0, -1.0) : v;
         }
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-            uint16_t v; std::memcpy(&v, p, 2);
+            uint16_t v;
+            std::memcpy(&v, p, 2);
             return normalized ? v / 65535.0 : v;
         }
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-            uint32_t v; std::memcpy(&v, p, 4);
+            uint32_t v;
+            std::memcpy(&v, p, 4);
             return normalized ? v / 4294967295.0 : v;
         }
         default: {
-            float v; std::memcpy(&v, p, 4);
+            float v;
+            std::memcpy(&v, p, 4);
             return v;
         }
     }
@@ -102,22 +123,24 @@ void apply_sparse(const Source& src, const tinygltf::Accessor& acc, const std::s
         throw input_error(src.file, element, "count must be between 1 and the accessor's count");
     const int isize = component_size(sp.indices.componentType);
     if (isize == 0 || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
-        sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT || sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
+        sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+        sp.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
         throw input_error(src.file, element + ".indices", "componentType must be an unsigned integer type");
     if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0)
         throw input_error(src.file, element, "negative byteOffset");
     const size_t count = size_t(sp.count), csize = size_t(component_size(acc.componentType));
-    const View iv = view_for(src, sp.indices.bufferView, size_t(sp.indices.byteOffset), count, size_t(isize), true,
-                             element + ".indices");
-    const View vv = view_for(src, sp.values.bufferView, size_t(sp.values.byteOffset), count, csize * size_t(n), true,
-                             element + ".values");
+    const View iv = view_for(src, sp.indices.bufferView, size_t(sp.indices.byteOffset), count, size_t(isize),
+                             true, element + ".indices");
+    const View vv = view_for(src, sp.values.bufferView, size_t(sp.values.byteOffset), count,
+                             csize * size_t(n), true, element + ".values");
     for (size_t k = 0; k < count; ++k) {
         const auto target = size_t(decode(iv.data + k * iv.stride, sp.indices.componentType, false));
         if (target >= acc.count)
-            throw input_error(src.file, element + ".indices", "index " + std::to_string(target) + " out of range");
+            throw input_error(src.file, element + ".indices",
+                              "index " + std::to_string(target) + " out of range");
         for (int c = 0; c < n; ++c)
-            out[target * size_t(n) + size_t(c)] = decode(vv.data + k * vv.stride + size_t(c) * csize, acc.componentType,
-                                                         acc.normalized);
+            out[target * size_t(n) + size_t(c)] =
+                decode(vv.data + k * vv.stride + size_t(c) * csize, acc.componentType, acc.normalized);
     }
 }
 
@@ -130,14 +153,18 @@ std::vector<double> read_accessor(const Source& src, int index, const std::strin
     const tinygltf::Accessor& acc = m.accessors[size_t(index)];
     const std::string name = accessor_name(index);
     const int csize = component_size(acc.componentType), n = component_count(acc.type);
-    if (csize == 0) throw input_error(src.file, name, "invalid componentType " + std::to_string(acc.componentType));
+    if (csize == 0)
+        throw input_error(src.file, name, "invalid componentType " + std::to_string(acc.componentType));
     if (n != components)
-        throw input_error(src.file, name, "has " + std::to_string(n) + " components, " + user + " needs " +
-                                              std::to_string(components));
+        throw input_error(
+            src.file, name,
+            "has " + std::to_string(n) + " components, " + user + " needs " + std::to_string(components));
     // Without a bufferView the count is not backed by file data: cap it (16M numbers)
     // so that a few bytes of JSON cannot demand gigabytes.
     if (acc.bufferView < 0 && acc.count > (size_t(1) << 24) / size_t(n))
-        throw input_error(src.file, name, "count " + std::to_string(acc.count) + " too large for an accessor without bufferView");
+        throw input_error(
+            src.file, name,
+            "count " + std::to_string(acc.count) + " too large for an accessor without bufferView");
     std::vector<double> out;
     const size_t elem = size_t(csize) * size_t(n);
     if (acc.bufferView >= 0) {
@@ -153,7 +180,8 @@ std::vector<double> read_accessor(const Source& src, int index, const std::strin
     if (acc.sparse.isSparse) apply_sparse(src, acc, name, n, out);
     for (size_t i = 0; i < out.size(); ++i)
         if (!std::isfinite(out[i]))
-            throw input_error(src.file, name, "element " + std::to_string(i / size_t(n)) + " is not a finite number");
+            throw input_error(src.file, name,
+                              "element " + std::to_string(i / size_t(n)) + " is not a finite number");
     return out;
 }
 

@@ -15,8 +15,8 @@ namespace sahara::gltf {
 
 /// A parsed glTF file plus what sahara needs to name it in messages.
 struct Source {
-    std::string file;                ///< as given, for messages
-    std::filesystem::path dir;       ///< external URIs are relative to it
+    std::string file;           ///< as given, for messages
+    std::filesystem::path dir;  ///< external URIs are relative to it
     tinygltf::Model model;
     /// Encoded bytes of images given as data: URIs, captured while tinygltf parses.
     std::map<int, std::vector<unsigned char>> data_uri_images;
@@ -33,14 +33,14 @@ std::vector<uint32_t> read_indices(const Source& src, int index, const std::stri
 
 /// Converts glTF materials (and their textures and images) on demand.
 class Materials {
-public:
+   public:
     Materials(const Source& src, LoadedModel& out);
     /// Index into out.materials for glTF material `index` (-1: a default material).
     uint32_t get(int index, const std::string& user);
     /// The TEXCOORD set the material's base colour (else emissive) texture reads.
     int texcoord_set(int index) const;
 
-private:
+   private:
     MaterialDesc convert(const tinygltf::Material& m, const std::string& element);
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
     std::shared_ptr<const Image> image(int index, bool srgb, const std::string& element);

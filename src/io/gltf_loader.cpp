@@ -29,7 +29,8 @@ const std::set<std::string> kSupportedRequired = {"KHR_texture_transform", "KHR_
 std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
     std::error_code ec;
     if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
-    if (!std::filesystem::is_regular_file(file, ec)) throw input_error(file.string(), "", "not a regular file");
+    if (!std::filesystem::is_regular_file(file, ec))
+        throw input_error(file.string(), "", "not a regular file");
     std::ifstream in(file, std::ios::binary);
     if (!in) throw input_error(file.string(), "", "cannot open file");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -37,9 +38,13 @@ std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
     return bytes;
 }
 
-uint32_t le32(const unsigned char* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+uint32_t le32(const unsigned char* p) {
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 
-bool is_glb(const std::vector<unsigned char>& bytes) { return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0; }
+bool is_glb(const std::vector<unsigned char>& bytes) {
+    return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
 
 /// The JSON text of a .gltf, or of a .glb's first chunk, and the size of a
 /// .glb's BIN chunk (0 if none).
@@ -50,10 +55,13 @@ struct JsonPart {
 };
 
 JsonPart json_part(const std::string& file, const std::vector<unsigned char>& bytes) {
-    if (!is_glb(bytes)) return {std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), false, 0};
+    if (!is_glb(bytes))
+        return {std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), false, 0};
     if (bytes.size() < 20) throw input_error(file, "GLB header", "file is shorter than the 20-byte header");
-    if (le32(&bytes[4]) != 2) throw input_error(file, "GLB header", "version " + std::to_string(le32(&bytes[4])) + ", expected 2");
-    if (le32(&bytes[8]) > bytes.size()) throw input_error(file, "GLB header", "length is larger than the file");
+    if (le32(&bytes[4]) != 2)
+        throw input_error(file, "GLB header", "version " + std::to_string(le32(&bytes[4])) + ", expected 2");
+    if (le32(&bytes[8]) > bytes.size())
+        throw input_error(file, "GLB header", "length is larger than the file");
     const size_t json_len = le32(&bytes[12]);
     if (le32(&bytes[16]) != 0x4E4F534Au) throw input_error(file, "GLB chunk 0", "is not the JSON chunk");
     if (json_len > bytes.size() - 20) throw input_error(file, "GLB chunk 0", "runs past the end of the file");
@@ -82,9 +90,10 @@ void precheck(const std::string& file, const std::filesystem::path& dir, const J
         const std::string element = "buffers[" + std::to_string(i) + "]";
         if (!b.contains("uri")) {
             if (i == 0 && part.glb && length > part.bin_size)
-                throw input_error(file, element, "byteLength " + std::to_string(length) +
-                                                     " is larger than the GLB BIN chunk (" +
-                                                     std::to_string(part.bin_size) + " bytes)");
+                throw input_error(file, element,
+                                  "byteLength " + std::to_string(length) +
+                                      " is larger than the GLB BIN chunk (" + std::to_string(part.bin_size) +
+                                      " bytes)");
             continue;
         }
         if (!b["uri"].is_string()) continue;
@@ -92,11 +101,13 @@ void precheck(const std::string& file, const std::filesystem::path& dir, const J
         if (uri.rfind("data:", 0) == 0) continue;
         const std::filesystem::path path = dir / gltf::uri_decode(uri);
         std::error_code ec;
-        if (!std::filesystem::is_regular_file(path, ec)) throw input_error(file, element, "file " + uri + " not found");
+        if (!std::filesystem::is_regular_file(path, ec))
+            throw input_error(file, element, "file " + uri + " not found");
         const auto size = std::filesystem::file_size(path, ec);
         if (!ec && length > size)
-            throw input_error(file, element, "byteLength " + std::to_string(length) + " is larger than " + uri + " (" +
-                                                 std::to_string(size) + " bytes)");
+            throw input_error(file, element,
+                              "byteLength " + std::to_string(length) + " is larger than " + uri + " (" +
+                                  std::to_string(size) + " bytes)");
     }
 }
 
@@ -125,8 +136,10 @@ void parse(Source& src, const std::vector<unsigned char>& bytes) {
     if (bytes.size() > 0xFFFFFFFFu) throw input_error(src.file, "", "file is larger than 4 GB");
     try {
         const std::string base = src.dir.string();
-        ok = is_glb(bytes) ? loader.LoadBinaryFromMemory(&src.model, &err, &warn, bytes.data(), unsigned(bytes.size()), base)
-                           : loader.LoadASCIIFromString(&src.model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+        ok = is_glb(bytes) ? loader.LoadBinaryFromMemory(&src.model, &err, &warn, bytes.data(),
+                                                         unsigned(bytes.size()), base)
+                           : loader.LoadASCIIFromString(&src.model, &err, &warn,
+                                                        reinterpret_cast<const char*>(bytes.data()),
                                                         unsigned(bytes.size()), base);
     } catch (const std::exception& e) {
         throw input_error(src.file, "", std::string("malformed glTF: ") + e.what());

@@ -17,9 +17,12 @@ namespace {
 
 WrapMode wrap_mode(int gl) {
     switch (gl) {
-        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::clamp;
-        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::mirror;
-        default: return WrapMode::repeat;
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+            return WrapMode::clamp;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+            return WrapMode::mirror;
+        default:
+            return WrapMode::repeat;
     }
 }
 
@@ -63,15 +66,17 @@ uint32_t Materials::get(int index, const std::string& user) {
         throw input_error(src_.file, user, "material " + std::to_string(index) + " does not exist");
     if (auto it = converted_.find(index); it != converted_.end()) return it->second;
     const std::string element = "materials[" + std::to_string(index) + "]";
-    out_.materials.push_back(index < 0 ? default_material() : convert(src_.model.materials[size_t(index)], element));
+    out_.materials.push_back(index < 0 ? default_material()
+                                       : convert(src_.model.materials[size_t(index)], element));
     return converted_[index] = uint32_t(out_.materials.size() - 1);
 }
 
 int Materials::texcoord_set(int index) const {
     if (index < 0 || size_t(index) >= src_.model.materials.size()) return 0;
     const tinygltf::Material& m = src_.model.materials[size_t(index)];
-    const tinygltf::TextureInfo& info =
-        m.pbrMetallicRoughness.baseColorTexture.index >= 0 ? m.pbrMetallicRoughness.baseColorTexture : m.emissiveTexture;
+    const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture.index >= 0
+                                            ? m.pbrMetallicRoughness.baseColorTexture
+                                            : m.emissiveTexture;
     int set = info.texCoord;
     if (auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end())
         set = int(number(it->second, "texCoord", set));
@@ -123,7 +128,8 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
     const tinygltf::Texture& tex = m.textures[size_t(info.index)];
     const std::string tex_name = "textures[" + std::to_string(info.index) + "]";
     if (tex.source < 0) {
-        log_warning(src_.file + ": " + tex_name + ": no image source (extension-only images are not supported), ignored");
+        log_warning(src_.file + ": " + tex_name +
+                    ": no image source (extension-only images are not supported), ignored");
         return -1;
     }
     if (tex.sampler >= 0 && size_t(tex.sampler) >= m.samplers.size())
@@ -142,8 +148,8 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
     }
     set_transform(desc, offset, rotation, scale);
     std::ostringstream key;
-    key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x << ' '
-        << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation;
+    key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x
+        << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation;
     if (auto it = texture_keys_.find(key.str()); it != texture_keys_.end()) return it->second;
     desc.image = image(tex.source, srgb, tex_name);
     if (!desc.image) return texture_keys_[key.str()] = -1;
@@ -168,7 +174,8 @@ std::shared_ptr<const Image> Materials::image(int index, bool srgb, const std::s
         const std::filesystem::path path = src_.dir / uri_decode(img.uri);
         std::error_code ec;
         if (img.uri.empty() || !std::filesystem::is_regular_file(path, ec)) {
-            log_warning(src_.file + ": " + element + ": image file " + path.string() + " not found, texture ignored");
+            log_warning(src_.file + ": " + element + ": image file " + path.string() +
+                        " not found, texture ignored");
         } else {
             try {
                 result = read_image(path, srgb);
@@ -184,14 +191,16 @@ std::shared_ptr<const Image> Materials::decode_buffer_view_image(const tinygltf:
                                                                  const std::string& element) {
     const tinygltf::Model& m = src_.model;
     if (size_t(img.bufferView) >= m.bufferViews.size())
-        throw input_error(src_.file, element, "bufferView " + std::to_string(img.bufferView) + " does not exist");
+        throw input_error(src_.file, element,
+                          "bufferView " + std::to_string(img.bufferView) + " does not exist");
     const tinygltf::BufferView& view = m.bufferViews[size_t(img.bufferView)];
     const std::string view_name = "bufferViews[" + std::to_string(img.bufferView) + "]";
     if (view.buffer < 0 || size_t(view.buffer) >= m.buffers.size())
         throw input_error(src_.file, view_name, "buffer " + std::to_string(view.buffer) + " does not exist");
     const std::vector<unsigned char>& data = m.buffers[size_t(view.buffer)].data;
     if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
-        throw input_error(src_.file, view_name, "extends past the end of buffers[" + std::to_string(view.buffer) + "]");
+        throw input_error(src_.file, view_name,
+                          "extends past the end of buffers[" + std::to_string(view.buffer) + "]");
     return decode_image_bytes(data.data() + view.byteOffset, view.byteLength, srgb, src_.file, element);
 }
 

@@ -35,7 +35,7 @@ std::vector<uint32_t> to_triangle_list(const std::vector<uint32_t>& idx, int mod
 
 /// Builds world-space meshes, cameras and lights from the node tree.
 class SceneBuilder {
-public:
+   public:
     SceneBuilder(const Source& src, const Mat4& world_from_model, LoadedModel& out)
         : src_(src), m_(src.model), world_from_model_(world_from_model), out_(out), materials_(src, out) {}
 
@@ -43,7 +43,7 @@ public:
         for (int root : roots()) walk(root);
     }
 
-private:
+   private:
     /// Root nodes of the default scene (scene 0 if none is marked; all parentless nodes without scenes).
     std::vector<int> roots() const {
         if (!m_.scenes.empty()) {
@@ -74,7 +74,8 @@ private:
                 throw input_error(src_.file, "nodes", "node " + std::to_string(index) + " does not exist");
             const std::string element = indexed("nodes", size_t(index));
             if (visited_[size_t(index)])
-                throw input_error(src_.file, element, "reached twice (cycle or shared child in the node tree)");
+                throw input_error(src_.file, element,
+                                  "reached twice (cycle or shared child in the node tree)");
             visited_[size_t(index)] = true;
             const tinygltf::Node& node = m_.nodes[size_t(index)];
             const Mat4 world = parent * local_matrix(node, element);
@@ -120,7 +121,8 @@ private:
 
     void add_mesh(int mesh, const Mat4& world, const std::string& node_element) {
         if (size_t(mesh) >= m_.meshes.size())
-            throw input_error(src_.file, node_element + ".mesh", "mesh " + std::to_string(mesh) + " does not exist");
+            throw input_error(src_.file, node_element + ".mesh",
+                              "mesh " + std::to_string(mesh) + " does not exist");
         const auto& prims = m_.meshes[size_t(mesh)].primitives;
         for (size_t p = 0; p < prims.size(); ++p) {
             const auto key = std::make_pair(mesh, int(p));
@@ -152,9 +154,11 @@ private:
             return std::nullopt;
         }
         TriangleMesh out;
-        const std::vector<double> pos = read_accessor(src_, pos_it->second, element + ".attributes.POSITION", 3);
+        const std::vector<double> pos =
+            read_accessor(src_, pos_it->second, element + ".attributes.POSITION", 3);
         const size_t n = pos.size() / 3;
-        for (size_t i = 0; i < n; ++i) out.positions.emplace_back(float(pos[3 * i]), float(pos[3 * i + 1]), float(pos[3 * i + 2]));
+        for (size_t i = 0; i < n; ++i)
+            out.positions.emplace_back(float(pos[3 * i]), float(pos[3 * i + 1]), float(pos[3 * i + 2]));
         if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
             const auto nrm = read_attribute(it->second, element + ".attributes.NORMAL", 3, n);
             for (size_t i = 0; i < n; ++i) {
@@ -165,15 +169,17 @@ private:
         const std::string uv_name = "TEXCOORD_" + std::to_string(materials_.texcoord_set(prim.material));
         if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
             const auto uv = read_attribute(it->second, element + ".attributes." + uv_name, 2, n);
-            for (size_t i = 0; i < n; ++i) out.uvs.push_back({float(uv[2 * i]), 1.0f - float(uv[2 * i + 1])});  // v=0 at bottom
+            for (size_t i = 0; i < n; ++i)
+                out.uvs.push_back({float(uv[2 * i]), 1.0f - float(uv[2 * i + 1])});  // v=0 at bottom
         }
         std::vector<uint32_t> idx;
         if (prim.indices >= 0) {
             idx = read_indices(src_, prim.indices, element + ".indices");
             for (uint32_t i : idx)
                 if (i >= n)
-                    throw input_error(src_.file, element + ".indices", "index " + std::to_string(i) + " out of range (" +
-                                                                           std::to_string(n) + " vertices)");
+                    throw input_error(
+                        src_.file, element + ".indices",
+                        "index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
         } else {
             idx.resize(n);
             std::iota(idx.begin(), idx.end(), 0u);
@@ -183,18 +189,21 @@ private:
         return out;
     }
 
-    std::vector<double> read_attribute(int accessor, const std::string& element, int components, size_t count) {
+    std::vector<double> read_attribute(int accessor, const std::string& element, int components,
+                                       size_t count) {
         std::vector<double> v = read_accessor(src_, accessor, element, components);
         if (v.size() != count * size_t(components))
-            throw input_error(src_.file, element, "has " + std::to_string(v.size() / size_t(components)) +
-                                                      " elements, POSITION has " + std::to_string(count));
+            throw input_error(src_.file, element,
+                              "has " + std::to_string(v.size() / size_t(components)) +
+                                  " elements, POSITION has " + std::to_string(count));
         return v;
     }
 
     /// Camera looks down its local -Z with +Y up (glTF 2.0 spec, "Cameras").
     void add_camera(int index, const Mat4& world, const std::string& node_element) {
         if (size_t(index) >= m_.cameras.size())
-            throw input_error(src_.file, node_element + ".camera", "camera " + std::to_string(index) + " does not exist");
+            throw input_error(src_.file, node_element + ".camera",
+                              "camera " + std::to_string(index) + " does not exist");
         const tinygltf::Camera& cam = m_.cameras[size_t(index)];
         const Vec3 fwd = world.apply_vector({0, 0, -1}), up = world.apply_vector({0, 1, 0});
         if (length_squared(cross(fwd, up)) == 0.0f) {
@@ -233,7 +242,8 @@ private:
         Rgb color(1.0f);
         if (l.color.size() == 3) color = Rgb(float(l.color[0]), float(l.color[1]), float(l.color[2]));
         const Rgb power = color * float(l.intensity);
-        if (!is_finite(power)) throw input_error(src_.file, element, "color or intensity is not a finite number");
+        if (!is_finite(power))
+            throw input_error(src_.file, element, "color or intensity is not a finite number");
         LightDesc d;
         if (l.type == "directional") {
             const Vec3 dir = world.apply_vector({0, 0, -1});
@@ -242,8 +252,10 @@ private:
             d.direction = normalize(dir);
             d.irradiance = power;
         } else {
-            if (l.type == "spot") log_warning(src_.file + ": " + element + ": spot light treated as a point light");
-            else if (l.type != "point") throw input_error(src_.file, element + ".type", "unknown light type '" + l.type + "'");
+            if (l.type == "spot")
+                log_warning(src_.file + ": " + element + ": spot light treated as a point light");
+            else if (l.type != "point")
+                throw input_error(src_.file, element + ".type", "unknown light type '" + l.type + "'");
             d.position = world.apply_point({0, 0, 0});
             d.intensity = power;
         }

@@ -28,7 +28,9 @@ std::string format_hint(const unsigned char* data, size_t size) {
     return "";
 }
 
-uint32_t be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+uint32_t be32(const unsigned char* p) {
+    return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3];
+}
 
 /// CRC-32 (ISO 3309, as the PNG specification defines it) of `n` bytes.
 uint32_t crc32(const unsigned char* p, size_t n) {
@@ -66,11 +68,21 @@ void expand_to_rgba(const std::vector<float>& src, int channels, bool srgb, Imag
         const float* s = &src[i * size_t(channels)];
         float r = s[0], g = s[0], b = s[0], a = 1.0f;
         if (channels == 2) a = s[1];
-        if (channels >= 3) { g = s[1]; b = s[2]; }
+        if (channels >= 3) {
+            g = s[1];
+            b = s[2];
+        }
         if (channels >= 4) a = s[3];
-        if (srgb) { r = srgb_to_linear_value(r); g = srgb_to_linear_value(g); b = srgb_to_linear_value(b); }
+        if (srgb) {
+            r = srgb_to_linear_value(r);
+            g = srgb_to_linear_value(g);
+            b = srgb_to_linear_value(b);
+        }
         float* d = &out.rgba[i * 4];
-        d[0] = r; d[1] = g; d[2] = b; d[3] = a;
+        d[0] = r;
+        d[1] = g;
+        d[2] = b;
+        d[3] = a;
     }
 }
 
@@ -90,9 +102,9 @@ std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         throw input_error(file, element, "image has no pixels");
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        throw input_error(file, element, "image is " + std::to_string(spec.width) + "x" +
-                                             std::to_string(spec.height) + ", over " +
-                                             std::to_string(kMaxImageSide) + " pixels per side");
+        throw input_error(file, element,
+                          "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                              ", over " + std::to_string(kMaxImageSide) + " pixels per side");
     const int channels = std::min(spec.nchannels, 4);
     std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))

@@ -22,7 +22,8 @@ constexpr int kMaxImageSide = 32768;
 
 std::string lower_extension(const fs::path& file) {
     std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return ext;
 }
 
@@ -47,8 +48,9 @@ std::shared_ptr<const Image> read_image(const fs::path& file, bool srgb_to_linea
     if (!in) throw input_error(name, "", "cannot decode image: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        throw input_error(name, "", "image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                                        " is outside 1..32768 per side");
+        throw input_error(name, "",
+                          "image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                              " is outside 1..32768 per side");
     const int channels = spec.nchannels;
     std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
@@ -88,7 +90,8 @@ void check_output_path(const fs::path& file) {
     fs::path dir = file.parent_path();
     if (dir.empty()) dir = ".";
     std::error_code ec;
-    if (!fs::is_directory(dir, ec)) throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
+    if (!fs::is_directory(dir, ec))
+        throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
 }
 
@@ -156,7 +159,8 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
     const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
     auto out = OIIO::ImageOutput::create(tmp.string());
     if (!out) throw input_error(name, "", "cannot create image writer: " + OIIO::geterror());
-    bool ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, pixels.data()) && out->close();
+    bool ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, pixels.data()) &&
+              out->close();
     if (!ok) {
         std::error_code ec;
         fs::remove(tmp, ec);
@@ -181,8 +185,8 @@ ImageMetadata read_image_metadata(const fs::path& file) {
     return meta;
 }
 
-std::vector<ExtraChannel> read_extra_channels(const fs::path& file, const std::vector<std::string>& names, int* width,
-                                              int* height) {
+std::vector<ExtraChannel> read_extra_channels(const fs::path& file, const std::vector<std::string>& names,
+                                              int* width, int* height) {
     const std::string name = file.string();
     auto in = OIIO::ImageInput::open(name);
     if (!in) throw input_error(name, "", "cannot open image: " + OIIO::geterror());
@@ -194,7 +198,8 @@ std::vector<ExtraChannel> read_extra_channels(const fs::path& file, const std::v
         const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), channel);
         if (it == spec.channelnames.end()) throw input_error(name, channel, "channel missing");
         const int c = int(it - spec.channelnames.begin());
-        if (spec.channelformat(c) != OIIO::TypeDesc::UINT32) throw input_error(name, channel, "expected uint32 data");
+        if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
+            throw input_error(name, channel, "expected uint32 data");
         ExtraChannel ch{channel, std::vector<uint32_t>(size_t(spec.width) * size_t(spec.height))};
         if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::UINT32, ch.values.data()))
             throw input_error(name, channel, "cannot read: " + in->geterror());

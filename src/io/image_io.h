@@ -49,8 +49,8 @@ ImageMetadata read_image_metadata(const std::filesystem::path& file);
 
 /// Reads the named uint32 channels of an EXR written with extra channels.
 /// Throws InputError naming the file and the channel if one is missing.
-std::vector<ExtraChannel> read_extra_channels(const std::filesystem::path& file, const std::vector<std::string>& names,
-                                              int* width, int* height);
+std::vector<ExtraChannel> read_extra_channels(const std::filesystem::path& file,
+                                              const std::vector<std::string>& names, int* width, int* height);
 
 /// IEC 61966-2-1 sRGB transfer functions.
 float srgb_encode(float linear);

@@ -23,7 +23,9 @@ struct P2 {
 };
 
 /// Twice the signed area of 2-D triangle (a, b, c); positive when counter-clockwise.
-double orient(const P2& a, const P2& b, const P2& c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+double orient(const P2& a, const P2& b, const P2& c) {
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
 
 /// Point p inside or on the boundary of counter-clockwise triangle (a, b, c).
 bool in_triangle(const P2& p, const P2& a, const P2& b, const P2& c) {
@@ -39,7 +41,8 @@ std::vector<P2> project(std::span<const Vec3> polygon, const Vec3d& normal) {
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
     const double sign = normal[axis] < 0 ? -1.0 : 1.0;
     std::vector<P2> pts(polygon.size());
-    for (size_t i = 0; i < polygon.size(); ++i) pts[i] = {sign * double(polygon[i][u]), double(polygon[i][v])};
+    for (size_t i = 0; i < polygon.size(); ++i)
+        pts[i] = {sign * double(polygon[i][u]), double(polygon[i][v])};
     return pts;
 }
 
@@ -98,7 +101,9 @@ Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
     return len > 0.0f ? n / len : Vec3(0.0f);
 }
 
-bool is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) { return length_squared(cross(b - a, c - a)) == 0.0f; }
+bool is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) {
+    return length_squared(cross(b - a, c - a)) == 0.0f;
+}
 
 size_t remove_degenerate(TriangleMesh& mesh) {
     const size_t count = mesh.triangle_count();
@@ -120,7 +125,8 @@ void transform_mesh(TriangleMesh& mesh, const Mat4& world_from_model) {
     for (Vec3& p : mesh.positions) p = world_from_model.apply_point(p);
     for (Vec3& n : mesh.normals) n = world_from_model.apply_normal(n);
     if (world_from_model.determinant3() < 0)
-        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+        for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+            std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
 }
 
 Bounds3 mesh_bounds(const TriangleMesh& mesh) {

@@ -25,7 +25,8 @@ namespace {
 std::string read_text_file(const std::filesystem::path& file) {
     std::error_code ec;
     if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
-    if (!std::filesystem::is_regular_file(file, ec)) throw input_error(file.string(), "", "not a regular file");
+    if (!std::filesystem::is_regular_file(file, ec))
+        throw input_error(file.string(), "", "not a regular file");
     std::ifstream in(file, std::ios::binary);
     if (!in) throw input_error(file.string(), "", "cannot open file");
     std::ostringstream ss;
@@ -53,8 +54,9 @@ std::filesystem::path portable_path(std::string name) {
 /// separators tolerated); a missing one is a warning. Remembers the folder of
 /// the first one read: MTL texture paths are relative to it.
 class MtlFileReader : public tinyobj::MaterialReader {
-public:
-    explicit MtlFileReader(const std::filesystem::path& obj_file) : obj_file_(obj_file), dir_(obj_file.parent_path()) {}
+   public:
+    explicit MtlFileReader(const std::filesystem::path& obj_file)
+        : obj_file_(obj_file), dir_(obj_file.parent_path()) {}
 
     bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* names, std::string* warn, std::string* err) override {
@@ -63,8 +65,8 @@ public:
         std::ifstream in;
         if (std::filesystem::is_regular_file(path, ec)) in.open(path, std::ios::binary);
         if (!in.is_open()) {
-            log_warning(path.string() + ": material library not found (mtllib of " + obj_file_.filename().string() +
-                        "), using the default material");
+            log_warning(path.string() + ": material library not found (mtllib of " +
+                        obj_file_.filename().string() + "), using the default material");
             return false;
         }
         if (!found_) dir_ = path.parent_path();
@@ -75,7 +77,7 @@ public:
 
     const std::filesystem::path& texture_dir() const { return dir_; }
 
-private:
+   private:
     std::filesystem::path obj_file_, dir_;
     bool found_ = false;
 };
@@ -95,8 +97,10 @@ void reject_non_finite_words(const std::string& file, const std::string& text) {
         if (start == std::string_view::npos || line[start] != 'v') continue;
         int kind = -1;
         const std::string_view rest = line.substr(start);
-        if (rest.size() > 1 && (rest[1] == ' ' || rest[1] == '\t')) kind = 0;
-        else if (rest.size() > 2 && (rest[2] == ' ' || rest[2] == '\t')) kind = rest[1] == 't' ? 1 : rest[1] == 'n' ? 2 : -1;
+        if (rest.size() > 1 && (rest[1] == ' ' || rest[1] == '\t'))
+            kind = 0;
+        else if (rest.size() > 2 && (rest[2] == ' ' || rest[2] == '\t'))
+            kind = rest[1] == 't' ? 1 : rest[1] == 'n' ? 2 : -1;
         if (kind < 0) continue;
         ++counts[kind];
         const std::string_view numbers = rest.substr(0, rest.find('#'));  // comments may say anything
@@ -111,17 +115,20 @@ enum class TexUse { color, alpha };
 
 /// Loads MTL textures once per (file, use) and turns them into TextureDesc.
 class ObjTextures {
-public:
-    ObjTextures(LoadedModel& model, std::filesystem::path mtl_dir) : model_(model), dir_(std::move(mtl_dir)) {}
+   public:
+    ObjTextures(LoadedModel& model, std::filesystem::path mtl_dir)
+        : model_(model), dir_(std::move(mtl_dir)) {}
 
     /// Index into model.textures, or -1 (with a warning) when the file is missing.
-    int get(const std::string& name, const tinyobj::texture_option_t& opt, TexUse use, const std::string& what) {
+    int get(const std::string& name, const tinyobj::texture_option_t& opt, TexUse use,
+            const std::string& what) {
         const std::filesystem::path path = dir_ / portable_path(name);
         const auto key = std::make_pair(path.string(), use);
         if (auto it = cache_.find(key); it != cache_.end()) return it->second;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(path, ec)) {
-            log_warning(path.string() + ": " + what + " texture not found, material falls back to its colour");
+            log_warning(path.string() + ": " + what +
+                        " texture not found, material falls back to its colour");
             return cache_[key] = -1;
         }
         TextureDesc tex;
@@ -134,7 +141,7 @@ public:
         return cache_[key] = int(model_.textures.size()) - 1;
     }
 
-private:
+   private:
     /// map_d images are usually grey without an alpha channel: then the grey
     /// value is the alpha (MaterialDesc reads a texture's alpha channel).
     static std::shared_ptr<const Image> alpha_from_grey(std::shared_ptr<const Image> img) {
@@ -176,7 +183,8 @@ MaterialDesc convert_material(const tinyobj::material_t& m, ObjTextures& texture
     }
     out.alpha = std::clamp(float(m.dissolve), 0.0f, 1.0f);
     if (!m.alpha_texname.empty())
-        out.alpha_texture = textures.get(m.alpha_texname, m.alpha_texopt, TexUse::alpha, "map_d of " + m.name);
+        out.alpha_texture =
+            textures.get(m.alpha_texname, m.alpha_texopt, TexUse::alpha, "map_d of " + m.name);
     return out;
 }
 
@@ -202,14 +210,15 @@ struct VertexKey {
 };
 struct VertexKeyHash {
     size_t operator()(const VertexKey& k) const {
-        return std::hash<uint64_t>()((uint64_t(uint32_t(k.v)) << 32) ^ (uint64_t(uint32_t(k.vt)) * 0x9E3779B1u) ^
+        return std::hash<uint64_t>()((uint64_t(uint32_t(k.v)) << 32) ^
+                                     (uint64_t(uint32_t(k.vt)) * 0x9E3779B1u) ^
                                      (uint64_t(uint32_t(k.vn)) << 16));
     }
 };
 
 /// Turns one tinyobjloader shape (an OBJ group) into an indexed TriangleMesh.
 class ObjShapeBuilder {
-public:
+   public:
     ObjShapeBuilder(const std::string& file, const tinyobj::attrib_t& attrib, LoadedModel& model,
                     int& default_material)
         : file_(file), attrib_(attrib), model_(model), default_material_(default_material) {}
@@ -223,24 +232,27 @@ public:
         mesh_ = TriangleMesh{};
         mesh_.name = file_ + ": group '" + shape.name + "'";
         map_.clear();
-        with_normals_ = std::any_of(m.indices.begin(), m.indices.end(), [](auto& i) { return i.normal_index >= 0; });
-        with_uvs_ = std::any_of(m.indices.begin(), m.indices.end(), [](auto& i) { return i.texcoord_index >= 0; });
+        with_normals_ =
+            std::any_of(m.indices.begin(), m.indices.end(), [](auto& i) { return i.normal_index >= 0; });
+        with_uvs_ =
+            std::any_of(m.indices.begin(), m.indices.end(), [](auto& i) { return i.texcoord_index >= 0; });
         size_t offset = 0;
         for (size_t f = 0; f < m.num_face_vertices.size(); ++f) {
             ++face_number;
             const size_t n = m.num_face_vertices[f];
-            add_face(std::span(m.indices).subspan(offset, n), f < m.material_ids.size() ? m.material_ids[f] : -1,
-                     face_number);
+            add_face(std::span(m.indices).subspan(offset, n),
+                     f < m.material_ids.size() ? m.material_ids[f] : -1, face_number);
             offset += n;
         }
         return std::move(mesh_);
     }
 
-private:
+   private:
     void check(int index, size_t count, const char* kind, size_t face_number) const {
         if (index >= 0 && size_t(index) < count) return;
-        throw input_error(file_, "face " + std::to_string(face_number),
-                          std::string(kind) + " index out of range (the file has " + std::to_string(count) + ")");
+        throw input_error(
+            file_, "face " + std::to_string(face_number),
+            std::string(kind) + " index out of range (the file has " + std::to_string(count) + ")");
     }
 
     void add_face(std::span<const tinyobj::index_t> face, int material_id, size_t face_number) {
@@ -268,7 +280,8 @@ private:
         for (size_t t = 0; t < local_.size(); t += 3) {
             for (size_t k = 0; k < 3; ++k) {
                 const tinyobj::index_t& i = face[local_[t + k]];
-                const VertexKey key{i.vertex_index, i.texcoord_index, face_normals ? i.normal_index : -int(face_number) - 1};
+                const VertexKey key{i.vertex_index, i.texcoord_index,
+                                    face_normals ? i.normal_index : -int(face_number) - 1};
                 mesh_.indices.push_back(vertex(key, poly_[local_[t + k]], flat));
             }
             mesh_.material_ids.push_back(material);
@@ -281,7 +294,9 @@ private:
         mesh_.positions.push_back(position);
         if (with_uvs_) {
             Vec2 uv{0, 0};
-            if (key.vt >= 0) uv = {float(attrib_.texcoords[2 * size_t(key.vt)]), float(attrib_.texcoords[2 * size_t(key.vt) + 1])};
+            if (key.vt >= 0)
+                uv = {float(attrib_.texcoords[2 * size_t(key.vt)]),
+                      float(attrib_.texcoords[2 * size_t(key.vt) + 1])};
             mesh_.uvs.push_back(uv);
         }
         if (with_normals_) {
@@ -347,7 +362,8 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
     std::string warn, err;
-    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &mtl_reader, /*triangulate=*/false,
+    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &mtl_reader,
+                          /*triangulate=*/false,
                           /*default_vcols_fallback=*/false))
         throw input_error(file.string(), "", "malformed OBJ: " + first_line(err));
     std::istringstream warnings(warn);
@@ -368,7 +384,8 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     }
     std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.indices.empty(); });
     if (model.dropped_degenerate > 0)
-        log_info(file.string() + ": dropped " + std::to_string(model.dropped_degenerate) + " zero-area triangles");
+        log_info(file.string() + ": dropped " + std::to_string(model.dropped_degenerate) +
+                 " zero-area triangles");
     return model;
 }
 

@@ -63,14 +63,18 @@ constexpr int kAdvance = 6;  // font dots per character, spacing included
 
 Raster::Raster(int w, int h, Rgb fill) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3) {
     for (size_t i = 0; i < rgb.size(); i += 3) {
-        rgb[i] = fill.x; rgb[i + 1] = fill.y; rgb[i + 2] = fill.z;
+        rgb[i] = fill.x;
+        rgb[i + 1] = fill.y;
+        rgb[i + 2] = fill.z;
     }
 }
 
 void Raster::set(int x, int y, Rgb c) {
     if (x < 0 || y < 0 || x >= width || y >= height) return;
     float* p = &rgb[(size_t(y) * size_t(width) + size_t(x)) * 3];
-    p[0] = c.x; p[1] = c.y; p[2] = c.z;
+    p[0] = c.x;
+    p[1] = c.y;
+    p[2] = c.z;
 }
 
 void Raster::fill_rect(int x0, int y0, int x1, int y1, Rgb c) {
@@ -109,9 +113,12 @@ int text_width(const std::string& s, int scale) { return int(s.size()) * kAdvanc
 
 std::string decade_label(int e) {
     char buf[32];
-    if (e >= 0 && e <= 3) std::snprintf(buf, sizeof buf, "%.0f", std::pow(10.0, e));
-    else if (e < 0 && e >= -3) std::snprintf(buf, sizeof buf, "%.*f", -e, std::pow(10.0, e));
-    else std::snprintf(buf, sizeof buf, "1E%d", e);
+    if (e >= 0 && e <= 3)
+        std::snprintf(buf, sizeof buf, "%.0f", std::pow(10.0, e));
+    else if (e < 0 && e >= -3)
+        std::snprintf(buf, sizeof buf, "%.*f", -e, std::pow(10.0, e));
+    else
+        std::snprintf(buf, sizeof buf, "1E%d", e);
     return buf;
 }
 
@@ -122,8 +129,14 @@ void decade_range(const LogLogPlot& plot, bool y_axis, int& lo, int& hi) {
     double mn = INFINITY, mx = -INFINITY;
     for (const PlotSeries& s : plot.series)
         for (double v : y_axis ? s.y : s.x)
-            if (v > 0 && std::isfinite(v)) { mn = std::min(mn, v); mx = std::max(mx, v); }
-    if (!(mn <= mx)) { mn = 1; mx = 10; }
+            if (v > 0 && std::isfinite(v)) {
+                mn = std::min(mn, v);
+                mx = std::max(mx, v);
+            }
+    if (!(mn <= mx)) {
+        mn = 1;
+        mx = 10;
+    }
     lo = int(std::floor(std::log10(mn) + 1e-9));
     hi = int(std::ceil(std::log10(mx) - 1e-9));
     if (hi <= lo) hi = lo + 1;
@@ -177,8 +190,10 @@ void draw_legend(Raster& r, const LogLogPlot& plot, const Frame2& f) {
     const int row = 22, x0 = f.left + 12, x1 = x0 + w + 60, y1 = f.bottom - 12;
     const int y0 = y1 - row * int(plot.series.size()) - 8;
     r.fill_rect(x0, y0, x1, y1, Rgb(1.0f));
-    r.line(x0, y0, x1, y0, Rgb(0.0f)); r.line(x0, y1, x1, y1, Rgb(0.0f));
-    r.line(x0, y0, x0, y1, Rgb(0.0f)); r.line(x1, y0, x1, y1, Rgb(0.0f));
+    r.line(x0, y0, x1, y0, Rgb(0.0f));
+    r.line(x0, y1, x1, y1, Rgb(0.0f));
+    r.line(x0, y0, x0, y1, Rgb(0.0f));
+    r.line(x1, y0, x1, y1, Rgb(0.0f));
     for (size_t i = 0; i < plot.series.size(); ++i) {
         const PlotSeries& s = plot.series[i];
         const int y = y0 + 15 + row * int(i);
@@ -204,7 +219,9 @@ Raster draw_loglog_plot(const LogLogPlot& plot, int width, int height) {
             const double x = f.px(s.x[i]), y = f.py(s.y[i]);
             if (have_prev) r.line(px, py, x, y, s.color, s.dashed ? 2 : 3, s.dashed ? 8 : 0);
             if (!s.dashed) r.fill_rect(int(x) - 4, int(y) - 4, int(x) + 4, int(y) + 4, s.color);
-            px = x; py = y; have_prev = true;
+            px = x;
+            py = y;
+            have_prev = true;
         }
     }
     draw_legend(r, plot, f);

@@ -13,7 +13,7 @@ namespace sahara {
 
 /// A distribution over n bins of [0,1) proportional to non-negative weights.
 class Distribution1D {
-public:
+   public:
     Distribution1D() = default;
     /// Weights must be finite and >= 0; all zero gives the uniform distribution.
     explicit Distribution1D(std::vector<float> weights) : func_(std::move(weights)) {
@@ -64,7 +64,7 @@ public:
         return std::min((float(i) + du) / float(func_.size()), 0x1.fffffep-1f);
     }
 
-private:
+   private:
     size_t find_bin(float u) const {
         // The first cdf entry greater than u ends the bin; zero-weight bins
         // have equal neighbouring cdf entries and are never chosen.
@@ -80,10 +80,11 @@ private:
 /// A distribution over [0,1)^2 on a width x height grid of cells: a marginal
 /// over rows and one conditional distribution per row.
 class Distribution2D {
-public:
+   public:
     Distribution2D() = default;
     /// `weights` is row-major, width * height values.
-    Distribution2D(const std::vector<float>& weights, int width, int height) : width_(width), height_(height) {
+    Distribution2D(const std::vector<float>& weights, int width, int height)
+        : width_(width), height_(height) {
         std::vector<float> row_sums(size_t(height), 0.0f);
         rows_.reserve(size_t(height));
         for (int y = 0; y < height; ++y) {
@@ -113,7 +114,7 @@ public:
         return marginal_.density(size_t(y)) * rows_[size_t(y)].density(size_t(x));
     }
 
-private:
+   private:
     int width_ = 0, height_ = 0;
     std::vector<Distribution1D> rows_;
     Distribution1D marginal_;

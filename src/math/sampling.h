@@ -30,8 +30,13 @@ inline Vec2 sample_disk_concentric(Vec2 u) {
     float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
     if (a == 0.0f && b == 0.0f) return {0, 0};
     float r, phi;
-    if (std::abs(a) > std::abs(b)) { r = a; phi = (kPi / 4.0f) * (b / a); }
-    else { r = b; phi = kPi / 2.0f - (kPi / 4.0f) * (a / b); }
+    if (std::abs(a) > std::abs(b)) {
+        r = a;
+        phi = (kPi / 4.0f) * (b / a);
+    } else {
+        r = b;
+        phi = kPi / 2.0f - (kPi / 4.0f) * (a / b);
+    }
     return {r * std::cos(phi), r * std::sin(phi)};
 }
 

@@ -15,12 +15,16 @@ struct Mat4 {
     static Mat4 identity() { return {}; }
     static Mat4 translate(const Vec3d& t) {
         Mat4 r;
-        r.m[0][3] = t.x; r.m[1][3] = t.y; r.m[2][3] = t.z;
+        r.m[0][3] = t.x;
+        r.m[1][3] = t.y;
+        r.m[2][3] = t.z;
         return r;
     }
     static Mat4 scale(const Vec3d& s) {
         Mat4 r;
-        r.m[0][0] = s.x; r.m[1][1] = s.y; r.m[2][2] = s.z;
+        r.m[0][0] = s.x;
+        r.m[1][1] = s.y;
+        r.m[2][2] = s.z;
         return r;
     }
     /// Rotation by `deg` degrees about coordinate axis `axis` (0 = X, 1 = Y, 2 = Z), right-handed.
@@ -28,8 +32,10 @@ struct Mat4 {
         double a = deg * std::numbers::pi / 180.0, c = std::cos(a), s = std::sin(a);
         Mat4 r;
         int i = (axis + 1) % 3, j = (axis + 2) % 3;
-        r.m[i][i] = c; r.m[i][j] = -s;
-        r.m[j][i] = s; r.m[j][j] = c;
+        r.m[i][i] = c;
+        r.m[i][j] = -s;
+        r.m[j][i] = s;
+        r.m[j][j] = c;
         return r;
     }
     /// Euler rotation in degrees: about X first, then Y, then Z (R = Rz Ry Rx).
@@ -39,9 +45,15 @@ struct Mat4 {
     /// Rotation from a unit quaternion (x, y, z, w), as glTF stores it.
     static Mat4 rotate_quaternion(double x, double y, double z, double w) {
         Mat4 r;
-        r.m[0][0] = 1 - 2 * (y * y + z * z); r.m[0][1] = 2 * (x * y - z * w);     r.m[0][2] = 2 * (x * z + y * w);
-        r.m[1][0] = 2 * (x * y + z * w);     r.m[1][1] = 1 - 2 * (x * x + z * z); r.m[1][2] = 2 * (y * z - x * w);
-        r.m[2][0] = 2 * (x * z - y * w);     r.m[2][1] = 2 * (y * z + x * w);     r.m[2][2] = 1 - 2 * (x * x + y * y);
+        r.m[0][0] = 1 - 2 * (y * y + z * z);
+        r.m[0][1] = 2 * (x * y - z * w);
+        r.m[0][2] = 2 * (x * z + y * w);
+        r.m[1][0] = 2 * (x * y + z * w);
+        r.m[1][1] = 1 - 2 * (x * x + z * z);
+        r.m[1][2] = 2 * (y * z - x * w);
+        r.m[2][0] = 2 * (x * z - y * w);
+        r.m[2][1] = 2 * (y * z + x * w);
+        r.m[2][2] = 1 - 2 * (x * x + y * y);
         return r;
     }
 

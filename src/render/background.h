@@ -40,7 +40,8 @@ inline Rgb envmap_radiance(const BackgroundDesc& bg, Vec2 uv) {
 /// Radiance arriving from direction `dir` (not necessarily unit).
 inline Rgb eval_background(const BackgroundDesc& bg, const Vec3& dir) {
     switch (bg.type) {
-        case BackgroundDesc::Type::constant: return bg.color;
+        case BackgroundDesc::Type::constant:
+            return bg.color;
         case BackgroundDesc::Type::gradient: {
             const float t = 0.5f * (dot(normalize(dir), bg.up) + 1.0f);
             return bg.bottom * (1.0f - t) + bg.top * t;

@@ -103,7 +103,8 @@ bool sample_dielectric(const Bsdf& b, const Vec3& wo, float u_lobe, BsdfSample& 
 
 }  // namespace
 
-Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
+               const std::vector<TextureDesc>& textures) {
     Bsdf b;
     b.frame = Frame(si.ns);
     b.ng = si.ng;
@@ -121,7 +122,9 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::v
             b.kind = BsdfKind::dielectric;
             b.eta = si.front_face ? m.ior : 1.0f / m.ior;
             break;
-        case MaterialType::emissive: b.kind = BsdfKind::none; break;
+        case MaterialType::emissive:
+            b.kind = BsdfKind::none;
+            break;
     }
     return b;
 }
@@ -136,8 +139,10 @@ Rgb eval_bsdf(const Bsdf& b, const Vec3& wo_w, const Vec3& wi_w, float* pdf) {
             if (wi.z <= 0) return Rgb(0.0f);
             *pdf = wi.z * kInvPi;
             return b.albedo * (wi.z * kInvPi);
-        case BsdfKind::ggx: return eval_ggx(b, b.frame.to_local(wo_w), wi, pdf);
-        default: return Rgb(0.0f);
+        case BsdfKind::ggx:
+            return eval_ggx(b, b.frame.to_local(wo_w), wi, pdf);
+        default:
+            return Rgb(0.0f);
     }
 }
 
@@ -177,7 +182,8 @@ bool sample_bsdf(const Bsdf& b, const Vec3& wo_w, Vec2 u, float u_lobe, BsdfSamp
             s.wi = b.frame.to_world(s.wi);
             // A shading normal can send the sample to the wrong side of the true surface.
             return s.transmit ? dot(s.wi, b.ng) < 0 : dot(s.wi, b.ng) > 0;
-        case BsdfKind::none: return false;
+        case BsdfKind::none:
+            return false;
     }
     s.transmit = false;
     return dot(s.wi, b.ng) > 0;

@@ -19,11 +19,11 @@ inline constexpr float kMinGgxAlpha = 1e-3f;
 /// A BSDF instantiated at one surface point.
 struct Bsdf {
     BsdfKind kind = BsdfKind::none;
-    Rgb albedo{0.0f};  ///< Lambertian reflectance, or the metal's F0
-    float alpha = 0;   ///< GGX roughness parameter (= roughness^2)
-    float eta = 1;     ///< ior on the far side / ior on the side of wo (dielectric)
+    Rgb albedo{0.0f};            ///< Lambertian reflectance, or the metal's F0
+    float alpha = 0;             ///< GGX roughness parameter (= roughness^2)
+    float eta = 1;               ///< ior on the far side / ior on the side of wo (dielectric)
     Frame frame{Vec3(0, 0, 1)};  ///< around the shading normal
-    Vec3 ng;           ///< geometric normal on the side of wo
+    Vec3 ng;                     ///< geometric normal on the side of wo
 
     bool is_delta() const { return kind == BsdfKind::mirror || kind == BsdfKind::dielectric; }
 };
@@ -32,10 +32,10 @@ struct Bsdf {
 struct BsdfSample {
     Vec3 wi;
     Rgb weight{0.0f};
-    float pdf = 0;        ///< solid-angle density (1 for delta lobes: unused)
+    float pdf = 0;  ///< solid-angle density (1 for delta lobes: unused)
     bool delta = false;
     bool transmit = false;  ///< wi goes through the surface (spawn on the far side)
-    float eta_scale = 1;  ///< radiance scale 1/eta^2 undone, for Russian roulette
+    float eta_scale = 1;    ///< radiance scale 1/eta^2 undone, for Russian roulette
 };
 
 /// The BSDF of material `m` at `si`.

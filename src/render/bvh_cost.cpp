@@ -20,8 +20,11 @@ constexpr int kLegendHeight = 44;
 Rgb heat_color(float t) {
     t = std::clamp(t, 0.0f, 1.0f);
     // Piecewise-linear ramp through perceptually ordered stops (linear RGB).
-    static const Rgb stops[] = {{0.00f, 0.00f, 0.15f}, {0.00f, 0.25f, 0.80f}, {0.00f, 0.80f, 0.80f},
-                                {0.95f, 0.90f, 0.10f}, {0.90f, 0.10f, 0.05f}};
+    static const Rgb stops[] = {{0.00f, 0.00f, 0.15f},
+                                {0.00f, 0.25f, 0.80f},
+                                {0.00f, 0.80f, 0.80f},
+                                {0.95f, 0.90f, 0.10f},
+                                {0.90f, 0.10f, 0.05f}};
     const float x = t * 4.0f;
     const int i = std::min(3, int(x));
     return lerp(x - float(i), stops[i], stops[i + 1]);
@@ -43,8 +46,8 @@ BvhCostImage render_bvh_cost(const Scene& scene, int width, int height, int thre
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads)
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            cost[size_t(y) * size_t(width) + size_t(x)] =
-                bvh_ray_cost(scene, camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f, {0.5f, 0.5f}, 0.5f));
+            cost[size_t(y) * size_t(width) + size_t(x)] = bvh_ray_cost(
+                scene, camera.generate_ray(float(x) + 0.5f, float(y) + 0.5f, {0.5f, 0.5f}, 0.5f));
 
     BvhCostImage out;
     double sum = 0;

@@ -7,7 +7,7 @@
 namespace sahara {
 
 class Camera {
-public:
+   public:
     Camera(const CameraDesc& desc, int width, int height);
 
     /// Ray through continuous pixel position (px, py) (0,0 = top-left corner of
@@ -19,7 +19,7 @@ public:
     const Vec3& position() const { return origin_; }
     const Vec3& forward() const { return forward_; }
 
-private:
+   private:
     Vec3 origin_, forward_, right_, up_;
     float half_w_ = 1, half_h_ = 1;  ///< view plane half extents at distance 1
     int width_, height_;

@@ -3,7 +3,8 @@
 namespace sahara {
 
 Film::Film(int width, int height)
-    : width_(width), height_(height),
+    : width_(width),
+      height_(height),
       sum_(size_t(width) * size_t(height)),
       sum_sq_(size_t(width) * size_t(height), 0.0),
       count_(size_t(width) * size_t(height), 0u) {}
@@ -29,7 +30,9 @@ std::vector<float> Film::to_rgb() const {
         for (int x = 0; x < width_; ++x) {
             Rgb m = mean(x, y);
             float* p = &out[(size_t(y) * size_t(width_) + size_t(x)) * 3];
-            p[0] = m.x; p[1] = m.y; p[2] = m.z;
+            p[0] = m.x;
+            p[1] = m.y;
+            p[2] = m.z;
         }
     return out;
 }

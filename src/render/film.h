@@ -11,7 +11,7 @@
 namespace sahara {
 
 class Film {
-public:
+   public:
     Film(int width, int height);
 
     int width() const { return width_; }
@@ -52,7 +52,7 @@ public:
     /// Adds to the discarded-sample count (restoring a checkpoint).
     void add_nonfinite(uint64_t n) { nonfinite_.fetch_add(n); }
 
-private:
+   private:
     int width_, height_;
     std::vector<Vec3d> sum_;  // double: sums of millions of samples stay exact enough
     std::vector<double> sum_sq_;

@@ -23,9 +23,12 @@ enum class Strategy : uint8_t { none, delta, mis, light_only };
 /// direction light sampling could also have produced with density light_pdf.
 template <Strategy S>
 float hit_weight(float bsdf_pdf, float light_pdf) {
-    if constexpr (S == Strategy::mis) return power_heuristic(bsdf_pdf, light_pdf);
-    else if constexpr (S == Strategy::light_only) return 0.0f;
-    else return 1.0f;
+    if constexpr (S == Strategy::mis)
+        return power_heuristic(bsdf_pdf, light_pdf);
+    else if constexpr (S == Strategy::light_only)
+        return 0.0f;
+    else
+        return 1.0f;
 }
 
 /// The Lambertian-only kernels' BSDF: no dispatch, no frame until sampling.
@@ -44,7 +47,9 @@ inline Rgb eval_shading(const LambertShading& b, const Vec3&, const Vec3& wi, fl
     *pdf = cos * kInvPi;
     return b.albedo * (cos * kInvPi);
 }
-inline Rgb eval_shading(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) { return eval_bsdf(b, wo, wi, pdf); }
+inline Rgb eval_shading(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
+    return eval_bsdf(b, wo, wi, pdf);
+}
 
 inline bool sample_shading(const LambertShading& b, const Vec3&, Sampler& sampler, BsdfSample& bs) {
     const Vec3 local = sample_cosine_hemisphere(sampler.next_2d());
@@ -59,15 +64,18 @@ inline bool sample_shading(const Bsdf& b, const Vec3& wo, Sampler& sampler, Bsdf
 }
 
 template <bool kLambertOnly>
-auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
-    if constexpr (kLambertOnly) return LambertShading{eval_color(m.albedo, textures, si.p, si.uv), si.ns, si.ng};
-    else return make_bsdf(m, si, textures);
+auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si,
+                  const std::vector<TextureDesc>& textures) {
+    if constexpr (kLambertOnly)
+        return LambertShading{eval_color(m.albedo, textures, si.p, si.uv), si.ns, si.ng};
+    else
+        return make_bsdf(m, si, textures);
 }
 
 /// Next-event estimation at a non-delta vertex: one emitter, one shadow ray.
 template <Strategy S, class Shading>
-Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading& bsdf, const Vec3& wo, float time,
-                 float u_select, Vec2 u) {
+Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading& bsdf, const Vec3& wo,
+                 float time, float u_select, Vec2 u) {
     LightSample ls;
     if (!sample_light(scene, si.p, time, u_select, u, ls)) return Rgb(0.0f);
     float bsdf_pdf = 0;
@@ -130,7 +138,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
             if constexpr (kEmission) radiance += beta * hit_emission<S>(scene, ray, hit, si, mat, prev);
             break;
         }
-        if constexpr (kEmission) radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
+        if constexpr (kEmission)
+            radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if (depth == max_depth) break;
 
         const Vec3 wo = -ray.dir;
@@ -138,7 +147,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
         if constexpr (S != Strategy::none) {
             const float u_select = sampler.next_1d();
             const Vec2 u_light = sampler.next_2d();
-            if (!bsdf.is_delta()) radiance += beta * direct_light<S>(scene, si, bsdf, wo, ray.time, u_select, u_light);
+            if (!bsdf.is_delta())
+                radiance += beta * direct_light<S>(scene, si, bsdf, wo, ray.time, u_select, u_light);
         }
         BsdfSample bs;
         if (!sample_shading(bsdf, wo, sampler, bs)) break;
@@ -159,7 +169,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
 enum class PathKernel : uint8_t { plain_lambert, plain, delta_lambert, delta, mis_lambert, mis };
 
 PathKernel choose_kernel(const SceneFeatures& f) {
-    if (f.has_area_lights || f.has_envmap) return f.lambertian_only ? PathKernel::mis_lambert : PathKernel::mis;
+    if (f.has_area_lights || f.has_envmap)
+        return f.lambertian_only ? PathKernel::mis_lambert : PathKernel::mis;
     if (f.has_lights) return f.lambertian_only ? PathKernel::delta_lambert : PathKernel::delta;
     // The plain Lambertian kernel skips emission altogether.
     return f.lambertian_only && !f.has_emitters ? PathKernel::plain_lambert : PathKernel::plain;
@@ -169,33 +180,48 @@ PathKernel choose_kernel(const SceneFeatures& f) {
 
 Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
     switch (choose_kernel(scene.features)) {
-        case PathKernel::plain_lambert: return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth);
-        case PathKernel::plain: return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
-        case PathKernel::delta_lambert: return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth);
-        case PathKernel::delta: return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth);
-        case PathKernel::mis_lambert: return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth);
-        case PathKernel::mis: break;
+        case PathKernel::plain_lambert:
+            return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth);
+        case PathKernel::plain:
+            return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+        case PathKernel::delta_lambert:
+            return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth);
+        case PathKernel::delta:
+            return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth);
+        case PathKernel::mis_lambert:
+            return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth);
+        case PathKernel::mis:
+            break;
     }
     return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
 }
 
 Rgb path_trace_with(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, LightStrategy strategy) {
     switch (strategy) {
-        case LightStrategy::bsdf_only: return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
-        case LightStrategy::light_only: return path_kernel<Strategy::light_only, false>(scene, ray, sampler, max_depth);
-        case LightStrategy::mis: break;
+        case LightStrategy::bsdf_only:
+            return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+        case LightStrategy::light_only:
+            return path_kernel<Strategy::light_only, false>(scene, ray, sampler, max_depth);
+        case LightStrategy::mis:
+            break;
     }
     return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
 }
 
 const char* path_kernel_name(const Scene& scene) {
     switch (choose_kernel(scene.features)) {
-        case PathKernel::plain_lambert: return "path<no light sampling, lambertian only>";
-        case PathKernel::plain: return "path<no light sampling, all materials>";
-        case PathKernel::delta_lambert: return "path<delta lights, lambertian only>";
-        case PathKernel::delta: return "path<delta lights, all materials>";
-        case PathKernel::mis_lambert: return "path<MIS, lambertian only>";
-        case PathKernel::mis: break;
+        case PathKernel::plain_lambert:
+            return "path<no light sampling, lambertian only>";
+        case PathKernel::plain:
+            return "path<no light sampling, all materials>";
+        case PathKernel::delta_lambert:
+            return "path<delta lights, lambertian only>";
+        case PathKernel::delta:
+            return "path<delta lights, all materials>";
+        case PathKernel::mis_lambert:
+            return "path<MIS, lambertian only>";
+        case PathKernel::mis:
+            break;
     }
     return "path<MIS, all materials>";
 }
@@ -213,9 +239,12 @@ Rgb inspect(const Scene& scene, Ray ray) {
     if (type == IntegratorType::depth) return Rgb(hit.t);
     const MaterialDesc& m = scene.materials[si.material];
     switch (m.type) {
-        case MaterialType::dielectric: return Rgb(1.0f);
-        case MaterialType::emissive: return eval_color(m.radiance, scene.textures, si.p, si.uv);
-        default: return eval_color(m.albedo, scene.textures, si.p, si.uv);
+        case MaterialType::dielectric:
+            return Rgb(1.0f);
+        case MaterialType::emissive:
+            return eval_color(m.radiance, scene.textures, si.p, si.uv);
+        default:
+            return eval_color(m.albedo, scene.textures, si.p, si.uv);
     }
 }
 
@@ -223,12 +252,16 @@ Rgb inspect(const Scene& scene, Ray ray) {
 
 Rgb estimate_radiance(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
     switch (scene.render.integrator) {
-        case IntegratorType::path: return path_trace(scene, ray, sampler, max_depth);
-        case IntegratorType::whitted: return whitted(scene, ray, max_depth);
+        case IntegratorType::path:
+            return path_trace(scene, ray, sampler, max_depth);
+        case IntegratorType::whitted:
+            return whitted(scene, ray, max_depth);
         case IntegratorType::albedo:
         case IntegratorType::normals:
-        case IntegratorType::depth: return inspect(scene, ray);
-        default: return path_trace(scene, ray, sampler, max_depth);
+        case IntegratorType::depth:
+            return inspect(scene, ray);
+        default:
+            return path_trace(scene, ray, sampler, max_depth);
     }
 }
 

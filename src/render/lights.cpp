@@ -42,7 +42,8 @@ bool sample_sphere_cone(const Sphere& s, const Vec3& p, float time, Vec2 u, Vec3
         sin2_theta / sin_max + cos_theta * std::sqrt(std::max(0.0f, 1.0f - sin2_theta / sin2_max));
     const float sin_alpha = std::sqrt(std::max(0.0f, 1.0f - cos_alpha * cos_alpha));
     const float phi = 2.0f * kPi * u.y;
-    const Vec3 n = Frame(normalize(p - c)).to_world(Vec3(sin_alpha * std::cos(phi), sin_alpha * std::sin(phi), cos_alpha));
+    const Vec3 n = Frame(normalize(p - c))
+                       .to_world(Vec3(sin_alpha * std::cos(phi), sin_alpha * std::sin(phi), cos_alpha));
     *n_light = n;
     *p_light = c + n * s.radius;
     *pdf = 1.0f / (2.0f * kPi * one_minus_cos_max);
@@ -93,31 +94,41 @@ Vec3 sample_box(const Bounds3& b, Vec2 u, Vec3* n) {
 
 uint32_t material_of(const Scene& scene, const Emitter& e) {
     switch (e.kind) {
-        case Emitter::Kind::sphere: return scene.spheres[e.index].material;
-        case Emitter::Kind::triangle: return scene.triangles.material[e.index];
-        case Emitter::Kind::box: return scene.boxes[e.index].material;
-        default: return 0;
+        case Emitter::Kind::sphere:
+            return scene.spheres[e.index].material;
+        case Emitter::Kind::triangle:
+            return scene.triangles.material[e.index];
+        case Emitter::Kind::box:
+            return scene.boxes[e.index].material;
+        default:
+            return 0;
     }
 }
 
 PrimKind prim_kind_of(Emitter::Kind k) {
-    return k == Emitter::Kind::sphere ? PrimKind::sphere : k == Emitter::Kind::triangle ? PrimKind::triangle : PrimKind::box;
+    return k == Emitter::Kind::sphere     ? PrimKind::sphere
+           : k == Emitter::Kind::triangle ? PrimKind::triangle
+                                          : PrimKind::box;
 }
 
 /// A point on an area emitter with its outward normal and its density per unit solid angle at p.
-bool sample_area_point(const Scene& scene, const Emitter& e, const Vec3& p, float time, Vec2 u, Vec3* pl, Vec3* nl,
-                       float* pdf_solid, Vec2* bary) {
+bool sample_area_point(const Scene& scene, const Emitter& e, const Vec3& p, float time, Vec2 u, Vec3* pl,
+                       Vec3* nl, float* pdf_solid, Vec2* bary) {
     float area = 0;
     switch (e.kind) {
-        case Emitter::Kind::sphere: return sample_sphere_cone(scene.spheres[e.index], p, time, u, pl, nl, pdf_solid);
-        case Emitter::Kind::triangle: *pl = sample_triangle(scene.triangles, e.index, u, nl, &area, bary); break;
+        case Emitter::Kind::sphere:
+            return sample_sphere_cone(scene.spheres[e.index], p, time, u, pl, nl, pdf_solid);
+        case Emitter::Kind::triangle:
+            *pl = sample_triangle(scene.triangles, e.index, u, nl, &area, bary);
+            break;
         case Emitter::Kind::box: {
             const Bounds3& b = scene.boxes[e.index].box;
             *pl = sample_box(b, u, nl);
             area = b.surface_area();
             break;
         }
-        default: return false;
+        default:
+            return false;
     }
     const Vec3 d = *pl - p;
     const float dist2 = length_squared(d);
@@ -127,7 +138,8 @@ bool sample_area_point(const Scene& scene, const Emitter& e, const Vec3& p, floa
     return true;
 }
 
-bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, float time, Vec2 u, LightSample& ls) {
+bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, float time, Vec2 u,
+                       LightSample& ls) {
     Vec3 pl, nl;
     Vec2 bary{0, 0};
     float pdf_solid = 0;
@@ -143,7 +155,8 @@ bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, floa
     } else {
         // Textured emission: let the scene compute uv exactly as for a hit.
         const Ray r{p, d, 0.0f, 2.0f, time};
-        const SurfaceInteraction si = scene.interact(r, Hit{1.0f, make_prim_id(prim_kind_of(e.kind), e.index), bary.x, bary.y});
+        const SurfaceInteraction si =
+            scene.interact(r, Hit{1.0f, make_prim_id(prim_kind_of(e.kind), e.index), bary.x, bary.y});
         ls.li = eval_color(m.radiance, scene.textures, si.p, si.uv);
     }
     ls.pdf *= pdf_solid;
@@ -190,17 +203,22 @@ bool sample_light(const Scene& scene, const Vec3& p, float time, float u_select,
             ls.delta = true;
             return true;
         }
-        case Emitter::Kind::envmap: return sample_envmap(scene, u, ls);
-        default: return sample_area_light(scene, e, p, time, u, ls);
+        case Emitter::Kind::envmap:
+            return sample_envmap(scene, u, ls);
+        default:
+            return sample_area_light(scene, e, p, time, u, ls);
     }
 }
 
 uint32_t emitter_of_hit(const Scene& scene, const Hit& hit) {
     const uint32_t i = prim_index(hit.prim);
     switch (prim_kind(hit.prim)) {
-        case PrimKind::sphere: return scene.sphere_emitter.empty() ? kNoEmitter : scene.sphere_emitter[i];
-        case PrimKind::triangle: return scene.triangle_emitter.empty() ? kNoEmitter : scene.triangle_emitter[i];
-        case PrimKind::box: return scene.box_emitter.empty() ? kNoEmitter : scene.box_emitter[i];
+        case PrimKind::sphere:
+            return scene.sphere_emitter.empty() ? kNoEmitter : scene.sphere_emitter[i];
+        case PrimKind::triangle:
+            return scene.triangle_emitter.empty() ? kNoEmitter : scene.triangle_emitter[i];
+        case PrimKind::box:
+            return scene.box_emitter.empty() ? kNoEmitter : scene.box_emitter[i];
         case PrimKind::plane:    // planes and quadrics are not light-sampled:
         case PrimKind::quadric:  // found by BSDF sampling alone (MIS weight 1)
             return kNoEmitter;
@@ -208,8 +226,8 @@ uint32_t emitter_of_hit(const Scene& scene, const Hit& hit) {
     return kNoEmitter;
 }
 
-float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const Vec3& p_light, const Vec3& n_light,
-                     float time) {
+float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const Vec3& p_light,
+                     const Vec3& n_light, float time) {
     const Emitter& e = scene.emitters[emitter];
     const float select = scene.emitter_distribution.pmf(emitter);
     if (e.kind == Emitter::Kind::sphere) {
@@ -222,7 +240,8 @@ float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const 
     if (e.kind == Emitter::Kind::triangle) {
         const TriangleSoup& t = scene.triangles;
         const Vec3& p0 = t.positions[t.indices[3 * e.index]];
-        area = 0.5f * length(cross(t.positions[t.indices[3 * e.index + 1]] - p0, t.positions[t.indices[3 * e.index + 2]] - p0));
+        area = 0.5f * length(cross(t.positions[t.indices[3 * e.index + 1]] - p0,
+                                   t.positions[t.indices[3 * e.index + 2]] - p0));
     } else if (e.kind == Emitter::Kind::box) {
         area = scene.boxes[e.index].box.surface_area();
     }

@@ -11,11 +11,11 @@ namespace sahara {
 
 /// A direction towards a light and what arrives along it.
 struct LightSample {
-    Vec3 wi;               ///< unit direction from the shading point
-    float distance = 0;    ///< to the sampled point (kInfinity: directional, envmap)
-    Rgb li{0.0f};          ///< radiance (area, envmap) or irradiance at normal incidence (delta)
-    float pdf = 0;         ///< selection probability times solid-angle density (delta: selection only)
-    bool delta = false;    ///< point or directional light: no MIS
+    Vec3 wi;             ///< unit direction from the shading point
+    float distance = 0;  ///< to the sampled point (kInfinity: directional, envmap)
+    Rgb li{0.0f};        ///< radiance (area, envmap) or irradiance at normal incidence (delta)
+    float pdf = 0;       ///< selection probability times solid-angle density (delta: selection only)
+    bool delta = false;  ///< point or directional light: no MIS
 };
 
 /// Samples one emitter of the scene as seen from p at the given time; false if
@@ -28,8 +28,8 @@ uint32_t emitter_of_hit(const Scene& scene, const Hit& hit);
 /// Density (selection probability times solid angle) with which sample_light
 /// from p would have produced the point p_light with outward normal n_light
 /// on area emitter `emitter`.
-float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const Vec3& p_light, const Vec3& n_light,
-                     float time);
+float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const Vec3& p_light,
+                     const Vec3& n_light, float time);
 
 /// Density with which sample_light would have chosen direction `dir` on the envmap.
 float envmap_light_pdf(const Scene& scene, const Vec3& dir);

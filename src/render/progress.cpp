@@ -9,13 +9,19 @@ namespace sahara {
 using Clock = std::chrono::steady_clock;
 
 Progress::Progress(uint64_t total, std::string unit, bool enabled)
-    : total_(total ? total : 1), unit_(std::move(unit)), enabled_(enabled), start_(Clock::now()), last_draw_(start_) {}
+    : total_(total ? total : 1),
+      unit_(std::move(unit)),
+      enabled_(enabled),
+      start_(Clock::now()),
+      last_draw_(start_) {}
 
 Progress::~Progress() { finish(); }
 
 bool Progress::stderr_is_tty() { return ::isatty(STDERR_FILENO) != 0; }
 
-double Progress::elapsed_seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+double Progress::elapsed_seconds() const {
+    return std::chrono::duration<double>(Clock::now() - start_).count();
+}
 
 void Progress::advance(uint64_t n, uint64_t samples) {
     done_.fetch_add(n, std::memory_order_relaxed);

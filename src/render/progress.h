@@ -10,7 +10,7 @@
 namespace sahara {
 
 class Progress {
-public:
+   public:
     /// `total` units of work; `unit` names the throughput (e.g. "samples").
     Progress(uint64_t total, std::string unit, bool enabled);
     ~Progress();
@@ -23,7 +23,7 @@ public:
     /// Whether progress should show by default: stderr is a terminal.
     static bool stderr_is_tty();
 
-private:
+   private:
     void draw(bool force);
 
     uint64_t total_;

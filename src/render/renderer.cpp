@@ -43,8 +43,8 @@ std::vector<TileRect> make_tiles(int w, int h) {
 
 }  // namespace
 
-void render_pixel_samples(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x, int y, int fx,
-                          int fy, uint32_t begin, uint32_t end) {
+void render_pixel_samples(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x,
+                          int y, int fx, int fy, uint32_t begin, uint32_t end) {
     for (uint32_t s = begin; s < end; ++s) {
         sampler.start(uint32_t(x), uint32_t(y), s);
         const Vec2 jitter = sampler.next_2d();
@@ -57,7 +57,8 @@ void render_pixel_samples(const Scene& scene, const Camera& camera, Film& film, 
     if (end > begin) film.add_count(fx, fy, end - begin);
 }
 
-void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_end, int threads, Progress* progress) {
+void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_end, int threads,
+                 Progress* progress) {
     const Camera camera(scene.camera, film.width(), film.height());
     const std::vector<TileRect> tiles = make_tiles(film.width(), film.height());
 #pragma omp parallel num_threads(threads)
@@ -68,8 +69,10 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
             const TileRect& r = tiles[t];
             for (int y = r.y0; y < r.y1; ++y)
                 for (int x = r.x0; x < r.x1; ++x)
-                    render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin), uint32_t(sample_end));
-            const uint64_t n = uint64_t(r.x1 - r.x0) * uint64_t(r.y1 - r.y0) * uint64_t(sample_end - sample_begin);
+                    render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin),
+                                 uint32_t(sample_end));
+            const uint64_t n =
+                uint64_t(r.x1 - r.x0) * uint64_t(r.y1 - r.y0) * uint64_t(sample_end - sample_begin);
             if (progress) progress->advance(n, n);
         }
         flush_thread_counters();
@@ -77,9 +80,13 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
 }
 
 RenderSession::RenderSession(const Scene& scene, Film& film, RenderOptions options)
-    : scene_(scene), film_(film), options_(std::move(options)),
+    : scene_(scene),
+      film_(film),
+      options_(std::move(options)),
       threads_(options_.threads > 0 ? options_.threads : omp_get_max_threads()),
-      tiles_(make_tiles(film.width(), film.height())), tile_locks_(tiles_.size()), tile_generation_(tiles_.size()) {}
+      tiles_(make_tiles(film.width(), film.height())),
+      tile_locks_(tiles_.size()),
+      tile_generation_(tiles_.size()) {}
 
 RenderSession::~RenderSession() = default;
 
@@ -89,12 +96,15 @@ void RenderSession::request_stop(StopReason reason) {
     stop_.store(true);
 }
 
-double RenderSession::elapsed_seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+double RenderSession::elapsed_seconds() const {
+    return std::chrono::duration<double>(Clock::now() - start_).count();
+}
 
 double RenderSession::eta_seconds() const {
     const double t = elapsed_seconds();
     const uint64_t done = samples_.load();
-    double eta = done > 0 ? t * double(samples_planned_ - std::min(done, samples_planned_)) / double(done) : -1.0;
+    double eta =
+        done > 0 ? t * double(samples_planned_ - std::min(done, samples_planned_)) / double(done) : -1.0;
     if (scene_.render.time_limit_s) {
         const double left = std::max(0.0, *scene_.render.time_limit_s - t);
         eta = eta < 0 ? left : std::min(eta, left);
@@ -102,7 +112,8 @@ double RenderSession::eta_seconds() const {
     return eta;
 }
 
-uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* targets, uint32_t uniform_target) {
+uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* targets,
+                                    uint32_t uniform_target) {
     const Camera camera(scene_.camera, film_.width(), film_.height());
     Sampler sampler(scene_.render.seed, scene_.render.sampler);
     const TileRect& r = tiles_[tile];
@@ -111,7 +122,8 @@ uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* ta
     for (int y = r.y0; y < r.y1 && !stop_.load(std::memory_order_relaxed); ++y)
         for (int x = r.x0; x < r.x1 && !stop_.load(std::memory_order_relaxed); ++x) {
             const uint32_t begin = film_.count(x, y);
-            const uint32_t end = targets ? (*targets)[size_t(y) * size_t(film_.width()) + size_t(x)] : uniform_target;
+            const uint32_t end =
+                targets ? (*targets)[size_t(y) * size_t(film_.width()) + size_t(x)] : uniform_target;
             if (end <= begin) continue;
             render_pixel(scene_, camera, film_, sampler, x, y, begin, end);
             taken += end - begin;
@@ -137,7 +149,8 @@ void RenderSession::run_pass(const std::vector<uint32_t>* targets, uint32_t unif
 /// One round of adaptive sampling (see adaptive_sample_targets).
 bool RenderSession::adaptive_round() {
     std::vector<uint32_t> targets;
-    if (!adaptive_sample_targets(film_, *scene_.render.target_error, uint32_t(scene_.render.spp), targets)) return false;
+    if (!adaptive_sample_targets(film_, *scene_.render.target_error, uint32_t(scene_.render.spp), targets))
+        return false;
     pass_target_.store(0);
     run_pass(&targets, 0);
     return true;
@@ -231,8 +244,10 @@ void RenderSession::visit_changed_tiles(std::vector<uint64_t>& seen, bool wait,
         const uint64_t gen = tile_generation_[t].load(std::memory_order_acquire);
         if (gen == seen[t]) continue;
         std::unique_lock lock(tile_locks_[t], std::defer_lock);
-        if (wait) lock.lock();
-        else if (!lock.try_lock()) continue;
+        if (wait)
+            lock.lock();
+        else if (!lock.try_lock())
+            continue;
         seen[t] = tile_generation_[t].load(std::memory_order_relaxed);
         fn(tiles_[t]);
     }

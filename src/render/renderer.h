@@ -36,9 +36,9 @@ enum class StopReason : uint8_t { complete, converged, time_limit, interrupted }
 
 struct RenderResult {
     double seconds = 0;
-    uint64_t samples = 0;    ///< camera samples taken in this run
-    int spp_done = 0;        ///< samples per pixel completed in every pixel
-    int spp_max = 0;         ///< most samples in any pixel
+    uint64_t samples = 0;  ///< camera samples taken in this run
+    int spp_done = 0;      ///< samples per pixel completed in every pixel
+    int spp_max = 0;       ///< most samples in any pixel
     double spp_mean = 0;
     uint64_t nonfinite = 0;  ///< NaN/Inf samples discarded (film total)
     StopReason stop = StopReason::complete;
@@ -57,7 +57,7 @@ struct TileRect {
 /// the calling thread watches the clock, the stop flag and calls on_tick; the
 /// other members are for on_tick (or any thread) while the render runs.
 class RenderSession {
-public:
+   public:
     RenderSession(const Scene& scene, Film& film, RenderOptions options);
     ~RenderSession();
 
@@ -84,11 +84,12 @@ public:
     const TileRect& tile(size_t i) const { return tiles_[i]; }
     /// Calls fn for each tile that changed since seen[i] (updated); tiles being
     /// rendered are skipped unless `wait`. fn may read the film inside the tile.
-    void visit_changed_tiles(std::vector<uint64_t>& seen, bool wait, const std::function<void(const TileRect&)>& fn);
+    void visit_changed_tiles(std::vector<uint64_t>& seen, bool wait,
+                             const std::function<void(const TileRect&)>& fn);
     /// A consistent copy of the film (waits for each tile in flight).
     void snapshot(Film& out);
 
-private:
+   private:
     void render_all();
     void run_pass(const std::vector<uint32_t>* targets, uint32_t uniform_target);
     uint64_t render_tile(size_t tile, const std::vector<uint32_t>* targets, uint32_t uniform_target);
@@ -132,13 +133,14 @@ uint32_t min_sample_count(const Film& film);
 
 /// Takes samples [begin, end) of image pixel (x, y), in index order, into pixel
 /// (fx, fy) of `film` (which may be a tile-sized film: distributed rendering).
-void render_pixel_samples(const Scene& scene, const class Camera& camera, Film& film, class Sampler& sampler, int x,
-                          int y, int fx, int fy, uint32_t begin, uint32_t end);
+void render_pixel_samples(const Scene& scene, const class Camera& camera, Film& film, class Sampler& sampler,
+                          int x, int y, int fx, int fy, uint32_t begin, uint32_t end);
 
 /// The per-pixel sample targets of the next adaptive-sampling round: pixels
 /// whose (3x3-smoothed) estimated error exceeds `target_error` get as many more
 /// samples as the 1/sqrt(n) law says they need, at most doubling, capped at
 /// `cap`. Returns false when no pixel needs more.
-bool adaptive_sample_targets(const Film& film, double target_error, uint32_t cap, std::vector<uint32_t>& targets);
+bool adaptive_sample_targets(const Film& film, double target_error, uint32_t cap,
+                             std::vector<uint32_t>& targets);
 
 }  // namespace sahara

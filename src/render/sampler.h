@@ -13,7 +13,7 @@
 namespace sahara {
 
 class Sampler {
-public:
+   public:
     explicit Sampler(uint64_t seed = 0, SamplerType type = SamplerType::sobol) : seed_(seed), type_(type) {}
 
     /// Positions the sampler at the start of sample `index` of pixel (x, y).
@@ -21,8 +21,10 @@ public:
         const uint64_t pixel = (uint64_t(y) << 32) | x;
         reversed_index_ = sobol::reverse_bits(index);
         dimension_ = 0;
-        if (type_ == SamplerType::independent) rng_.reseed(hash_words(seed_, pixel, index), 0x5a4a5a4a);
-        else pixel_key_ = hash_words(seed_, pixel, 0x50b01u);
+        if (type_ == SamplerType::independent)
+            rng_.reseed(hash_words(seed_, pixel, index), 0x5a4a5a4a);
+        else
+            pixel_key_ = hash_words(seed_, pixel, 0x50b01u);
     }
     /// The next dimension of the current sample, in [0, 1).
     float next_1d() {
@@ -43,7 +45,7 @@ public:
     }
     SamplerType type() const { return type_; }
 
-private:
+   private:
     struct Keys {
         uint32_t index, scramble_x, scramble_y;
     };

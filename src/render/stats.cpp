@@ -23,7 +23,8 @@ void StatsReport::add_seconds(const std::string& group, const std::string& name,
     add(group, name, buf, seconds);
 }
 
-void StatsReport::add_ratio(const std::string& group, const std::string& name, double value, const std::string& unit) {
+void StatsReport::add_ratio(const std::string& group, const std::string& name, double value,
+                            const std::string& unit) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.3f %s", value, unit.c_str());
     add(group, name, buf, value);
@@ -47,14 +48,17 @@ nlohmann::json StatsReport::to_json() const {
     return j;
 }
 
-uint64_t texture_bytes(const TextureDesc& t) { return t.image ? uint64_t(t.image->rgba.size()) * sizeof(float) : 0; }
+uint64_t texture_bytes(const TextureDesc& t) {
+    return t.image ? uint64_t(t.image->rgba.size()) * sizeof(float) : 0;
+}
 
 SceneMemory estimate_scene_memory(const Scene& scene) {
     SceneMemory m;
     m.spheres = scene.spheres.size() * sizeof(Sphere);
     const TriangleSoup& s = scene.triangles;
-    m.triangles = s.positions.size() * sizeof(Vec3) + s.normals.size() * sizeof(Vec3) + s.uvs.size() * sizeof(Vec2) +
-                  s.indices.size() * sizeof(uint32_t) + s.material.size() * sizeof(uint32_t);
+    m.triangles = s.positions.size() * sizeof(Vec3) + s.normals.size() * sizeof(Vec3) +
+                  s.uvs.size() * sizeof(Vec2) + s.indices.size() * sizeof(uint32_t) +
+                  s.material.size() * sizeof(uint32_t);
     m.other_geometry = scene.planes.size() * sizeof(Plane) + scene.boxes.size() * sizeof(Box);
     // Shared images (one texture used twice) count once.
     std::vector<const Image*> seen;
@@ -71,10 +75,14 @@ SceneMemory estimate_scene_memory(const Scene& scene) {
 
 std::string format_bytes(uint64_t bytes) {
     char buf[32];
-    if (bytes < 1024) std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
-    else if (bytes < 1024ull * 1024) std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
-    else if (bytes < 1024ull * 1024 * 1024) std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / 1048576.0);
-    else std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / 1073741824.0);
+    if (bytes < 1024)
+        std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+    else if (bytes < 1024ull * 1024)
+        std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / 1024.0);
+    else if (bytes < 1024ull * 1024 * 1024)
+        std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / 1048576.0);
+    else
+        std::snprintf(buf, sizeof buf, "%.2f GiB", double(bytes) / 1073741824.0);
     return buf;
 }
 

@@ -13,9 +13,10 @@
 namespace sahara {
 
 class StatsReport {
-public:
+   public:
     /// Adds a line; groups print in the order they first appear.
-    void add(const std::string& group, const std::string& name, const std::string& text, nlohmann::json value);
+    void add(const std::string& group, const std::string& name, const std::string& text,
+             nlohmann::json value);
     void add_count(const std::string& group, const std::string& name, uint64_t n);
     void add_bytes(const std::string& group, const std::string& name, uint64_t bytes);
     void add_seconds(const std::string& group, const std::string& name, double seconds);
@@ -25,7 +26,7 @@ public:
     /// {"Group": {"Name": value, ...}, ...}
     nlohmann::json to_json() const;
 
-private:
+   private:
     struct Line {
         std::string group, name, text;
         nlohmann::json value;

@@ -9,13 +9,15 @@ namespace {
 
 int wrap_index(int i, int n, WrapMode mode) {
     switch (mode) {
-        case WrapMode::clamp: return std::clamp(i, 0, n - 1);
+        case WrapMode::clamp:
+            return std::clamp(i, 0, n - 1);
         case WrapMode::mirror: {
             int period = 2 * n;
             int m = ((i % period) + period) % period;
             return m < n ? m : period - 1 - m;
         }
-        case WrapMode::repeat: break;
+        case WrapMode::repeat:
+            break;
     }
     return ((i % n) + n) % n;
 }
@@ -29,7 +31,8 @@ TVec3<float> sample_texture_rgb(const TextureDesc& tex, Vec2 uv, float* alpha) {
     if (tex.uv_rotation != 0.0f) {
         float c = std::cos(tex.uv_rotation), s = std::sin(tex.uv_rotation);
         float ru = c * su + s * sv, rv = -s * su + c * sv;
-        su = ru; sv = rv;
+        su = ru;
+        sv = rv;
     }
     su += tex.uv_offset.x;
     sv += tex.uv_offset.y;

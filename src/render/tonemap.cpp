@@ -27,9 +27,12 @@ float hable(float x) {
 /// The curve before the final clamp to [0,1]; v is finite and > 0.
 float curve_unclamped(float v, Tonemap curve) {
     switch (curve) {
-        case Tonemap::clamp: return v;
-        case Tonemap::reinhard: return v / (1.0f + v);
-        case Tonemap::aces: return aces_fit(v);
+        case Tonemap::clamp:
+            return v;
+        case Tonemap::reinhard:
+            return v / (1.0f + v);
+        case Tonemap::aces:
+            return aces_fit(v);
         case Tonemap::filmic: {
             const float exposure_bias = 2.0f, linear_white = 11.2f;
             return hable(exposure_bias * v) / hable(linear_white);
@@ -39,7 +42,10 @@ float curve_unclamped(float v, Tonemap curve) {
 }
 
 constexpr std::array<std::pair<Tonemap, std::string_view>, 4> kNames{{
-    {Tonemap::clamp, "clamp"}, {Tonemap::reinhard, "reinhard"}, {Tonemap::aces, "aces"}, {Tonemap::filmic, "filmic"},
+    {Tonemap::clamp, "clamp"},
+    {Tonemap::reinhard, "reinhard"},
+    {Tonemap::aces, "aces"},
+    {Tonemap::filmic, "filmic"},
 }};
 
 }  // namespace
@@ -56,7 +62,8 @@ bool tonemap_clips(float v, Tonemap curve) {
     return curve_unclamped(v, curve) > 1.0f;
 }
 
-std::vector<float> tonemap_image(const std::vector<float>& rgb, float exposure_stops, Tonemap curve, size_t* clipped) {
+std::vector<float> tonemap_image(const std::vector<float>& rgb, float exposure_stops, Tonemap curve,
+                                 size_t* clipped) {
     const float scale = std::exp2(exposure_stops);
     std::vector<float> out(rgb.size());
     size_t n_clipped = 0;

@@ -44,8 +44,8 @@ Rgb direct_lights(const Scene& scene, const SurfaceInteraction& si, const Rgb& a
 Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight);
 
 /// Continues along a reflected or refracted direction if the branch still matters.
-Rgb branch(const Scene& scene, const SurfaceInteraction& si, const Vec3& dir, bool transmit, float time, int depth,
-           int max_depth, float weight) {
+Rgb branch(const Scene& scene, const SurfaceInteraction& si, const Vec3& dir, bool transmit, float time,
+           int depth, int max_depth, float weight) {
     if (weight < kMinBranchWeight) return Rgb(0.0f);
     const Ray next{offset_ray_origin(si.p, transmit ? -si.ng : si.ng), dir, 0.0f, kInfinity, time};
     return trace(scene, next, depth + 1, max_depth, weight);
@@ -72,14 +72,16 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
             const Rgb f = fresnel_schlick(eval_color(m.albedo, scene.textures, si.p, si.uv), dot(wo, si.ns));
             const Vec3 wr = reflect(wo, si.ns);
             if (dot(wr, si.ng) > 0)
-                radiance += f * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * max_component(f));
+                radiance +=
+                    f * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * max_component(f));
             break;
         }
         case MaterialType::dielectric: {
             const float eta = si.front_face ? m.ior : 1.0f / m.ior;
             const float r = fresnel_dielectric(dot(wo, si.ns), eta);
             const Vec3 wr = reflect(wo, si.ns);
-            if (dot(wr, si.ng) > 0) radiance += r * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * r);
+            if (dot(wr, si.ng) > 0)
+                radiance += r * branch(scene, si, wr, false, ray.time, depth, max_depth, weight * r);
             Vec3 wt;
             if (r < 1.0f && refract(wo, si.ns, eta, &wt) && dot(wt, si.ng) < 0) {
                 const float t = (1.0f - r) / (eta * eta);  // radiance compression across the interface
@@ -87,7 +89,8 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
             }
             break;
         }
-        case MaterialType::emissive: break;
+        case MaterialType::emissive:
+            break;
     }
     return radiance;
 }

@@ -18,7 +18,10 @@ std::string line_column(const std::string& text, size_t byte) {
     size_t end = std::min(byte == 0 ? 0 : byte - 1, text.size());
     size_t line = 1, line_start = 0;
     for (size_t i = 0; i < end; ++i)
-        if (text[i] == '\n') { ++line; line_start = i + 1; }
+        if (text[i] == '\n') {
+            ++line;
+            line_start = i + 1;
+        }
     return "line " + std::to_string(line) + ", column " + std::to_string(end - line_start + 1);
 }
 
@@ -42,26 +45,34 @@ bool is_identifier(const std::string& s) {
 /// The container frames the parser is inside; rebuilds the JSON path of a
 /// duplicate key, which nlohmann would otherwise silently overwrite.
 class DuplicateKeyCheck {
-public:
+   public:
     explicit DuplicateKeyCheck(const std::string& file) : file_(file) {}
 
     bool operator()(int, nlohmann::detail::parse_event_t event, Json& parsed) {
         using E = nlohmann::detail::parse_event_t;
         switch (event) {
-            case E::object_start: frames_.push_back({true, 0, {}, {}}); break;
-            case E::array_start: frames_.push_back({false, 0, {}, {}}); break;
-            case E::key: on_key(parsed.get<std::string>()); break;
+            case E::object_start:
+                frames_.push_back({true, 0, {}, {}});
+                break;
+            case E::array_start:
+                frames_.push_back({false, 0, {}, {}});
+                break;
+            case E::key:
+                on_key(parsed.get<std::string>());
+                break;
             case E::object_end:
             case E::array_end:
                 frames_.pop_back();
                 element_done();
                 break;
-            case E::value: element_done(); break;
+            case E::value:
+                element_done();
+                break;
         }
         return true;
     }
 
-private:
+   private:
     struct Frame {
         bool object;
         size_t index;
@@ -95,7 +106,8 @@ Json parse_json_text(const std::string& text, const std::string& file) {
     try {
         return Json::parse(text, std::ref(check), true, false);
     } catch (const Json::parse_error& e) {
-        throw input_error(file, line_column(text, e.byte), "invalid JSON: " + strip_nlohmann_prefix(e.what()));
+        throw input_error(file, line_column(text, e.byte),
+                          "invalid JSON: " + strip_nlohmann_prefix(e.what()));
     } catch (const Json::out_of_range& e) {
         // "number overflow parsing '1e999'": locate the literal for the position.
         std::string what = strip_nlohmann_prefix(e.what());
@@ -150,12 +162,18 @@ void JsonValue::fail(const std::string& message) const { throw input_error(*file
 
 std::string JsonValue::kind() const {
     switch (json_->type()) {
-        case Json::value_t::null: return "null";
-        case Json::value_t::boolean: return "a boolean";
-        case Json::value_t::string: return "a string";
-        case Json::value_t::array: return "an array";
-        case Json::value_t::object: return "an object";
-        default: return "a number";
+        case Json::value_t::null:
+            return "null";
+        case Json::value_t::boolean:
+            return "a boolean";
+        case Json::value_t::string:
+            return "a string";
+        case Json::value_t::array:
+            return "an array";
+        case Json::value_t::object:
+            return "an object";
+        default:
+            return "a number";
     }
 }
 
@@ -168,7 +186,8 @@ double JsonValue::number(const NumberRange& range) const {
 
 float JsonValue::number_f(const NumberRange& range) const {
     double v = number(range);
-    if (std::abs(v) > double(FLT_MAX)) fail_expected("a number" + range.describe() + " that fits a 32-bit float");
+    if (std::abs(v) > double(FLT_MAX))
+        fail_expected("a number" + range.describe() + " that fits a 32-bit float");
     return float(v);
 }
 
@@ -199,7 +218,8 @@ uint64_t JsonValue::unsigned_integer() const {
     if (json_->is_number_integer()) fail_expected(expected);  // negative
     if (!json_->is_number()) fail_expected(expected);
     double v = json_->get<double>();
-    if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v >= 18446744073709551616.0) fail_expected(expected);
+    if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v >= 18446744073709551616.0)
+        fail_expected(expected);
     return uint64_t(v);
 }
 
@@ -228,7 +248,8 @@ size_t JsonValue::one_of(std::initializer_list<const char*> names) const {
 }
 
 Vec3 JsonValue::vec3(const NumberRange& range) const {
-    const std::string expected = "[x, y, z]: 3 numbers" + (range.describe().empty() ? "" : " each" + range.describe());
+    const std::string expected =
+        "[x, y, z]: 3 numbers" + (range.describe().empty() ? "" : " each" + range.describe());
     if (!json_->is_array() || json_->size() != 3) fail_expected(expected);
     Vec3 v;
     for (int i = 0; i < 3; ++i) {
@@ -246,12 +267,15 @@ Vec3 JsonValue::nonzero_vec3() const {
 
 std::vector<JsonValue> JsonValue::array(size_t min_size, size_t max_size) const {
     std::string expected = "an array";
-    if (min_size == max_size) expected += " of " + std::to_string(min_size) + " elements";
-    else if (min_size > 0) expected += " of at least " + std::to_string(min_size) + " elements";
+    if (min_size == max_size)
+        expected += " of " + std::to_string(min_size) + " elements";
+    else if (min_size > 0)
+        expected += " of at least " + std::to_string(min_size) + " elements";
     if (!json_->is_array() || json_->size() < min_size || json_->size() > max_size) fail_expected(expected);
     std::vector<JsonValue> out;
     out.reserve(json_->size());
-    for (size_t i = 0; i < json_->size(); ++i) out.emplace_back((*json_)[i], *file_, path_ + "[" + std::to_string(i) + "]");
+    for (size_t i = 0; i < json_->size(); ++i)
+        out.emplace_back((*json_)[i], *file_, path_ + "[" + std::to_string(i) + "]");
     return out;
 }
 
@@ -261,7 +285,9 @@ JsonObject::JsonObject(const JsonValue& value) : value_(value) {
     if (!value.json().is_object()) value.fail_expected("an object");
 }
 
-std::string JsonObject::child_path(const std::string& key) const { return json_member_path(value_.path(), key); }
+std::string JsonObject::child_path(const std::string& key) const {
+    return json_member_path(value_.path(), key);
+}
 
 std::optional<JsonValue> JsonObject::get(const char* key) {
     allowed_.emplace_back(key);
@@ -278,7 +304,9 @@ std::optional<JsonValue> JsonObject::get_non_null(const char* key) {
 
 JsonValue JsonObject::require(const char* key, const std::string& what) {
     auto v = get(key);
-    if (!v) throw input_error(value_.file(), value_.path(), "missing key \"" + std::string(key) + "\" (expected " + what + ")");
+    if (!v)
+        throw input_error(value_.file(), value_.path(),
+                          "missing key \"" + std::string(key) + "\" (expected " + what + ")");
     return *v;
 }
 

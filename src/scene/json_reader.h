@@ -38,7 +38,7 @@ struct NumberRange {
 
 /// One JSON value plus its file and path; cheap to copy (holds a reference).
 class JsonValue {
-public:
+   public:
     JsonValue(const Json& json, const std::string& file, std::string path)
         : json_(&json), file_(&file), path_(std::move(path)) {}
 
@@ -73,7 +73,7 @@ public:
     /// `what` for messages: "a number", "an object", ... of this value's JSON type.
     std::string kind() const;
 
-private:
+   private:
     const Json* json_;
     const std::string* file_;
     std::string path_;
@@ -82,7 +82,7 @@ private:
 /// A JSON object whose keys are consumed one by one; `finish()` rejects any key
 /// that was never asked for (typos must not be silently ignored).
 class JsonObject {
-public:
+   public:
     explicit JsonObject(const JsonValue& value);
 
     /// The value at `key`, or nothing when absent. Also declares `key` as allowed.
@@ -98,7 +98,7 @@ public:
     /// JSON path of a (possibly absent) member.
     std::string child_path(const std::string& key) const;
 
-private:
+   private:
     JsonValue value_;
     std::vector<std::string> allowed_;
 };

@@ -102,7 +102,10 @@ Vec3 box_normal(const Bounds3& b, const Vec3& p) {
     float best = -1;
     for (int k = 0; k < 3; ++k) {
         float r = e[k] > 0 ? std::abs(d[k]) / e[k] : 1.0f;
-        if (r > best) { best = r; axis = k; }
+        if (r > best) {
+            best = r;
+            axis = k;
+        }
     }
     Vec3 n(0.0f);
     n[axis] = d[axis] >= 0 ? 1.0f : -1.0f;
@@ -117,14 +120,24 @@ Quadric make_quadric(const QuadricDesc& d) {
     const Vec3 o(0, 0, 0), z(0, 0, 1);
     Quadric q;
     switch (d.type) {
-        case QuadricDesc::Type::ellipsoid: q = make_ellipsoid(o, d.radii, d.world_from_local); break;
-        case QuadricDesc::Type::cylinder: q = make_cylinder(o, z, d.radius, d.height, d.capped, d.world_from_local); break;
-        case QuadricDesc::Type::cone: q = make_cone(o, z, d.angle, d.height, d.capped, d.world_from_local); break;
-        case QuadricDesc::Type::paraboloid: q = make_paraboloid(o, z, d.radius, d.height, d.world_from_local); break;
+        case QuadricDesc::Type::ellipsoid:
+            q = make_ellipsoid(o, d.radii, d.world_from_local);
+            break;
+        case QuadricDesc::Type::cylinder:
+            q = make_cylinder(o, z, d.radius, d.height, d.capped, d.world_from_local);
+            break;
+        case QuadricDesc::Type::cone:
+            q = make_cone(o, z, d.angle, d.height, d.capped, d.world_from_local);
+            break;
+        case QuadricDesc::Type::paraboloid:
+            q = make_paraboloid(o, z, d.radius, d.height, d.world_from_local);
+            break;
         case QuadricDesc::Type::hyperboloid:
             q = make_hyperboloid(o, z, d.radius, d.waist, d.height, d.world_from_local);
             break;
-        case QuadricDesc::Type::general: q = make_general_quadric(d.coefficients, d.local_bounds, d.world_from_local); break;
+        case QuadricDesc::Type::general:
+            q = make_general_quadric(d.coefficients, d.local_bounds, d.world_from_local);
+            break;
     }
     q.material = d.material;
     return q;
@@ -134,7 +147,9 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
     SurfaceInteraction si;
     const uint32_t idx = prim_index(hit.prim);
     switch (prim_kind(hit.prim)) {
-        case PrimKind::triangle: interact_triangle(triangles, idx, hit, si); break;
+        case PrimKind::triangle:
+            interact_triangle(triangles, idx, hit, si);
+            break;
         case PrimKind::sphere: {
             const Sphere& s = spheres[idx];
             const Vec3 c = s.center_at(ray.time);
@@ -200,10 +215,12 @@ Scene build_scene(const SceneDesc& desc) {
     if (scene.materials.empty()) scene.materials.push_back(default_material());
     scene.textures = desc.textures;
     scene.lights = desc.lights;
-    for (const SphereDesc& s : desc.spheres) scene.spheres.push_back({s.center, s.radius, s.velocity, s.material});
+    for (const SphereDesc& s : desc.spheres)
+        scene.spheres.push_back({s.center, s.radius, s.velocity, s.material});
     for (const PlaneDesc& p : desc.planes) scene.planes.push_back({p.point, normalize(p.normal), p.material});
     for (const QuadricDesc& q : desc.quadrics) scene.quadrics.push_back(make_quadric(q));
-    for (const BoxDesc& b : desc.boxes) scene.boxes.push_back({Bounds3{min(b.lo, b.hi), max(b.lo, b.hi)}, b.material});
+    for (const BoxDesc& b : desc.boxes)
+        scene.boxes.push_back({Bounds3{min(b.lo, b.hi), max(b.lo, b.hi)}, b.material});
 
     bool any_normals = false, any_uvs = false;
     for (const TriangleMesh& m : desc.meshes) {
@@ -216,12 +233,16 @@ Scene build_scene(const SceneDesc& desc) {
         soup.positions.insert(soup.positions.end(), m.positions.begin(), m.positions.end());
         // Meshes without normals get zero normals: interact() falls back to the geometric one.
         if (any_normals) {
-            if (m.normals.empty()) soup.normals.resize(soup.positions.size(), Vec3(0.0f));
-            else soup.normals.insert(soup.normals.end(), m.normals.begin(), m.normals.end());
+            if (m.normals.empty())
+                soup.normals.resize(soup.positions.size(), Vec3(0.0f));
+            else
+                soup.normals.insert(soup.normals.end(), m.normals.begin(), m.normals.end());
         }
         if (any_uvs) {
-            if (m.uvs.empty()) soup.uvs.resize(soup.positions.size(), Vec2{0, 0});
-            else soup.uvs.insert(soup.uvs.end(), m.uvs.begin(), m.uvs.end());
+            if (m.uvs.empty())
+                soup.uvs.resize(soup.positions.size(), Vec2{0, 0});
+            else
+                soup.uvs.insert(soup.uvs.end(), m.uvs.begin(), m.uvs.end());
         }
         for (uint32_t idx : m.indices) soup.indices.push_back(base + idx);
         for (size_t t = 0; t < m.triangle_count(); ++t)

@@ -16,9 +16,9 @@ namespace sahara {
 
 /// Everything shading needs about the accepted hit.
 struct SurfaceInteraction {
-    Vec3 p;            ///< hit point
-    Vec3 ng;           ///< geometric normal, unit, facing against the incoming ray
-    Vec3 ns;           ///< shading normal, unit, same hemisphere as ng
+    Vec3 p;   ///< hit point
+    Vec3 ng;  ///< geometric normal, unit, facing against the incoming ray
+    Vec3 ns;  ///< shading normal, unit, same hemisphere as ng
     Vec2 uv;
     uint32_t material = 0;
     bool front_face = true;  ///< the ray hit the outward (front) side
@@ -57,8 +57,8 @@ struct SceneFeatures {
     bool has_lens = false;               ///< thin-lens depth of field
     bool has_textures = false;           ///< checker or image colour sources
     bool has_metal = false, has_rough_metal = false, has_dielectric = false;
-    bool lambertian_only = true;         ///< no metal, no dielectric
-    bool forced_all = false;             ///< everything on (SAHARA_FORCE_ALL_FEATURES=1), for measurements
+    bool lambertian_only = true;  ///< no metal, no dielectric
+    bool forced_all = false;      ///< everything on (SAHARA_FORCE_ALL_FEATURES=1), for measurements
 };
 
 /// Something that light sampling can pick: a light, an emissive primitive, or the envmap.
@@ -71,7 +71,7 @@ inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
 class Accelerator;  // accel/: the BVH over bounded primitives
 
 class Scene {
-public:
+   public:
     Scene();
     ~Scene();
     Scene(Scene&&) noexcept;
@@ -111,8 +111,8 @@ public:
     std::vector<uint32_t> triangle_emitter;  ///< same per triangle
     std::vector<uint32_t> box_emitter;       ///< same per box
     uint32_t envmap_emitter = kNoEmitter;
-    Distribution2D envmap_distribution;      ///< over the envmap's (u, v), luminance * sin(theta)
-    float scene_radius = 1;                  ///< bounding-sphere radius of the bounded geometry
+    Distribution2D envmap_distribution;  ///< over the envmap's (u, v), luminance * sin(theta)
+    float scene_radius = 1;              ///< bounding-sphere radius of the bounded geometry
 
     /// Builds the acceleration structure over the current geometry.
     void build_accelerator();
@@ -121,7 +121,7 @@ public:
     void prepare_lighting(bool force_all_features);
     const Accelerator* accelerator() const { return accel_.get(); }
 
-private:
+   private:
     std::unique_ptr<Accelerator> accel_;
     Bounds3 bounds_;
 };

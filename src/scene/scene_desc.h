@@ -54,9 +54,9 @@ enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive };
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
-    ColorSource albedo;        ///< lambertian and metal
-    float roughness = 0.0f;    ///< metal
-    float ior = 1.5f;          ///< dielectric
+    ColorSource albedo;                                            ///< lambertian and metal
+    float roughness = 0.0f;                                        ///< metal
+    float ior = 1.5f;                                              ///< dielectric
     ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};  ///< emissive (front side)
     /// Lambertian only: radiance it also emits, from both sides. Not light-sampled
     /// (found by BSDF sampling only); meant for analytic scenes such as the closed
@@ -122,9 +122,9 @@ struct BoxDesc {
 struct TriangleMesh {
     std::string name;  ///< source file and element, for messages and stats
     std::vector<Vec3> positions;
-    std::vector<Vec3> normals;      ///< empty, or one per position
-    std::vector<Vec2> uvs;          ///< empty, or one per position
-    std::vector<uint32_t> indices;  ///< 3 per triangle, counter-clockwise = front
+    std::vector<Vec3> normals;           ///< empty, or one per position
+    std::vector<Vec2> uvs;               ///< empty, or one per position
+    std::vector<uint32_t> indices;       ///< 3 per triangle, counter-clockwise = front
     std::vector<uint32_t> material_ids;  ///< empty (all use `material`) or one per triangle
     uint32_t material = 0;
 
@@ -143,14 +143,15 @@ struct QuadricDesc {
     enum class Type : uint8_t { ellipsoid, cylinder, cone, paraboloid, hyperboloid, general };
     Type type = Type::general;
     // --- parameters as written (before the object's transform) ---
-    Vec3 origin{0, 0, 0};  ///< centre (ellipsoid, hyperboloid), base (cylinder), apex (cone), vertex (paraboloid)
-    Vec3 axis{0, 0, 1};    ///< unit symmetry axis (not used by ellipsoid and general)
-    Vec3 radii{1, 1, 1};   ///< ellipsoid semi-axes along the scene's x, y, z
-    float radius = 1;      ///< cylinder; paraboloid at `height`; hyperboloid at both ends
-    float height = 1;      ///< cylinder, cone, paraboloid: from origin along axis; hyperboloid: total, centred
-    float angle = 45;      ///< cone: half-angle between axis and side, degrees, in (0, 90)
-    float waist = 0.5f;    ///< hyperboloid: radius at the centre, 0 < waist < radius
-    bool capped = false;   ///< cylinder: discs at both ends; cone: disc at the open end
+    Vec3 origin{0, 0,
+                0};  ///< centre (ellipsoid, hyperboloid), base (cylinder), apex (cone), vertex (paraboloid)
+    Vec3 axis{0, 0, 1};   ///< unit symmetry axis (not used by ellipsoid and general)
+    Vec3 radii{1, 1, 1};  ///< ellipsoid semi-axes along the scene's x, y, z
+    float radius = 1;     ///< cylinder; paraboloid at `height`; hyperboloid at both ends
+    float height = 1;     ///< cylinder, cone, paraboloid: from origin along axis; hyperboloid: total, centred
+    float angle = 45;     ///< cone: half-angle between axis and side, degrees, in (0, 90)
+    float waist = 0.5f;   ///< hyperboloid: radius at the centre, 0 < waist < radius
+    bool capped = false;  ///< cylinder: discs at both ends; cone: disc at the open end
     // --- canonical form ---
     std::array<double, 10> coefficients{};  ///< A..J above, in the local frame
     Bounds3 local_bounds;                   ///< clip box in the local frame

@@ -15,18 +15,24 @@ constexpr float kPiF = std::numbers::pi_v<float>;
 /// A rough mean of a colour source, enough to pick lights by power.
 float mean_color(const ColorSource& c) {
     switch (c.kind) {
-        case ColorSource::Kind::constant: return average(c.color);
-        case ColorSource::Kind::checker: return 0.5f * (average(c.even) + average(c.odd));
-        case ColorSource::Kind::texture: return average(c.color);  // the texture's mean is not known here
+        case ColorSource::Kind::constant:
+            return average(c.color);
+        case ColorSource::Kind::checker:
+            return 0.5f * (average(c.even) + average(c.odd));
+        case ColorSource::Kind::texture:
+            return average(c.color);  // the texture's mean is not known here
     }
     return average(c.color);
 }
 
-bool is_sampled_emitter(const MaterialDesc& m) { return m.type == MaterialType::emissive && mean_color(m.radiance) > 0; }
+bool is_sampled_emitter(const MaterialDesc& m) {
+    return m.type == MaterialType::emissive && mean_color(m.radiance) > 0;
+}
 
 float triangle_area(const TriangleSoup& soup, size_t i) {
     const Vec3& p0 = soup.positions[soup.indices[3 * i]];
-    return 0.5f * length(cross(soup.positions[soup.indices[3 * i + 1]] - p0, soup.positions[soup.indices[3 * i + 2]] - p0));
+    return 0.5f * length(cross(soup.positions[soup.indices[3 * i + 1]] - p0,
+                               soup.positions[soup.indices[3 * i + 2]] - p0));
 }
 
 float bounding_radius(const Scene& s) {
@@ -90,7 +96,8 @@ void collect_features(const Scene& s, SceneFeatures& f) {
         f.has_metal |= m.type == MaterialType::metal;
         f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
         f.has_dielectric |= m.type == MaterialType::dielectric;
-        f.has_textures |= m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
+        f.has_textures |=
+            m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
     }
     f.lambertian_only = !f.has_metal && !f.has_dielectric;
     const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
@@ -123,11 +130,11 @@ void Scene::prepare_lighting(bool force_all_features) {
     const size_t delta_count = emitters.size();
     for (uint32_t i = 0; i < spheres.size(); ++i)
         add_area_emitter(sphere_emitter, spheres.size(), Emitter::Kind::sphere, i,
-                         4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material], emitters,
-                         power);
+                         4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material],
+                         emitters, power);
     for (uint32_t i = 0; i < triangles.size(); ++i)
-        add_area_emitter(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i, triangle_area(triangles, i),
-                         materials[triangles.material[i]], emitters, power);
+        add_area_emitter(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i,
+                         triangle_area(triangles, i), materials[triangles.material[i]], emitters, power);
     for (uint32_t i = 0; i < boxes.size(); ++i)
         add_area_emitter(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
                          materials[boxes[i].material], emitters, power);

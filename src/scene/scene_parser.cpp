@@ -23,7 +23,8 @@ void parse_render(JsonObject o, RenderSettings& r) {
     if (auto v = o.get("max_depth")) r.max_depth = int(v->integer(1, 1024));
     if (auto v = o.get("seed")) r.seed = v->unsigned_integer();
     if (auto v = o.get("integrator"))
-        r.integrator = IntegratorType(v->one_of({"path", "whitted", "albedo", "normals", "depth", "bvh-cost"}));
+        r.integrator =
+            IntegratorType(v->one_of({"path", "whitted", "albedo", "normals", "depth", "bvh-cost"}));
     if (auto v = o.get_non_null("time_limit_s")) r.time_limit_s = v->number(NumberRange::positive());
     if (auto v = o.get_non_null("target_error")) r.target_error = v->number(NumberRange::positive());
     // 2^±64 already saturates or blacks out any image; larger values are typos.
@@ -67,8 +68,10 @@ void parse_camera(JsonObject o, CameraDesc& cam) {
         o.value().fail(std::string("mixes the look-at form (\"") + look_key + "\") with the euler form (\"" +
                        euler_key + "\"); use either position/look_at/up/vfov or position/euler/focal_length");
     cam.position = o.require("position", "the camera position [x, y, z]").vec3();
-    if (euler_key) parse_euler_camera(o, cam);
-    else parse_look_at_camera(o, cam);
+    if (euler_key)
+        parse_euler_camera(o, cam);
+    else
+        parse_look_at_camera(o, cam);
     if (auto v = o.get("aperture")) cam.aperture = v->number_f(NumberRange::non_negative());
     if (auto v = o.get_non_null("focus_distance")) cam.focus_distance = v->number_f(NumberRange::positive());
     // The euler form has no target; its natural focus is the view plane.
@@ -172,8 +175,10 @@ MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext&
             if (auto v = o.get("ior")) m.ior = v->number_f(NumberRange::positive());
             break;
         case MaterialType::emissive:
-            if (auto v = o.get("radiance")) m.radiance.color = v->vec3(NumberRange::non_negative());
-            else m.radiance.color = Rgb(1.0f);
+            if (auto v = o.get("radiance"))
+                m.radiance.color = v->vec3(NumberRange::non_negative());
+            else
+                m.radiance.color = Rgb(1.0f);
             break;
     }
     o.finish();
@@ -194,9 +199,11 @@ void parse_materials(JsonObject o, ParseContext& ctx) {
 
 std::string read_text_file(const std::filesystem::path& file) {
     std::error_code ec;
-    if (std::filesystem::is_directory(file, ec)) throw input_error(file.string(), "", "is a directory, not a scene file");
+    if (std::filesystem::is_directory(file, ec))
+        throw input_error(file.string(), "", "is a directory, not a scene file");
     std::ifstream in(file, std::ios::binary);
-    if (!in) throw input_error(file.string(), "", std::string("cannot open scene file: ") + std::strerror(errno));
+    if (!in)
+        throw input_error(file.string(), "", std::string("cannot open scene file: ") + std::strerror(errno));
     std::ostringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw input_error(file.string(), "", "read error");
@@ -253,13 +260,16 @@ SceneLoaders SceneLoaders::standard() {
     return l;
 }
 
-SceneDesc parse_scene_file(const std::filesystem::path& file) { return parse_scene_json(read_text_file(file), file); }
+SceneDesc parse_scene_file(const std::filesystem::path& file) {
+    return parse_scene_json(read_text_file(file), file);
+}
 
 SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file) {
     return parse_scene_json(text, file, SceneLoaders::standard());
 }
 
-SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file, const SceneLoaders& loaders) {
+SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file,
+                           const SceneLoaders& loaders) {
     SceneDesc scene;
     ParseContext ctx;
     ctx.file = file.string();

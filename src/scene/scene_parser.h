@@ -31,7 +31,8 @@ SceneDesc parse_scene_file(const std::filesystem::path& file);
 /// for relative paths (its parent directory).
 SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file);
 /// As above, with substitute loaders.
-SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file, const SceneLoaders& loaders);
+SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file,
+                           const SceneLoaders& loaders);
 
 /// The built-in scene (the workshop's final image): a red sphere on a big green
 /// ground sphere under the white-to-blue gradient sky, z up.

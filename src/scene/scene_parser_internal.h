@@ -12,8 +12,8 @@
 namespace sahara {
 
 struct ParseContext {
-    std::string file;              ///< scene file name as given, for messages
-    std::filesystem::path base;    ///< directory relative paths resolve against
+    std::string file;            ///< scene file name as given, for messages
+    std::filesystem::path base;  ///< directory relative paths resolve against
     const SceneLoaders* loaders = nullptr;
     SceneDesc* scene = nullptr;
     std::unordered_map<std::string, uint32_t> material_by_name;

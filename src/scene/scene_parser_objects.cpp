@@ -21,15 +21,18 @@ Mat4 parse_matrix(const JsonValue& v) {
     for (int i = 0; i < 16; ++i) m.m[i / 4][i % 4] = elems[size_t(i)].number();
     if (m.m[3][0] != 0 || m.m[3][1] != 0 || m.m[3][2] != 0 || m.m[3][3] != 1)
         v.fail("expected an affine matrix: the last row (elements 12..15) must be 0, 0, 0, 1");
-    if (std::abs(m.determinant3()) < 1e-12) v.fail("expected an invertible matrix (its 3x3 part is singular)");
+    if (std::abs(m.determinant3()) < 1e-12)
+        v.fail("expected an invertible matrix (its 3x3 part is singular)");
     return m;
 }
 
 Vec3d parse_scale(const JsonValue& v) {
     const char* expected = "a non-zero number or [x, y, z] of non-zero numbers";
     Vec3d s(0.0);
-    if (v.json().is_array()) s = Vec3d(v.vec3());
-    else if (v.json().is_number()) s = Vec3d(double(v.number_f()));
+    if (v.json().is_array())
+        s = Vec3d(v.vec3());
+    else if (v.json().is_number())
+        s = Vec3d(double(v.number_f()));
     if (s.x == 0 || s.y == 0 || s.z == 0) v.fail_expected(expected);
     return s;
 }
@@ -43,7 +46,9 @@ Mat4 parse_transform(const JsonValue& v) {
     auto translate = o.get("translate");
     o.finish();
     if (matrix && (scale || rotate || translate))
-        v.fail("\"matrix\" excludes \"scale\", \"rotate\" and \"translate\"; give the matrix alone or those three");
+        v.fail(
+            "\"matrix\" excludes \"scale\", \"rotate\" and \"translate\"; give the matrix alone or those "
+            "three");
     if (matrix) return parse_matrix(*matrix);
     Mat4 s = scale ? Mat4::scale(parse_scale(*scale)) : Mat4::identity();
     Mat4 r = rotate ? Mat4::rotate_euler(Vec3d(rotate->vec3())) : Mat4::identity();
@@ -80,9 +85,11 @@ void parse_sphere(JsonObject& o, ParseContext& ctx) {
         Vec3d c0 = column(*m, 0), c1 = column(*m, 1), c2 = column(*m, 2);
         double l = length(c0), tol = 1e-6 * l * l;
         bool similar = std::abs(dot(c1, c1) - l * l) <= tol && std::abs(dot(c2, c2) - l * l) <= tol &&
-                       std::abs(dot(c0, c1)) <= tol && std::abs(dot(c0, c2)) <= tol && std::abs(dot(c1, c2)) <= tol;
+                       std::abs(dot(c0, c1)) <= tol && std::abs(dot(c0, c2)) <= tol &&
+                       std::abs(dot(c1, c2)) <= tol;
         JsonValue where(o.value().json().at("transform"), ctx.file, o.child_path("transform"));
-        if (!similar) where.fail("a sphere only takes a uniform scale (use an ellipsoid for non-uniform scale)");
+        if (!similar)
+            where.fail("a sphere only takes a uniform scale (use an ellipsoid for non-uniform scale)");
         s.center = checked_point(where, m->apply_point(s.center));
         s.velocity = checked_point(where, m->apply_vector(s.velocity));
         double r = double(s.radius) * l;
@@ -111,7 +118,8 @@ bool keeps_axis_aligned(const Mat4& m) {
     for (int c = 0; c < 3; ++c) {
         Vec3d col = column(m, c);
         double big = std::max({std::abs(col.x), std::abs(col.y), std::abs(col.z)});
-        int nonzero = (std::abs(col.x) > 1e-9 * big) + (std::abs(col.y) > 1e-9 * big) + (std::abs(col.z) > 1e-9 * big);
+        int nonzero =
+            (std::abs(col.x) > 1e-9 * big) + (std::abs(col.y) > 1e-9 * big) + (std::abs(col.z) > 1e-9 * big);
         if (nonzero != 1) return false;
     }
     return true;
@@ -140,7 +148,8 @@ TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, const Mat4& m, const std::
             for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) mesh.indices.push_back(base + i);
         }
     if (m.determinant3() < 0)  // a mirroring transform turns the faces inside out
-        for (size_t t = 0; t < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+        for (size_t t = 0; t < mesh.indices.size(); t += 3)
+            std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     return mesh;
 }
 
@@ -165,7 +174,8 @@ void parse_box(JsonObject& o, ParseContext& ctx, size_t index) {
     if (keeps_axis_aligned(*m)) {
         Bounds3 b;
         for (int c = 0; c < 8; ++c)
-            b.extend(checked_point(where, m->apply_point(Vec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z))));
+            b.extend(checked_point(
+                where, m->apply_point(Vec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z))));
         ctx.scene->boxes.push_back(BoxDesc{b.lo, b.hi, material});
         return;
     }
@@ -190,7 +200,8 @@ void parse_mesh(JsonObject& o, ParseContext& ctx) {
         file.fail(e.what());
     }
     if (model.dropped_degenerate > 0)
-        log_info(path.string() + ": dropped " + std::to_string(model.dropped_degenerate) + " degenerate triangles");
+        log_info(path.string() + ": dropped " + std::to_string(model.dropped_degenerate) +
+                 " degenerate triangles");
     if (!model.cameras.empty())
         log_info(path.string() + ": ignoring " + std::to_string(model.cameras.size()) +
                  " camera(s); the scene's camera is used");
@@ -276,7 +287,8 @@ void parse_named_quadric(JsonObject& o, QuadricDesc& q, const char* origin_key) 
             set_disc_bounds(q, r, -half, half);
             break;
         }
-        case QuadricDesc::Type::general: break;
+        case QuadricDesc::Type::general:
+            break;
     }
 }
 
@@ -286,7 +298,8 @@ void parse_general_quadric(JsonObject& o, QuadricDesc& q) {
     for (size_t i = 0; i < 10; ++i) q.coefficients[i] = elems[i].number();
     bool quadratic = false;
     for (size_t i = 0; i < 6; ++i) quadratic |= q.coefficients[i] != 0;
-    if (!quadratic) coeffs.fail("expected at least one of A..F (the quadratic terms) to be non-zero; use a plane");
+    if (!quadratic)
+        coeffs.fail("expected at least one of A..F (the quadratic terms) to be non-zero; use a plane");
     JsonObject b(o.require("bounds", "the clip box {\"min\": [x, y, z], \"max\": [x, y, z]}"));
     Vec3 lo = b.require("min", "[x, y, z]").vec3();
     JsonValue max_v = b.require("max", "[x, y, z]");
@@ -300,10 +313,12 @@ void parse_quadric(JsonObject& o, ParseContext& ctx, QuadricDesc::Type type) {
     QuadricDesc q;
     q.type = type;
     static const char* origin_keys[] = {"center", "base", "apex", "vertex", "center", ""};
-    if (type == QuadricDesc::Type::general) parse_general_quadric(o, q);
-    else parse_named_quadric(o, q, origin_keys[int(type)]);
+    if (type == QuadricDesc::Type::general)
+        parse_general_quadric(o, q);
+    else
+        parse_named_quadric(o, q, origin_keys[int(type)]);
     q.material = object_material(o, ctx);
-    Mat4 frame = type == QuadricDesc::Type::general   ? Mat4::identity()
+    Mat4 frame = type == QuadricDesc::Type::general     ? Mat4::identity()
                  : type == QuadricDesc::Type::ellipsoid ? Mat4::translate(Vec3d(q.origin))
                                                         : axis_frame(q.origin, q.axis);
     q.world_from_local = object_transform(o).value_or(Mat4::identity()) * frame;
@@ -318,21 +333,33 @@ void parse_quadric(JsonObject& o, ParseContext& ctx, QuadricDesc::Type type) {
 }
 
 void parse_object(JsonObject o, ParseContext& ctx, size_t index) {
-    size_t type = o.require("type", "the object type").one_of(
-        {"sphere", "plane", "box", "mesh", "ellipsoid", "cylinder", "cone", "paraboloid", "hyperboloid", "quadric"});
+    size_t type = o.require("type", "the object type")
+                      .one_of({"sphere", "plane", "box", "mesh", "ellipsoid", "cylinder", "cone",
+                               "paraboloid", "hyperboloid", "quadric"});
     switch (type) {
-        case 0: parse_sphere(o, ctx); break;
-        case 1: parse_plane(o, ctx); break;
-        case 2: parse_box(o, ctx, index); break;
-        case 3: parse_mesh(o, ctx); break;
-        default: parse_quadric(o, ctx, QuadricDesc::Type(type - 4)); break;
+        case 0:
+            parse_sphere(o, ctx);
+            break;
+        case 1:
+            parse_plane(o, ctx);
+            break;
+        case 2:
+            parse_box(o, ctx, index);
+            break;
+        case 3:
+            parse_mesh(o, ctx);
+            break;
+        default:
+            parse_quadric(o, ctx, QuadricDesc::Type(type - 4));
+            break;
     }
     o.finish();
 }
 
 void parse_light(JsonObject o, ParseContext& ctx) {
     LightDesc l;
-    l.type = LightDesc::Type(o.require("type", "\"point\" or \"directional\"").one_of({"point", "directional"}));
+    l.type =
+        LightDesc::Type(o.require("type", "\"point\" or \"directional\"").one_of({"point", "directional"}));
     if (l.type == LightDesc::Type::point) {
         if (auto v = o.get("position")) l.position = v->vec3();
         l.intensity = Rgb(1.0f);
@@ -371,14 +398,17 @@ Mat4 affine_inverse(const Mat4& m) {
     r.m[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
     r.m[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
     r.m[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
-    for (int i = 0; i < 3; ++i) r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
+    for (int i = 0; i < 3; ++i)
+        r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
     return r;
 }
 
 void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uint32_t> material_override) {
     const uint32_t material_offset = uint32_t(scene.materials.size());
     const int texture_offset = int(scene.textures.size());
-    auto shift = [&](int& t) { if (t >= 0) t += texture_offset; };
+    auto shift = [&](int& t) {
+        if (t >= 0) t += texture_offset;
+    };
     if (!material_override) {
         for (MaterialDesc& m : model.materials) {
             shift(m.albedo.texture);

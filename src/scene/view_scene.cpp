@@ -54,7 +54,8 @@ UpAxis guess_up_axis(const LoadedModel& model, std::string& reason) {
     return UpAxis::y;
 }
 
-SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& options, const std::string& source) {
+SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& options,
+                          const std::string& source) {
     if (model.meshes.empty()) throw input_error(source, "", "the model has no triangles to show");
     SceneDesc scene;
     scene.source = source;
@@ -110,7 +111,8 @@ SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& op
     if (options.sun) {
         LightDesc sun;
         sun.type = LightDesc::Type::directional;
-        sun.direction = -normalize(upv * 1.0f + Vec3(0.4f, 0, 0) + (up == UpAxis::y ? Vec3(0, 0, 0.3f) : Vec3(0, -0.3f, 0)));
+        sun.direction = -normalize(upv * 1.0f + Vec3(0.4f, 0, 0) +
+                                   (up == UpAxis::y ? Vec3(0, 0, 0.3f) : Vec3(0, -0.3f, 0)));
         sun.irradiance = {2.0f, 1.9f, 1.7f};
         scene.lights.push_back(sun);
     }

@@ -13,8 +13,8 @@ namespace sahara {
 enum class UpAxis : uint8_t { y, z };
 
 struct ViewOptions {
-    std::optional<UpAxis> up;            ///< none: y for glTF, guessed for OBJ
-    std::optional<int> gltf_camera;      ///< use the model's camera with this index
+    std::optional<UpAxis> up;        ///< none: y for glTF, guessed for OBJ
+    std::optional<int> gltf_camera;  ///< use the model's camera with this index
     bool ground = true;
     bool sun = true;
 };
@@ -25,6 +25,7 @@ struct ViewOptions {
 UpAxis guess_up_axis(const LoadedModel& model, std::string& reason);
 
 /// Builds the viewing scene. `is_gltf` selects the glTF default (y up).
-SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& options, const std::string& source);
+SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& options,
+                          const std::string& source);
 
 }  // namespace sahara

@@ -21,7 +21,8 @@ inline const std::filesystem::path& scratch_dir() {
 }
 
 inline void write_file(const std::filesystem::path& file, const uint8_t* data, size_t size) {
-    std::ofstream(file, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
+    std::ofstream(file, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(data), std::streamsize(size));
 }
 
 }  // namespace sahara_fuzz

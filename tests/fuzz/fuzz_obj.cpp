@@ -17,8 +17,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t split = text.find("#MTL\n");
     const size_t obj_size = split == std::string_view::npos ? size : split;
     sahara_fuzz::write_file(dir / "fuzz.obj", data, obj_size);
-    if (split != std::string_view::npos) sahara_fuzz::write_file(dir / "fuzz.mtl", data + split + 5, size - split - 5);
-    else std::filesystem::remove(dir / "fuzz.mtl");
+    if (split != std::string_view::npos)
+        sahara_fuzz::write_file(dir / "fuzz.mtl", data + split + 5, size - split - 5);
+    else
+        std::filesystem::remove(dir / "fuzz.mtl");
     try {
         sahara::load_obj(dir / "fuzz.obj");
     } catch (const sahara::InputError&) {
