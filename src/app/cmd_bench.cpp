@@ -109,6 +109,8 @@ std::string embree_plan(const BenchOptions& opt, const Scene& scene) {
     if (scene.spheres.size() + scene.boxes.size() + scene.quadrics.size() > 0)
         return "skipped: scene has " + primitive_kinds_text(scene, false) +
                " (Embree reference holds triangles only)";
+    if (scene.accelerator() && scene.accelerator()->has_cutouts())
+        return "skipped: scene has cut-out triangles (the Embree reference has no alpha test)";
     return "compared";
 }
 
