@@ -5,6 +5,9 @@
 /// in the primitive id (geometry/hit.h) with a switch, never a virtual call.
 /// The accelerator copies the primitive data it tests (triangle vertices in
 /// leaf order, spheres, boxes), so it stays valid when the Scene is moved.
+/// Scenes with cut-out triangles (accel/alpha_filter.h) run a second
+/// instantiation of the traversal whose triangle hits pass the alpha test
+/// before they count; the others run the traversal without it.
 #include <string_view>
 #include <vector>
 
