@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <set>
+#include <tuple>
 #include <vector>
 
 #include "render/sampler.h"
@@ -185,4 +186,32 @@ TEST_CASE("sobol sampler: same image with any thread count and any split into pa
     render_pass(scene, b, 3, 8, 2, nullptr);
     // Sums are accumulated in the same per-pixel order, so the images match bit for bit.
     CHECK(a.to_rgb() == b.to_rgb());
+}
+
+TEST_CASE("sampler: skipped dimensions leave every later dimension unchanged") {
+    for (SamplerType type : {SamplerType::sobol, SamplerType::independent}) {
+        INFO(int(type));
+        Sampler drawn(3, type), skipped(3, type);
+        // Pixels revisited out of order: the cached Sobol pixel key must follow.
+        for (const auto& [x, y, i] :
+             {std::tuple{4u, 7u, 0u}, {4u, 7u, 1u}, {9u, 7u, 5u}, {4u, 7u, 2u}, {4u, 8u, 2u}}) {
+            drawn.start(x, y, i);
+            skipped.start(x, y, i);
+            const Vec2 a = drawn.next_2d(), b = skipped.next_2d();
+            CHECK(a.x == b.x);
+            (void)drawn.next_2d();  // what the camera's lens would take
+            skipped.skip_2d();
+            (void)drawn.next_1d();  // and the shutter time
+            skipped.skip_1d();
+            for (int d = 0; d < 3; ++d) {
+                const Vec2 p = drawn.next_2d(), q = skipped.next_2d();
+                CHECK(p.x == q.x);
+                CHECK(p.y == q.y);
+                CHECK(drawn.next_1d() == skipped.next_1d());
+            }
+            Sampler fresh(3, type);  // no cached key: same stream as a sampler that moved between pixels
+            fresh.start(x, y, i);
+            CHECK(fresh.next_2d().x == a.x);
+        }
+    }
 }

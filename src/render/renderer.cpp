@@ -45,11 +45,26 @@ std::vector<TileRect> make_tiles(int w, int h) {
 
 void render_pixel_samples(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x,
                           int y, int fx, int fy, uint32_t begin, uint32_t end) {
+    // A pinhole camera ignores the lens sample, and the shutter time matters only
+    // when a sphere moves (nothing else depends on time; a closed or reversed
+    // shutter is left alone). Unused dimensions are skipped rather than drawn:
+    // every later dimension, and so the image, is unchanged.
+    const bool want_lens = camera.has_lens();
+    const bool want_time = scene.features.has_motion || scene.features.forced_all ||
+                           scene.camera.shutter_close < scene.camera.shutter_open;
     for (uint32_t s = begin; s < end; ++s) {
         sampler.start(uint32_t(x), uint32_t(y), s);
         const Vec2 jitter = sampler.next_2d();
-        const Vec2 lens = sampler.next_2d();
-        const float time_u = sampler.next_1d();
+        Vec2 lens{0.5f, 0.5f};
+        if (want_lens)
+            lens = sampler.next_2d();
+        else
+            sampler.skip_2d();
+        float time_u = 0.0f;
+        if (want_time)
+            time_u = sampler.next_1d();
+        else
+            sampler.skip_1d();
         const Ray ray = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y, lens, time_u);
         count_ray(RayKind::camera);
         film.add_sample(fx, fy, estimate_radiance(scene, ray, sampler, scene.render.max_depth));

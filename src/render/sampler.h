@@ -21,10 +21,14 @@ class Sampler {
         const uint64_t pixel = (uint64_t(y) << 32) | x;
         reversed_index_ = sobol::reverse_bits(index);
         dimension_ = 0;
-        if (type_ == SamplerType::independent)
+        if (type_ == SamplerType::independent) {
             rng_.reseed(hash_words(seed_, pixel, index), 0x5a4a5a4a);
-        else
+        } else if (!has_pixel_ || pixel != pixel_) {
+            // The key depends on the pixel only: hashed once for all its samples.
             pixel_key_ = hash_words(seed_, pixel, 0x50b01u);
+            pixel_ = pixel;
+            has_pixel_ = true;
+        }
     }
     /// The next dimension of the current sample, in [0, 1).
     float next_1d() {
@@ -42,6 +46,23 @@ class Sampler {
         const Keys k = next_keys();
         return {sobol::to_unit_float(sobol::scrambled_dim0(k.index, k.scramble_x)),
                 sobol::to_unit_float(sobol::scrambled_dim1(k.index, k.scramble_y))};
+    }
+    /// Skips one dimension as next_1d() would consume it, without computing the
+    /// value: later dimensions stay exactly as if it had been drawn.
+    void skip_1d() {
+        if (type_ == SamplerType::independent)
+            rng_.next_float();
+        else
+            ++dimension_;
+    }
+    /// Skips two dimensions as next_2d() would consume them (see skip_1d).
+    void skip_2d() {
+        if (type_ == SamplerType::independent) {
+            rng_.next_float();
+            rng_.next_float();
+        } else {
+            ++dimension_;
+        }
     }
     SamplerType type() const { return type_; }
 
@@ -66,6 +87,8 @@ class Sampler {
     SamplerType type_;
     Pcg32 rng_;
     uint64_t pixel_key_ = 0;
+    uint64_t pixel_ = 0;  ///< the pixel pixel_key_ belongs to (Sobol only)
+    bool has_pixel_ = false;
     uint32_t reversed_index_ = 0, dimension_ = 0;  ///< sample index, bit-reversed
 };
 

@@ -158,7 +158,8 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
             const Vec3d n = d / length(d);
             si.p = Vec3(Vec3d(c) + n * double(s.radius));
             si.ng = si.ns = Vec3(n);
-            si.uv = sphere_uv(Vec3(n));
+            // uv feeds image textures only (eval_color): without any, skip the atan2 and asin.
+            if (!textures.empty()) si.uv = sphere_uv(Vec3(n));
             si.material = s.material;
             break;
         }
