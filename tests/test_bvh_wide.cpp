@@ -134,15 +134,19 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed) {
     const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
     const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
     SimdPathGuard guard;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide4_slots}) {
+    for (auto [layout, builder] : {std::pair{BvhLayout::wide4, BvhBuilder::binned},
+                                   std::pair{BvhLayout::wide4_slots, BvhBuilder::binned},
+                                   std::pair{BvhLayout::wide4, BvhBuilder::reinsert}}) {
         AcceleratorOptions opt;
         opt.layout = layout;
+        opt.builder = builder;
         const Accelerator acc(scene, opt);
         REQUIRE(acc.layout() == layout);
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
-            INFO(mesh.name, " layout ", bvh_layout_name(layout), " path ", simd_path_name(path), " rays ",
+            INFO(mesh.name, " layout ", bvh_layout_name(layout), " builder ", bvh_builder_name(builder), " path ",
+                 simd_path_name(path), " rays ",
                  rays.size());
             CHECK(active_simd_path() == path);
             CHECK(disagreements(acc, rays) == 0);

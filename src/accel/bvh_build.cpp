@@ -229,8 +229,15 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     p.bin_count = std::clamp(p.bin_count, 2u, 64u);
     p.max_leaf_size = std::max(p.max_leaf_size, 1u);
     Bvh bvh;
-    BvhBuildJob(input, builder, p, bvh).run();
-    return bvh;
+    if (builder != BvhBuilder::reinsert) {
+        BvhBuildJob(input, builder, p, bvh).run();
+        return bvh;
+    }
+    // Reinsertion starts from one primitive per leaf, so that it may regroup every primitive.
+    BvhBuildParams single = p;
+    single.max_leaf_size = 1;
+    BvhBuildJob(input, BvhBuilder::binned, single, bvh).run();
+    return reinsert_optimize_bvh(bvh, input.boxes, p);
 }
 
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
@@ -238,13 +245,23 @@ bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
         out = BvhBuilder::binned;
     else if (text == "sweep")
         out = BvhBuilder::sweep;
+    else if (text == "reinsert")
+        out = BvhBuilder::reinsert;
     else
         return false;
     return true;
 }
 
 const char* bvh_builder_name(BvhBuilder builder) {
-    return builder == BvhBuilder::binned ? "binned" : "sweep";
+    switch (builder) {
+        case BvhBuilder::binned:
+            return "binned";
+        case BvhBuilder::sweep:
+            return "sweep";
+        case BvhBuilder::reinsert:
+            return "reinsert";
+    }
+    return "binned";
 }
 
 }  // namespace sahara
