@@ -50,12 +50,43 @@ class BvhBuildJob {
     }
 
    private:
+    /// Ranges longer than this are scanned (bounds, bins) as kScanChunks OpenMP tasks: near the
+    /// root there are fewer subtree tasks than threads. The chunks do not depend on the thread
+    /// count and merging boxes and counts is exact, so the tree does not either.
+    static constexpr uint32_t kParallelScanThreshold = 1u << 15;
+    static constexpr uint32_t kScanChunks = 8;
+
+    /// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
+    /// else as kScanChunks tasks (the caller is inside the build's parallel region).
+    template <class Fn>
+    static void for_chunks(uint32_t begin, uint32_t end, const Fn& fn) {
+        const uint32_t n = end - begin;
+        if (n <= kParallelScanThreshold) {
+            fn(0u, begin, end);
+            return;
+        }
+        for (uint32_t c = 0; c < kScanChunks; ++c) {
+            const auto b = begin + uint32_t(uint64_t(n) * c / kScanChunks);
+            const auto e = begin + uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
+#pragma omp task default(shared) firstprivate(c, b, e)
+            fn(c, b, e);
+        }
+#pragma omp taskwait
+    }
+
     /// Step 1 of every node: bounds of the boxes and of the centroids in the range.
     void range_bounds(uint32_t begin, uint32_t end, Bounds3& box, Bounds3& centroids) const {
-        for (uint32_t i = begin; i < end; ++i) {
-            const uint32_t p = out_.prim_indices[i];
-            box.extend(in_.boxes[p]);
-            centroids.extend(in_.centers[p]);
+        Bounds3 boxes[kScanChunks], cents[kScanChunks];
+        for_chunks(begin, end, [&](uint32_t c, uint32_t b, uint32_t e) {
+            for (uint32_t i = b; i < e; ++i) {
+                const uint32_t p = out_.prim_indices[i];
+                boxes[c].extend(in_.boxes[p]);
+                cents[c].extend(in_.centers[p]);
+            }
+        });
+        for (uint32_t c = 0; c < kScanChunks; ++c) {
+            box.extend(boxes[c]);
+            centroids.extend(cents[c]);
         }
     }
 
@@ -109,12 +140,22 @@ class BvhBuildJob {
         return uint32_t(std::clamp(b, 0, int(params_.bin_count) - 1));
     }
 
+    /// One pass over [begin, end) fills the bins of all three axes (3 x bin_count, cleared by the caller).
+    void fill_bins(uint32_t begin, uint32_t end, const float lo[3], const float scale[3], Bin* bins) const {
+        for (uint32_t i = begin; i < end; ++i) {
+            const uint32_t p = out_.prim_indices[i];
+            for (int axis = 0; axis < 3; ++axis) {
+                Bin& target =
+                    bins[size_t(axis) * params_.bin_count + bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
+                target.box.extend(in_.boxes[p]);
+                ++target.count;
+            }
+        }
+    }
+
     Split find_binned_split(uint32_t begin, uint32_t end, const Bounds3& centroids) const {
         const uint32_t bins = params_.bin_count;
         Split best;
-        // Only 3 * bins entries are cleared (a fixed 3 x 64 array would be cleared whole at every node).
-        thread_local std::vector<Bin> all_bins;
-        all_bins.assign(3 * size_t(bins), Bin{});
         float right_area[64];
         uint32_t right_count[64];
         float lo[3], scale[3];
@@ -123,14 +164,24 @@ class BvhBuildJob {
             lo[axis] = centroids.lo[axis];
             scale[axis] = extent > 0.0f ? float(bins) / extent : 0.0f;
         }
-        // fill_bins: one pass over the range fills the bins of all three axes.
-        for (uint32_t i = begin; i < end; ++i) {
-            const uint32_t p = out_.prim_indices[i];
-            for (int axis = 0; axis < 3; ++axis) {
-                Bin& target = all_bins[size_t(axis) * bins + bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
-                target.box.extend(in_.boxes[p]);
-                ++target.count;
-            }
+        // Only 3 * bins entries are cleared (a fixed 3 x 64 array would be cleared whole at every
+        // node). Not used across for_chunks' taskwait, where this thread may run another node.
+        thread_local std::vector<Bin> all_bins;
+        const size_t per_chunk = 3 * size_t(bins);
+        if (end - begin <= kParallelScanThreshold) {
+            all_bins.assign(per_chunk, Bin{});
+            fill_bins(begin, end, lo, scale, all_bins.data());
+        } else {
+            std::vector<Bin> parts(kScanChunks * per_chunk);
+            for_chunks(begin, end, [&](uint32_t c, uint32_t b, uint32_t e) {
+                fill_bins(b, e, lo, scale, &parts[c * per_chunk]);
+            });
+            all_bins.assign(per_chunk, Bin{});
+            for (uint32_t c = 0; c < kScanChunks; ++c)
+                for (size_t k = 0; k < per_chunk; ++k) {
+                    all_bins[k].box.extend(parts[c * per_chunk + k].box);
+                    all_bins[k].count += parts[c * per_chunk + k].count;
+                }
         }
         for (int axis = 0; axis < 3; ++axis) {
             if (!(scale[axis] > 0.0f)) continue;
