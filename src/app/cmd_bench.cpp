@@ -219,7 +219,7 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--size must be a positive integer";
     if (args.has("--repeat") && !parse_positive_int(args.values.at("--repeat"), opt.repeat))
         return "--repeat must be a positive integer";
-    if (!parse_bvh_builder(args.value_or("--builder", "binned"), opt.builder))
+    if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), opt.builder))
         return "--builder must be binned, sweep or reinsert";
     if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout))
         return "--layout must be wide4, wide4-slots or pairs";

@@ -133,7 +133,7 @@ int run_bvh_command(int argc, char** argv) {
     }
     if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh file", kBvhUsage);
     BvhBuilder builder = BvhBuilder::binned;
-    if (!parse_bvh_builder(args.value_or("--builder", "binned"), builder))
+    if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), builder))
         return usage_error("bvh", "--builder must be binned, sweep or reinsert", kBvhUsage);
     int size = 1024;
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
