@@ -319,7 +319,7 @@ class Collapser {
 }  // namespace
 
 Bvh reinsert_optimize_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes, const BvhBuildParams& params) {
-    if (bvh.empty() || bvh.prim_indices.size() < 3) return bvh;
+    if (bvh.empty()) return bvh;
     LinkedTree tree(bvh, prim_boxes);
     // The input collapsed by SAH: never worse than the input, and the fallback.
     const Collapser input_collapse(tree, params);
@@ -334,7 +334,7 @@ Bvh reinsert_optimize_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes, c
     for (uint32_t round = 0; round < params.reinsert_max_rounds && stalled < 2; ++round) {
         tree.reinsert_round(batch);
         const double next = tree.sah(ct, ci);
-        // The paper's termination: stop once rounds no longer reduce the cost noticeably.
+        // Stop once two rounds in a row no longer reduce the cost noticeably.
         stalled = next > cost * (1.0 - double(params.reinsert_min_gain)) ? stalled + 1 : 0;
         cost = std::min(cost, next);
     }
