@@ -94,11 +94,11 @@ std::vector<TriangleMesh> procedural_meshes() {
 
 }  // namespace
 
-TEST_CASE("both builders produce valid trees") {
+TEST_CASE("every builder produces valid trees") {
     std::vector<TriangleMesh> meshes = procedural_meshes();
     for (const auto& f : shared_obj_files()) meshes.push_back(read_obj_triangles(f));
     for (const TriangleMesh& m : meshes)
-        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep}) {
+        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert}) {
             INFO(m.name, " ", bvh_builder_name(builder));
             const Bvh bvh = build_for_mesh(m, builder);
             CHECK(validate_bvh(bvh, triangle_boxes(m)) == "");
@@ -154,14 +154,79 @@ TEST_CASE("sweep SAH is at least as good as binned on meshes") {
 TEST_CASE("BVH agrees with brute force on procedural meshes") {
     uint32_t seed = 1;
     for (const TriangleMesh& m : procedural_meshes())
-        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep})
+        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert})
             check_against_brute_force(m, builder, seed++, builder == BvhBuilder::binned ? 100000 : 25000);
 }
 
 TEST_CASE("BVH agrees with brute force on the shared OBJ meshes") {
     uint32_t seed = 100;
     for (const auto& f : shared_obj_files())
-        check_against_brute_force(read_obj_triangles(f), BvhBuilder::binned, seed++);
+        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::reinsert})
+            check_against_brute_force(read_obj_triangles(f), builder, seed++,
+                                      builder == BvhBuilder::binned ? 100000 : 25000);
+}
+
+TEST_CASE("reinsertion never raises the SAH cost of its input") {
+    std::vector<TriangleMesh> meshes = procedural_meshes();
+    meshes.push_back(make_icosphere(4));
+    const size_t procedural = meshes.size();
+    // Under ASan only the shared meshes up to 20k triangles (the optimiser is sequential).
+    for (const auto& f : shared_obj_files()) {
+        TriangleMesh m = read_obj_triangles(f);
+        if (!kSanitized || m.triangle_count() <= 20000) meshes.push_back(std::move(m));
+    }
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        const TriangleMesh& m = meshes[i];
+        const std::vector<Bounds3> boxes = triangle_boxes(m);
+        // The sweep build is slow on the big shared meshes; they start from the binned tree only.
+        const bool sweep_too = i < procedural;
+        for (BvhBuilder input_builder : {BvhBuilder::binned, BvhBuilder::sweep}) {
+            if (input_builder == BvhBuilder::sweep && !sweep_too) continue;
+            const Bvh input = build_for_mesh(m, input_builder);
+            const Bvh optimized = reinsert_optimize_bvh(input, boxes, BvhBuildParams{});
+            INFO(m.name, " from ", bvh_builder_name(input_builder));
+            CHECK(validate_bvh(optimized, boxes) == "");
+            CHECK(compute_bvh_stats(optimized).sah_cost <= compute_bvh_stats(input).sah_cost * (1 + 1e-9));
+        }
+        const double binned = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned)).sah_cost;
+        const double reinsert = compute_bvh_stats(build_for_mesh(m, BvhBuilder::reinsert)).sah_cost;
+        INFO(m.name, " binned ", binned, " reinsert ", reinsert);
+        CHECK(reinsert <= binned * (1 + 1e-9));
+    }
+}
+
+TEST_CASE("reinsertion repairs a tree built in random primitive order") {
+    const TriangleMesh m = make_icosphere(3);
+    const std::vector<Bounds3> boxes = triangle_boxes(m);
+    // One leaf over all primitives in a shuffled order: the optimiser first splits it
+    // into a balanced tree over that order (a bad tree), then reinserts.
+    Bvh bad;
+    const auto n = uint32_t(boxes.size());
+    for (uint32_t i = 0; i < n; ++i) bad.prim_indices.push_back((i * 7919u) % n);
+    Bounds3 all;
+    for (const Bounds3& b : boxes) all.extend(b);
+    BvhNode root{};
+    root.set_box(all);
+    root.count = n;
+    bad.nodes.push_back(root);
+    BvhBuildParams params;
+    params.max_leaf_size = 4;
+    const Bvh repaired = reinsert_optimize_bvh(bad, boxes, params);
+    REQUIRE(validate_bvh(repaired, boxes) == "");
+    // A balanced tree over a random order: every inner node spans most of the sphere.
+    BvhBuildParams one_per_leaf = params;
+    one_per_leaf.max_leaf_size = 1;
+    const Bvh balanced = reinsert_optimize_bvh(bad, boxes, [&] {
+        BvhBuildParams p = one_per_leaf;
+        p.reinsert_max_rounds = 0;
+        return p;
+    }());
+    const double before = compute_bvh_stats(balanced).sah_cost;
+    const double after = compute_bvh_stats(repaired).sah_cost;
+    const double binned = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned)).sah_cost;
+    INFO("random order ", before, " reinserted ", after, " binned SAH ", binned);
+    CHECK(after < before / 4);
+    CHECK(after < binned * 1.5);
 }
 
 TEST_CASE("spheres, boxes and triangles in one tree agree with brute force") {
@@ -318,7 +383,12 @@ TEST_CASE("the built tree does not depend on the thread count") {
     const Bvh one = build_for_mesh(m, BvhBuilder::binned, p);
     omp_set_num_threads(2);
     const Bvh two = build_for_mesh(m, BvhBuilder::binned, p);
+    omp_set_num_threads(1);
+    const Bvh reinsert_one = build_for_mesh(m, BvhBuilder::reinsert, p);
+    omp_set_num_threads(2);
+    const Bvh reinsert_two = build_for_mesh(m, BvhBuilder::reinsert, p);
     omp_set_num_threads(saved);
+    CHECK(reinsert_one.prim_indices == reinsert_two.prim_indices);
     CHECK(one.prim_indices == two.prim_indices);
     const BvhPairs a = make_bvh_pairs(one), b = make_bvh_pairs(two);
     REQUIRE(a.nodes.size() == b.nodes.size());
@@ -542,6 +612,12 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     CHECK(text.first == 0);
     CHECK(text.second.find("SAH cost") != std::string::npos);
     CHECK(run_captured(run_bvh_command, {"bvh", mesh, "--builder", "fast"}).first == 2);
+    const auto reinsert = run_captured(
+        run_bvh_command, {"bvh", mesh, "--builder", "reinsert", "--threads", "1", "--size", "16", "--json"});
+    REQUIRE(reinsert.first == 0);
+    for (const char* key : {"\"builder\":\"reinsert\"", "\"build_threads\":1", "\"mprims_s\"", "\"mprims_cpu_s\""})
+        CHECK(reinsert.second.find(key) != std::string::npos);
+    CHECK(run_captured(run_bvh_command, {"bvh", mesh, "--threads", "0"}).first == 2);
     CHECK(run_captured(run_bvh_command, {"bvh"}).first == 2);
     CHECK(run_captured(run_bvh_command, {"bvh", "/nonexistent.obj"}).first == 2);
     CHECK(run_captured(run_bvh_command, {"bvh", "--help"}).first == 0);

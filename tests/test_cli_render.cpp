@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "app/cmd_info.h"
+#include "app/render_args.h"
 #include "geometry/sphere.h"
 #include "io/image_io.h"
 
@@ -303,4 +304,18 @@ TEST_CASE("info: bad inputs exit 2") {
     CHECK(run_info_command({"--bogus"}) == 2);
     CHECK(run_info_command({"model.xyz"}) == 2);
     CHECK(run_info_command({"a.json", "b.json"}) == 2);
+}
+
+TEST_CASE("render --builder overrides the scene's render.bvh_builder") {
+    const RenderArgs a = parse_render_args({"--builder", "reinsert"});
+    REQUIRE(a.overrides.bvh_builder.has_value());
+    RenderSettings r;
+    CHECK(r.bvh_builder == kDefaultBvhBuilder);
+    a.overrides.apply(r);
+    CHECK(r.bvh_builder == BvhBuilder::reinsert);
+    RenderSettings untouched;
+    untouched.bvh_builder = BvhBuilder::sweep;
+    parse_render_args({}).overrides.apply(untouched);
+    CHECK(untouched.bvh_builder == BvhBuilder::sweep);
+    CHECK_THROWS_AS(parse_render_args({"--builder", "lbvh"}), UsageError);
 }

@@ -143,6 +143,7 @@ TEST_CASE("scene parser: minimal scene gets the documented defaults") {
     CHECK(s.materials[0].name == "default");
     CHECK(s.render.tonemap == Tonemap::clamp);
     CHECK(s.render.exposure == 0.0f);
+    CHECK(s.render.bvh_builder == kDefaultBvhBuilder);
 }
 
 TEST_CASE("scene parser: every key round-trips into SceneDesc") {
@@ -152,7 +153,7 @@ TEST_CASE("scene parser: every key round-trips into SceneDesc") {
       "format": "scene/1",
       "render": { "width": 320, "height": 200, "spp": 16, "max_depth": 5, "seed": 18446744073709551615,
                   "integrator": "bvh-cost", "time_limit_s": 2.5, "target_error": 0.01,
-                  "exposure": -1.5, "tonemap": "aces" },
+                  "exposure": -1.5, "tonemap": "aces", "bvh_builder": "reinsert" },
       "camera": { "position": [0, -6, 1.5], "look_at": [0, 0, 1], "up": [0, 0, 2], "vfov": 40,
                   "aperture": 0.1, "focus_distance": 5, "shutter": [0.25, 0.75] },
       "background": { "type": "envmap", "file": "sky.exr", "strength": 2, "up": [0, 1, 0] },
@@ -202,6 +203,7 @@ TEST_CASE("scene parser: every key round-trips into SceneDesc") {
     CHECK(r.target_error == 0.01);
     CHECK(r.exposure == -1.5f);
     CHECK(r.tonemap == Tonemap::aces);
+    CHECK(r.bvh_builder == BvhBuilder::reinsert);
 
     const CameraDesc& c = s.camera;
     CHECK(c.position == Vec3(0, -6, 1.5f));
@@ -455,6 +457,8 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
          {"render.integrator: expected one of \"path\", \"whitted\"", "got \"raytrace\""}},
         {"{" + cam + R"(, "objects": [], "render": {"tonemap": "agx"}})",
          {"render.tonemap: expected one of \"clamp\""}},
+        {"{" + cam + R"(, "objects": [], "render": {"bvh_builder": "lbvh"}})",
+         {"render.bvh_builder: expected one of \"binned\""}},
         {"{" + cam + R"(, "objects": [], "render": {"time_limit_s": 0}})",
          {"render.time_limit_s: expected a number > 0"}},
         {"{" + cam + R"(, "objects": [], "render": {"exposure": 100}})",

@@ -51,7 +51,7 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
     BvhLayout layout = BvhLayout::wide4;
-    BvhBuilder builder = BvhBuilder::binned;
+    BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
     /// The wide4 layout builds with params.intersection_cost times this: its
     /// leaves test four triangles per SSE step, so larger leaves pay off.

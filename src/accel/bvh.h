@@ -71,7 +71,29 @@ struct Bvh {
 enum class BvhBuilder : uint8_t {
     binned,  ///< binned SAH, parallel over subtrees (fast default)
     sweep,   ///< exact sweep SAH over all centroid-sorted splits (quality reference)
+    reinsert,  ///< binned SAH, then insertion-based reinsertion (accel/bvh_optimize.cpp)
 };
+
+/// The builder used unless a scene ("render": {"bvh_builder"}) or --builder says otherwise.
+/// Chosen to minimise build + trace time of a typical render (640x480, 64 spp, ~3 rays per
+/// sample: ~60M rays). Measured 2026-11-22 on this shared 2-core VM, one thread, CPU times
+/// (wall times were 3-5x the CPU times, the cores being shared): `sahara bvh --size 512
+/// --threads 1` (SAH cost; nodes + primitives per diffuse ray, deterministic) and `sahara bench
+/// --threads 1 --size 512 --repeat 7` (diffuse / shadow MRays/s per CPU second, +-10% noise):
+///   bunny  binned   SAH 28.89, build  94 ms, 43.74 + 5.86, 2.33 / 2.54
+///          sweep    SAH 28.61, build 397 ms, 43.20 + 5.85, 2.50 / 2.82
+///          reinsert SAH 28.75, build 218 ms, 43.88 + 5.86, 2.65 / 2.98
+///   ogre   binned   SAH 25.10, build 138 ms, 44.39 + 6.73, 2.18 / 2.41
+///          sweep    SAH 24.88, build 759 ms, 44.33 + 6.71, 2.28 / 2.27
+///          reinsert SAH 23.56, build 605 ms, 43.51 + 6.58, 2.19 / 2.54
+/// (binned builds have since become ~30% faster: all axes binned in one pass.) 60M rays at
+/// ~2.4 MRays/s are ~25 s of CPU time. The ray work differences (the steady measure; the MRays/s
+/// differences are within noise) are 0.3% worse (bunny) and 2.0% better (ogre) for reinsert,
+/// i.e. -0.1 s and +0.5 s of tracing, against +0.12 s and +0.47 s of build; sweep saves 1.1% and
+/// 0.1% (0.3 s, 0.03 s) for +0.3 s and +0.62 s. Nothing beats binned by more than the noise on
+/// a typical render, and binned wins on short ones: binned is the default; reinsert is worth
+/// choosing for long renders of meshes like the ogre (uneven triangle sizes).
+inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::binned;
 
 /// SAH cost model and build limits. The costs are relative: visiting an inner
 /// node (two box tests) costs `traversal`, testing one primitive costs
@@ -83,6 +105,14 @@ struct BvhBuildParams {
     uint32_t bin_count = 16;      ///< binned builder: centroid bins per axis
     /// Subtrees with more primitives than this are built as OpenMP tasks.
     uint32_t parallel_threshold = 4096;
+    /// Reinsertion: inner nodes removed and reinserted per round (the most inefficient ones), as a
+    /// fraction of all inner nodes. 0.1 gets most of the gain of 1.0 at a tenth of the time
+    /// (ogre, `sahara bvh`: SAH 25.10 binned, 23.56 at 0.1 in 0.64 s, 23.33 at 1.0 in 5.3 s).
+    float reinsert_batch_fraction = 0.1f;
+    /// Reinsertion: at most this many rounds ...
+    uint32_t reinsert_max_rounds = 100;
+    /// ... and it stops after two rounds in a row that lower the SAH cost by less than this fraction.
+    float reinsert_min_gain = 0.001f;
 };
 
 /// Inputs of a build: one box and one centre per primitive (same length).
@@ -95,15 +125,21 @@ struct BvhBuildInput {
 /// (they land in some leaf but can never be reached by a ray).
 Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params = {});
 
+/// Insertion-based reinsertion (Bittner, Hapala, Havran 2013) on `bvh`, built
+/// over `prim_boxes`, then an SAH-optimal collapse of subtrees into leaves of at
+/// most params.max_leaf_size primitives. The SAH cost of the result is never
+/// above that of `bvh` (the input, collapsed the same way, is the fallback).
+Bvh reinsert_optimize_bvh(const Bvh& bvh, std::span<const Bounds3> prim_boxes, const BvhBuildParams& params);
+
 /// Traversal stack depth: builders switch to median splits past
 /// kBvhMedianSplitDepth, which bounds the depth of any tree by
 /// kBvhMedianSplitDepth + log2(2^30 primitives) < kBvhMaxDepth.
 inline constexpr int kBvhMaxDepth = 64;
 inline constexpr int kBvhMedianSplitDepth = 32;
 
-/// Parses "binned" / "sweep"; returns false for anything else.
+/// Parses a bvh_builder_name(); returns false for anything else.
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out);
-/// "binned" or "sweep".
+/// "binned", "sweep" or "reinsert".
 const char* bvh_builder_name(BvhBuilder builder);
 
 }  // namespace sahara

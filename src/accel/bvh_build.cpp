@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <string_view>
+#include <vector>
 
 #include "accel/bvh.h"
 
@@ -49,12 +50,43 @@ class BvhBuildJob {
     }
 
    private:
+    /// Ranges longer than this are scanned (bounds, bins) as kScanChunks OpenMP tasks: near the
+    /// root there are fewer subtree tasks than threads. The chunks do not depend on the thread
+    /// count and merging boxes and counts is exact, so the tree does not either.
+    static constexpr uint32_t kParallelScanThreshold = 1u << 15;
+    static constexpr uint32_t kScanChunks = 8;
+
+    /// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
+    /// else as kScanChunks tasks (the caller is inside the build's parallel region).
+    template <class Fn>
+    static void for_chunks(uint32_t begin, uint32_t end, const Fn& fn) {
+        const uint32_t n = end - begin;
+        if (n <= kParallelScanThreshold) {
+            fn(0u, begin, end);
+            return;
+        }
+        for (uint32_t c = 0; c < kScanChunks; ++c) {
+            const auto b = begin + uint32_t(uint64_t(n) * c / kScanChunks);
+            const auto e = begin + uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
+#pragma omp task default(shared) firstprivate(c, b, e)
+            fn(c, b, e);
+        }
+#pragma omp taskwait
+    }
+
     /// Step 1 of every node: bounds of the boxes and of the centroids in the range.
     void range_bounds(uint32_t begin, uint32_t end, Bounds3& box, Bounds3& centroids) const {
-        for (uint32_t i = begin; i < end; ++i) {
-            const uint32_t p = out_.prim_indices[i];
-            box.extend(in_.boxes[p]);
-            centroids.extend(in_.centers[p]);
+        Bounds3 boxes[kScanChunks], cents[kScanChunks];
+        for_chunks(begin, end, [&](uint32_t c, uint32_t b, uint32_t e) {
+            for (uint32_t i = b; i < e; ++i) {
+                const uint32_t p = out_.prim_indices[i];
+                boxes[c].extend(in_.boxes[p]);
+                cents[c].extend(in_.centers[p]);
+            }
+        });
+        for (uint32_t c = 0; c < kScanChunks; ++c) {
+            box.extend(boxes[c]);
+            centroids.extend(cents[c]);
         }
     }
 
@@ -108,24 +140,52 @@ class BvhBuildJob {
         return uint32_t(std::clamp(b, 0, int(params_.bin_count) - 1));
     }
 
-    Split find_binned_split(uint32_t begin, uint32_t end, const Bounds3& centroids) const {
-        const uint32_t bins = params_.bin_count;
-        Split best;
-        Bin bin[64];
-        float right_area[64];
-        uint32_t right_count[64];
-        for (int axis = 0; axis < 3; ++axis) {
-            const float lo = centroids.lo[axis], extent = centroids.hi[axis] - lo;
-            if (!(extent > 0.0f)) continue;
-            const float scale = float(bins) / extent;
-            // fill_bins
-            for (uint32_t b = 0; b < bins; ++b) bin[b] = Bin{};
-            for (uint32_t i = begin; i < end; ++i) {
-                const uint32_t p = out_.prim_indices[i];
-                Bin& target = bin[bin_of(in_.centers[p][axis], lo, scale)];
+    /// One pass over [begin, end) fills the bins of all three axes (3 x bin_count, cleared by the caller).
+    void fill_bins(uint32_t begin, uint32_t end, const float lo[3], const float scale[3], Bin* bins) const {
+        for (uint32_t i = begin; i < end; ++i) {
+            const uint32_t p = out_.prim_indices[i];
+            for (int axis = 0; axis < 3; ++axis) {
+                Bin& target =
+                    bins[size_t(axis) * params_.bin_count + bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
                 target.box.extend(in_.boxes[p]);
                 ++target.count;
             }
+        }
+    }
+
+    Split find_binned_split(uint32_t begin, uint32_t end, const Bounds3& centroids) const {
+        const uint32_t bins = params_.bin_count;
+        Split best;
+        float right_area[64];
+        uint32_t right_count[64];
+        float lo[3], scale[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            const float extent = centroids.hi[axis] - centroids.lo[axis];
+            lo[axis] = centroids.lo[axis];
+            scale[axis] = extent > 0.0f ? float(bins) / extent : 0.0f;
+        }
+        // Only 3 * bins entries are cleared (a fixed 3 x 64 array would be cleared whole at every
+        // node). Not used across for_chunks' taskwait, where this thread may run another node.
+        thread_local std::vector<Bin> all_bins;
+        const size_t per_chunk = 3 * size_t(bins);
+        if (end - begin <= kParallelScanThreshold) {
+            all_bins.assign(per_chunk, Bin{});
+            fill_bins(begin, end, lo, scale, all_bins.data());
+        } else {
+            std::vector<Bin> parts(kScanChunks * per_chunk);
+            for_chunks(begin, end, [&](uint32_t c, uint32_t b, uint32_t e) {
+                fill_bins(b, e, lo, scale, &parts[c * per_chunk]);
+            });
+            all_bins.assign(per_chunk, Bin{});
+            for (uint32_t c = 0; c < kScanChunks; ++c)
+                for (size_t k = 0; k < per_chunk; ++k) {
+                    all_bins[k].box.extend(parts[c * per_chunk + k].box);
+                    all_bins[k].count += parts[c * per_chunk + k].count;
+                }
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(scale[axis] > 0.0f)) continue;
+            const Bin* bin = &all_bins[size_t(axis) * bins];
             // find_best_split: suffix sweep from the right, then prefix sweep from the left.
             Bounds3 acc;
             uint32_t cnt = 0;
@@ -229,8 +289,15 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     p.bin_count = std::clamp(p.bin_count, 2u, 64u);
     p.max_leaf_size = std::max(p.max_leaf_size, 1u);
     Bvh bvh;
-    BvhBuildJob(input, builder, p, bvh).run();
-    return bvh;
+    if (builder != BvhBuilder::reinsert) {
+        BvhBuildJob(input, builder, p, bvh).run();
+        return bvh;
+    }
+    // Reinsertion starts from one primitive per leaf, so that it may regroup every primitive.
+    BvhBuildParams single = p;
+    single.max_leaf_size = 1;
+    BvhBuildJob(input, BvhBuilder::binned, single, bvh).run();
+    return reinsert_optimize_bvh(bvh, input.boxes, p);
 }
 
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
@@ -238,13 +305,23 @@ bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
         out = BvhBuilder::binned;
     else if (text == "sweep")
         out = BvhBuilder::sweep;
+    else if (text == "reinsert")
+        out = BvhBuilder::reinsert;
     else
         return false;
     return true;
 }
 
 const char* bvh_builder_name(BvhBuilder builder) {
-    return builder == BvhBuilder::binned ? "binned" : "sweep";
+    switch (builder) {
+        case BvhBuilder::binned:
+            return "binned";
+        case BvhBuilder::sweep:
+            return "sweep";
+        case BvhBuilder::reinsert:
+            return "reinsert";
+    }
+    return "binned";
 }
 
 }  // namespace sahara

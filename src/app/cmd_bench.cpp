@@ -22,7 +22,7 @@ namespace {
 
 constexpr const char* kBenchUsage =
     "usage: sahara bench FILE [--threads N] [--rays primary|diffuse|shadow|all] [--json]\n"
-    "                         [--builder binned|sweep] [--layout L] [--size N] [--repeat K]\n"
+    "                         [--builder binned|sweep|reinsert] [--layout L] [--size N] [--repeat K]\n"
     "                         [--no-embree]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
@@ -143,7 +143,10 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"tree_bytes_per_primitive",
          double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
         {"build_ms", accel.build_ms()},
-        {"build_cpu_ms", accel.build_cpu_ms()}};
+        {"build_cpu_ms", accel.build_cpu_ms()},
+        {"build_threads", opt.threads},
+        {"mprims_s", double(accel.primitive_count()) / std::max(accel.build_ms() * 1e3, 1e-9)},
+        {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
     for (const std::string& set : opt.sets) {
         const std::vector<Ray>& r = set == "primary"   ? rays.primary
@@ -161,8 +164,9 @@ void print_text(const nlohmann::ordered_json& j) {
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
     std::printf("threads     %d\n", j["threads"].get<int>());
-    std::printf("build       %.1f ms, CPU %.1f ms (%s SAH, %s layout, %s)", j["build_ms"].get<double>(),
-                j["build_cpu_ms"].get<double>(), j["builder"].get<std::string>().c_str(),
+    std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s)",
+                j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),
+                j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms")) std::printf(", Embree %.1f ms", j["embree_build_ms"].get<double>());
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n",
@@ -244,8 +248,8 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--size must be a positive integer";
     if (args.has("--repeat") && !parse_positive_int(args.values.at("--repeat"), opt.repeat))
         return "--repeat must be a positive integer";
-    if (!parse_bvh_builder(args.value_or("--builder", "binned"), opt.builder))
-        return "--builder must be binned or sweep";
+    if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), opt.builder))
+        return "--builder must be binned, sweep or reinsert";
     if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout))
         return "--layout must be wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");

@@ -2,8 +2,10 @@
 /// and prints its statistics, plus
 /// the mean traversal work per ray for primary and diffuse-bounce rays.
 #include <nlohmann/json.hpp>
+#include <omp.h>
 
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "accel/accelerator.h"
@@ -19,11 +21,14 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBvhUsage =
-    "usage: sahara bvh FILE [--builder binned|sweep] [--size N] [--json]\n"
+    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--threads N] [--size N] [--json]\n"
     "  FILE        a mesh (.obj, .gltf, .glb; OBJ polygons are fan-split, degenerate triangles kept)\n"
     "              or a scene file (.json): the tree holds its triangles, spheres, boxes and quadrics;\n"
     "              planes are unbounded, stay outside the tree and are not traced here\n"
-    "  --builder   binned (default: binned SAH, parallel) or sweep (exact sweep SAH)\n"
+    "  --builder   binned (default: binned SAH, parallel), sweep (exact sweep SAH) or reinsert\n"
+    "              (binned SAH, then insertion-based reinsertion of the most inefficient nodes);\n"
+    "              a scene file's render.bvh_builder when not given\n"
+    "  --threads N threads for the build (default: all cores)\n"
     "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays;\n"
     "              a mesh is framed from (0.4, 0.3, 1), a scene is seen through its own camera\n"
     "  --json      print one JSON object instead of text\n"
@@ -62,11 +67,14 @@ nlohmann::ordered_json primitive_kinds_json(const Scene& scene) {
             {"quadrics", scene.quadrics.size()}};
 }
 
-nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, int size) {
+nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuilder> chosen, int size,
+                                  int threads) {
     const ToolInput input = read_tool_input(file);
     const Scene& scene = input.scene;
+    const BvhBuilder builder = chosen.value_or(scene.render.bvh_builder);
     AcceleratorOptions opt;
     opt.builder = builder;
+    omp_set_num_threads(threads);
     const Accelerator accel(scene, opt);
     // The SAH cost of the tree as built (the wide4 layout scales the intersection cost).
     BvhBuildParams built = opt.params;
@@ -95,7 +103,9 @@ nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, i
         {"wide4_nodes", accel.bvh4().nodes.size()},
         {"build_ms", accel.build_ms()},
         {"build_cpu_ms", accel.build_cpu_ms()},
+        {"build_threads", threads},
         {"mprims_s", accel.build_ms() > 0 ? double(prims) / (accel.build_ms() * 1e3) : 0.0},
+        {"mprims_cpu_s", accel.build_cpu_ms() > 0 ? double(prims) / (accel.build_cpu_ms() * 1e3) : 0.0},
         {"bytes", accel.bytes()},
         {"tree_bytes", s.bytes},
         {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
@@ -121,8 +131,9 @@ void print_text(const nlohmann::ordered_json& j) {
     std::printf("\nSAH cost          %.3f (traversal %g, intersection %g, root area = 1)\n",
                 j["sah_cost"].get<double>(), j["traversal_cost"].get<double>(),
                 j["intersection_cost"].get<double>());
-    std::printf("build             %.1f ms (%.2f Mprims/s), CPU time %.1f ms\n", j["build_ms"].get<double>(),
-                j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>());
+    std::printf("build             %.1f ms (%.2f Mprims/s), CPU time %.1f ms (%.2f Mprims/s), %d threads\n",
+                j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),
+                j["mprims_cpu_s"].get<double>(), j["build_threads"].get<int>());
     std::printf(
         "memory            %zu bytes (%.1f per primitive; tree %zu, leaf-ordered primitives the rest)\n",
         j["bytes"].get<size_t>(), j["bytes_per_primitive"].get<double>(), j["tree_bytes"].get<size_t>());
@@ -138,21 +149,28 @@ void print_text(const nlohmann::ordered_json& j) {
 
 int run_bvh_command(int argc, char** argv) {
     ToolArgs args;
-    const std::string err = parse_tool_args(argc, argv, {"--builder", "--size"}, {"--json"}, args);
+    const std::string err = parse_tool_args(argc, argv, {"--builder", "--size", "--threads"}, {"--json"}, args);
     if (!err.empty()) return usage_error("bvh", err, kBvhUsage);
     if (args.help) {
         std::fputs(kBvhUsage, stdout);
         return 0;
     }
     if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh or scene file", kBvhUsage);
-    BvhBuilder builder = BvhBuilder::binned;
-    if (!parse_bvh_builder(args.value_or("--builder", "binned"), builder))
-        return usage_error("bvh", "--builder must be binned or sweep", kBvhUsage);
+    std::optional<BvhBuilder> builder;  // none: the scene's render.bvh_builder (for a mesh, the default)
+    if (args.has("--builder")) {
+        BvhBuilder b{};
+        if (!parse_bvh_builder(args.values["--builder"], b))
+            return usage_error("bvh", "--builder must be binned, sweep or reinsert", kBvhUsage);
+        builder = b;
+    }
     int size = 1024;
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
         return usage_error("bvh", "--size must be a positive integer", kBvhUsage);
+    int threads = omp_get_num_procs();
+    if (args.has("--threads") && !parse_positive_int(args.values["--threads"], threads))
+        return usage_error("bvh", "--threads must be a positive integer", kBvhUsage);
     try {
-        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, size);
+        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, size, threads);
         if (args.switches.count("--json"))
             std::printf("%s\n", j.dump().c_str());
         else

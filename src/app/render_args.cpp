@@ -23,6 +23,7 @@ const char* const kRenderUsage =
     "  --exposure STOPS     exposure for 8-bit outputs (EXR stays linear)\n"
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
+    "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
     "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
@@ -140,7 +141,12 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
         o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
     else if (a == "--target-error")
         o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
-    else if (a == "--sampler")
+    else if (a == "--builder") {
+        const std::string& v = flag_value(args, i);
+        BvhBuilder b{};
+        if (!parse_bvh_builder(v, b)) throw UsageError(a + ": expected binned|sweep|reinsert, got '" + v + "'");
+        o.bvh_builder = b;
+    } else if (a == "--sampler")
         o.sampler = parse_sampler_name(a, flag_value(args, i));
     else if (a == "--exposure")
         o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
@@ -166,6 +172,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (exposure) r.exposure = *exposure;
     if (tonemap) r.tonemap = *tonemap;
     if (sampler) r.sampler = *sampler;
+    if (bvh_builder) r.bvh_builder = *bvh_builder;
 }
 
 RenderArgs parse_render_args(const std::vector<std::string>& args) {

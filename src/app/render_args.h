@@ -25,6 +25,7 @@ struct RenderOverrides {
     std::optional<float> exposure;
     std::optional<Tonemap> tonemap;
     std::optional<SamplerType> sampler;
+    std::optional<BvhBuilder> bvh_builder;
 
     void apply(RenderSettings& r) const;
 };

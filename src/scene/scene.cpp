@@ -20,7 +20,9 @@ size_t Scene::primitive_count() const {
 }
 
 void Scene::build_accelerator() {
-    accel_ = std::make_unique<Accelerator>(*this);
+    AcceleratorOptions options;
+    options.builder = render.bvh_builder;
+    accel_ = std::make_unique<Accelerator>(*this, options);
     bounds_ = accel_->bounds();
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "accel/bvh.h"
 #include "math/bounds.h"
 #include "math/transform.h"
 #include "math/vec3.h"
@@ -185,6 +186,7 @@ struct RenderSettings {
     float exposure = 0.0f;  ///< stops
     Tonemap tonemap = Tonemap::clamp;
     SamplerType sampler = SamplerType::sobol;  ///< command line only (--sampler)
+    BvhBuilder bvh_builder = kDefaultBvhBuilder;  ///< "bvh_builder" / --builder
 };
 
 struct SceneDesc {
