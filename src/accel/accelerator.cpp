@@ -98,7 +98,10 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
     BvhBuildParams params = options.params;
-    if (options.layout == BvhLayout::wide4) params.intersection_cost *= options.wide4_leaf_cost_scale;
+    if (options.layout == BvhLayout::wide4) {
+        params.intersection_cost *= options.wide4_leaf_cost_scale;
+        params.leaf_block_size = 4;  // a leaf block tests four triangles at once
+    }
     bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
                       : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].

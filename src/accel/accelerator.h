@@ -49,12 +49,14 @@ struct AcceleratorOptions {
     BvhLayout layout = BvhLayout::wide4;
     BvhBuilder builder = BvhBuilder::binned;
     BvhBuildParams params;
-    /// The wide4 layout builds with params.intersection_cost times this: its
-    /// leaves test four triangles per SSE step, so larger leaves pay off.
-    /// 0.5 measured best-or-equal against 0.25-1.0 with `sahara bench` on the
-    /// bunny (one thread, 2026-11-22; differences within the machine's noise
-    /// between 0.25 and 0.7, 1.0 clearly slower on diffuse rays).
-    float wide4_leaf_cost_scale = 0.5f;
+    /// The wide4 layout builds with params.intersection_cost times this and counts
+    /// leaves in whole blocks of four (BvhBuildParams::leaf_block_size): a block
+    /// tests four triangles per SSE step. 0.25 measured equal to 0.35-0.5 in speed
+    /// (`sahara bench --size 512 --threads 1`, bunny, 2026-11-22, within the shared
+    /// machine's noise of +-0.05 in the Embree ratio) and smallest in memory
+    /// (bunny: 53.6 bytes/triangle of nodes + blocks vs 58.0 at 0.5; without the
+    /// block rounding 0.5 gave 79.9, mostly padding lanes of 2- and 3-triangle leaves).
+    float wide4_leaf_cost_scale = 0.25f;
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
