@@ -91,7 +91,7 @@ class Accelerator {
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
-    size_t primitive_count() const { return slots_.size(); }
+    size_t primitive_count() const { return bvh_.prim_indices.size(); }
     /// Bytes of the traversal tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
@@ -107,7 +107,9 @@ class Accelerator {
     template <bool kAnyHit>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
-    void make_leaf_blocks();
+    void make_leaf_blocks(const std::vector<uint32_t>& ids, const std::vector<TriangleVerts>& tris);
+    bool intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const;
+    bool brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const;
     template <bool kAnyHit>
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
@@ -123,7 +125,9 @@ class Accelerator {
         TriangleVerts tri;  ///< 36 bytes; zero for other kinds
         uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
     };
-    std::vector<Slot> slots_;        ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    /// wide4 layout: the primitive id of each slot (the vertices live only in blocks_).
+    std::vector<uint32_t> ids_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
