@@ -141,6 +141,25 @@ TEST_CASE("SAH leaf creation: a single-leaf cap of 1 gives one primitive per lea
     CHECK(big.leaves < m.triangle_count() / 2);
 }
 
+TEST_CASE("SAH with leaf blocks of 4 leaves fewer padding lanes, with both builders") {
+    const TriangleMesh m = make_icosphere(4);
+    for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep}) {
+        auto padding = [&](uint32_t block) {
+            BvhBuildParams p;
+            p.intersection_cost = 0.25f;
+            p.leaf_block_size = block;
+            const BvhStats s = compute_bvh_stats(build_for_mesh(m, builder, p));
+            size_t pad = 0;
+            for (size_t k = 0; k < s.leaf_size_histogram.size(); ++k)
+                pad += s.leaf_size_histogram[k] * ((4 - k % 4) % 4);
+            return pad;
+        };
+        const size_t per_prim = padding(1), blocked = padding(4);
+        INFO(bvh_builder_name(builder), " padding lanes: block 1 ", per_prim, ", block 4 ", blocked);
+        CHECK(blocked * 2 < per_prim);
+    }
+}
+
 TEST_CASE("sweep SAH is at least as good as binned on meshes") {
     for (const TriangleMesh& m : {make_icosphere(4), make_slivers(3000)}) {
         const double binned = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned)).sah_cost;

@@ -98,29 +98,36 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
     BvhBuildParams params = options.params;
-    if (options.layout == BvhLayout::wide4) params.intersection_cost *= options.wide4_leaf_cost_scale;
+    if (options.layout == BvhLayout::wide4) {
+        params.intersection_cost *= options.wide4_leaf_cost_scale;
+        params.leaf_block_size = 4;  // a leaf block tests four triangles at once
+    }
     bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
                       : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
-    slots_.resize(slots);
+    std::vector<uint32_t> ids(slots);
+    std::vector<TriangleVerts> tris(slots);
     const TriangleSoup& soup = scene.triangles;
     for (size_t s = 0; s < slots; ++s) {
-        const uint32_t id = prims.ids[bvh_.prim_indices[s]];
-        slots_[s].id = id;
-        slots_[s].tri = TriangleVerts{};
-        if (prim_kind(id) == PrimKind::triangle) {
-            const uint32_t* v = &soup.indices[3 * size_t(prim_index(id))];
-            slots_[s].tri =
-                TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
+        ids[s] = prims.ids[bvh_.prim_indices[s]];
+        tris[s] = TriangleVerts{};
+        if (prim_kind(ids[s]) == PrimKind::triangle) {
+            const uint32_t* v = &soup.indices[3 * size_t(prim_index(ids[s]))];
+            tris[s] = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
         }
     }
     layout_ = options.layout;
-    if (layout_ == BvhLayout::pairs) {
+    if (layout_ == BvhLayout::pairs)
         pairs_ = make_bvh_pairs(bvh_);
-    } else {
+    else
         wide_ = make_bvh4(bvh_);
-        if (layout_ == BvhLayout::wide4) make_leaf_blocks();
+    if (layout_ == BvhLayout::wide4) {
+        make_leaf_blocks(ids, tris);  // the blocks and ids_ are all the wide4 layout keeps
+        ids_ = std::move(ids);
+    } else {
+        slots_.resize(slots);
+        for (size_t s = 0; s < slots; ++s) slots_[s] = Slot{tris[s], ids[s]};
     }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     build_cpu_ms_ = process_cpu_ms() - cpu_start;
@@ -129,22 +136,22 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 
 /// Rewrites every BVH4 leaf (first slot, count) to (first block, count), its
 /// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
-void Accelerator::make_leaf_blocks() {
-    auto add_leaf = [this](uint32_t first, uint32_t count) {
+void Accelerator::make_leaf_blocks(const std::vector<uint32_t>& ids, const std::vector<TriangleVerts>& tris) {
+    auto add_leaf = [&](uint32_t first, uint32_t count) {
         const auto block = uint32_t(blocks_.size());
         for (uint32_t s = first; s < first + count; s += 4) {
             TriangleBlock4 b{};
             for (int l = 0; l < 4; ++l) {
                 const uint32_t slot = s + uint32_t(l);
                 const bool in_leaf = slot < first + count;
-                const bool tri = in_leaf && prim_kind(slots_[slot].id) == PrimKind::triangle;
+                const bool tri = in_leaf && prim_kind(ids[slot]) == PrimKind::triangle;
                 b.slot[l] = !in_leaf ? TriangleBlock4::kEmptyLane
                             : tri    ? slot
                                      : slot | TriangleBlock4::kOtherKind;
                 for (int v = 0; v < 3; ++v)
                     for (int a = 0; a < 3; ++a)
                         b.p[v][a][l] =
-                            tri ? slots_[slot].tri.p[v][a] : std::numeric_limits<float>::quiet_NaN();
+                            tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
             }
             blocks_.push_back(b);
         }
@@ -160,10 +167,40 @@ void Accelerator::make_leaf_blocks() {
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
-    // The wide4 layout traverses blocks_ instead of slots_ (kept for brute force and other kinds).
-    if (layout_ == BvhLayout::wide4) return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + other;
+    // The wide4 layout keeps only the blocks (vertices) and one id per slot.
+    if (layout_ == BvhLayout::wide4)
+        return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + ids_.size() * sizeof(uint32_t) +
+               other;
     return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
            bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
+}
+
+/// Tests sphere, box or quadric `id` for a hit in (ray.tmin, tmax); sets its t and u.
+bool Accelerator::intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const {
+    switch (prim_kind(id)) {
+        case PrimKind::sphere: {
+            const Sphere& sp = spheres_[prim_index(id)];
+            Ray r = ray;
+            r.tmax = tmax;
+            const double ts = intersect_sphere(r, sp.center_at(ray.time), sp.radius);
+            if (ts < 0.0) return false;
+            t = float(ts);
+            return true;
+        }
+        case PrimKind::box:
+            return intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t);
+        case PrimKind::quadric: {
+            Ray r = ray;
+            r.tmax = tmax;
+            const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
+            if (!qh.hit()) return false;
+            t = qh.t;
+            u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
+            return true;
+        }
+        default:
+            return false;  // triangles are tested by the caller; planes are never in the tree
+    }
 }
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in
@@ -185,29 +222,9 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
                 t = th.t, u = th.u, v = th.v;
                 break;
             }
-            case PrimKind::sphere: {
-                const Sphere& sp = spheres_[prim_index(id)];
-                Ray r = ray;
-                r.tmax = tmax;
-                const double ts = intersect_sphere(r, sp.center_at(ray.time), sp.radius);
-                if (ts < 0.0) continue;
-                t = float(ts);
+            default:
+                if (!intersect_other(ray, id, tmax, t, u)) continue;
                 break;
-            }
-            case PrimKind::box:
-                if (!intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t)) continue;
-                break;
-            case PrimKind::quadric: {
-                Ray r = ray;
-                r.tmax = tmax;
-                const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
-                if (!qh.hit()) continue;
-                t = qh.t;
-                u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
-                break;
-            }
-            case PrimKind::plane:
-                continue;  // unbounded: never in the tree
         }
         if constexpr (kAnyHit) return true;
         tmax = t;
@@ -266,14 +283,14 @@ __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ra
                 const int l = __builtin_ctz(unsigned(m));
                 if (t[l] < t[best]) best = l;
             }
-        if (keep_triangle_hit(ray, slots_[block.slot[best]].id, u[best], v[best])) return 1 << best;
+        if (keep_triangle_hit(ray, ids_[block.slot[best]], u[best], v[best])) return 1 << best;
         mask &= ~(1 << best);
     }
     return 0;
 }
 
 /// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
-/// time, other kinds through test_slots; the closest hit lowers `tmax`.
+/// time, other kinds through intersect_other; the closest hit lowers `tmax`.
 template <bool kAnyHit, bool kCutouts>
 __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
                                                                     uint32_t first, uint32_t count,
@@ -293,7 +310,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
                 if (t[l] < t[best]) best = l;
             }
             tmax = t[best];
-            hit = Hit{t[best], slots_[block.slot[best]].id, u[best], v[best]};
+            hit = Hit{t[best], ids_[block.slot[best]], u[best], v[best]};
             found = true;
         }
         // Sign bits of the slots: lanes of other kinds (and padding, skipped).
@@ -302,10 +319,13 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
         for (int m = other; m; m &= m - 1) {
             const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
             if (slot == TriangleBlock4::kEmptyLane) continue;
-            if (test_slots<kAnyHit, kCutouts>(ray, tr, slot & ~TriangleBlock4::kOtherKind, 1, tmax, hit)) {
-                if constexpr (kAnyHit) return true;
-                found = true;
-            }
+            const uint32_t id = ids_[slot & ~TriangleBlock4::kOtherKind];
+            float t_other = 0.0f, u_other = 0.0f;
+            if (!intersect_other(ray, id, tmax, t_other, u_other)) continue;
+            if constexpr (kAnyHit) return true;
+            tmax = t_other;
+            hit = Hit{t_other, id, u_other, 0.0f};
+            found = true;
         }
     }
     return found;
@@ -364,12 +384,40 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
     return trace<true>(r, h, counters);
 }
 
+/// The wide4 brute force: every lane of every block, triangles by the scalar test.
+bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const {
+    bool found = false;
+    for (const TriangleBlock4& b : blocks_)
+        for (int l = 0; l < 4; ++l) {
+            if (b.slot[l] == TriangleBlock4::kEmptyLane) continue;
+            const uint32_t id = ids_[b.slot[l] & ~TriangleBlock4::kOtherKind];
+            float t = 0.0f, u = 0.0f, v = 0.0f;
+            if (prim_kind(id) == PrimKind::triangle) {
+                const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
+                                         {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
+                                         {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
+                TriangleHit th;
+                if (!intersect_triangle(tr, tri, ray.tmin, tmax, th)) continue;
+                if (!alpha_.empty() && !keep_triangle_hit(ray, id, th.u, th.v)) continue;
+                t = th.t, u = th.u, v = th.v;
+            } else if (!intersect_other(ray, id, tmax, t, u)) {
+                continue;
+            }
+            tmax = t;
+            hit = Hit{t, id, u, v};
+            found = true;
+        }
+    return found;
+}
+
 bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;
     Hit best;
-    const bool found = alpha_.empty() ? test_slots<false, false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)
-                                      : test_slots<false, true>(ray, tr, 0, uint32_t(slots_.size()), tmax, best);
+    const bool found = layout_ == BvhLayout::wide4 ? brute_force_blocks(ray, tr, tmax, best)
+                       : alpha_.empty()
+                           ? test_slots<false, false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)
+                           : test_slots<false, true>(ray, tr, 0, uint32_t(slots_.size()), tmax, best);
     if (!found) return false;
     hit = best;
     ray.tmax = best.t;

@@ -53,12 +53,14 @@ struct AcceleratorOptions {
     BvhLayout layout = BvhLayout::wide4;
     BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
-    /// The wide4 layout builds with params.intersection_cost times this: its
-    /// leaves test four triangles per SSE step, so larger leaves pay off.
-    /// 0.5 measured best-or-equal against 0.25-1.0 with `sahara bench` on the
-    /// bunny (one thread, 2026-11-22; differences within the machine's noise
-    /// between 0.25 and 0.7, 1.0 clearly slower on diffuse rays).
-    float wide4_leaf_cost_scale = 0.5f;
+    /// The wide4 layout builds with params.intersection_cost times this and counts
+    /// leaves in whole blocks of four (BvhBuildParams::leaf_block_size): a block
+    /// tests four triangles per SSE step. 0.25 measured equal to 0.35-0.5 in speed
+    /// (`sahara bench --size 512 --threads 1`, bunny, 2026-11-22, within the shared
+    /// machine's noise of +-0.05 in the Embree ratio) and smallest in memory
+    /// (bunny: 53.6 bytes/triangle of nodes + blocks vs 58.0 at 0.5; without the
+    /// block rounding 0.5 gave 79.9, mostly padding lanes of 2- and 3-triangle leaves).
+    float wide4_leaf_cost_scale = 0.25f;
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
@@ -93,7 +95,7 @@ class Accelerator {
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
-    size_t primitive_count() const { return slots_.size(); }
+    size_t primitive_count() const { return bvh_.prim_indices.size(); }
     /// Whether traversal runs the cut-out (alpha-tested) variant: the scene has
     /// triangles with a cut-out material (accel/alpha_filter.h).
     bool has_cutouts() const { return !alpha_.empty(); }
@@ -117,7 +119,9 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
-    void make_leaf_blocks();
+    void make_leaf_blocks(const std::vector<uint32_t>& ids, const std::vector<TriangleVerts>& tris);
+    bool intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const;
+    bool brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const;
     template <bool kAnyHit, bool kCutouts>
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
@@ -143,7 +147,9 @@ class Accelerator {
         TriangleVerts tri;  ///< 36 bytes; zero for other kinds
         uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
     };
-    std::vector<Slot> slots_;        ///< in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    /// wide4 layout: the primitive id of each slot (the vertices live only in blocks_).
+    std::vector<uint32_t> ids_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)

@@ -102,6 +102,9 @@ struct BvhBuildParams {
     float traversal_cost = 1.0f;
     float intersection_cost = 1.0f;
     uint32_t max_leaf_size = 16;  ///< larger ranges are always split
+    /// Leaves are tested in blocks of this many primitives (a partly filled block
+    /// costs as much as a full one), so the SAH counts ceil(n / size) * size.
+    uint32_t leaf_block_size = 1;
     uint32_t bin_count = 16;      ///< binned builder: centroid bins per axis
     /// Subtrees with more primitives than this are built as OpenMP tasks.
     uint32_t parallel_threshold = 4096;

@@ -126,7 +126,7 @@ class BvhBuildJob {
                                                            : find_sweep_split(begin, end, centroids);
         if (split.axis < 0) return may_be_leaf ? begin : median_split(begin, end, centroids);
         const float area = box.surface_area();
-        const float leaf_cost = params_.intersection_cost * float(n) * area;
+        const float leaf_cost = params_.intersection_cost * blocked(n) * area;
         const float split_cost = params_.traversal_cost * area + split.cost;
         if (may_be_leaf && leaf_cost <= split_cost) return begin;
         return builder_ == BvhBuilder::binned ? partition_binned(begin, end, centroids, split)
@@ -259,7 +259,13 @@ class BvhBuildJob {
 
     /// Unnormalised intersection term of a split's SAH cost (the traversal term is added by the caller).
     float sah_cost(float area_left, uint32_t n_left, float area_right, uint32_t n_right) const {
-        return params_.intersection_cost * (area_left * float(n_left) + area_right * float(n_right));
+        return params_.intersection_cost * (area_left * blocked(n_left) + area_right * blocked(n_right));
+    }
+
+    /// Primitive count rounded up to whole leaf blocks (what a leaf of n actually tests).
+    float blocked(uint32_t n) const {
+        const uint32_t b = params_.leaf_block_size;
+        return float((n + b - 1) / b * b);
     }
 
     /// fallback_split: object median on the widest centroid axis (used when SAH
@@ -288,6 +294,7 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     BvhBuildParams p = params;
     p.bin_count = std::clamp(p.bin_count, 2u, 64u);
     p.max_leaf_size = std::max(p.max_leaf_size, 1u);
+    p.leaf_block_size = std::max(p.leaf_block_size, 1u);
     Bvh bvh;
     if (builder != BvhBuilder::reinsert) {
         BvhBuildJob(input, builder, p, bvh).run();
