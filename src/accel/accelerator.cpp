@@ -334,6 +334,12 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
     return trace<true>(r, h, counters);
 }
 
+bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
+    const TriangleRay tr(ray);
+    float tmax = ray.tmax;
+    return test_slots<false>(ray, tr, slot, 1, tmax, hit);
+}
+
 bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;

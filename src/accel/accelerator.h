@@ -22,6 +22,8 @@
 namespace sahara {
 
 class Scene;
+struct RayPacket;
+struct HitPacket;
 
 /// Largest primitive count for which the accelerator skips the SAH build and
 /// tests everything in one root leaf (a flat loop). Decided by measurement,
@@ -72,6 +74,16 @@ class Accelerator {
     bool intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const;
     /// occluded() that also counts node visits and primitive tests into `counters`.
     bool occluded_counted(const Ray& ray, TraversalCounters& counters) const;
+    /// Nearest hits of the active rays of a packet (accel/packet.h); on a hit,
+    /// the lane's tmax becomes hit.t. Per ray the answer is intersect()'s up to
+    /// ties between primitives at exactly the same distance. Layouts other than
+    /// wide4 and incoherent packets (mixed direction signs) are traced ray by ray.
+    void intersect_packet(RayPacket& packet, HitPacket& hits) const;
+    /// Tests the primitive in leaf slot `slot` alone (packet fallback for non-triangles);
+    /// on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
+    bool intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const;
+    /// Primitive id held by leaf slot `slot`.
+    uint32_t slot_prim(uint32_t slot) const { return slots_[slot].id; }
     /// Reference answer: tests every primitive, no tree (for tests).
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
 

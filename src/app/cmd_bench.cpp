@@ -13,6 +13,7 @@
 #include "app/mesh_input.h"
 #include "app/ray_batch.h"
 #include "app/tool_args.h"
+#include "accel/packet.h"
 #include "base/error.h"
 
 namespace sahara {
@@ -20,13 +21,15 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBenchUsage =
-    "usage: sahara bench MESH [--threads N] [--rays primary|diffuse|shadow|all] [--json]\n"
+    "usage: sahara bench MESH [--threads N] [--rays primary|primary_packet|diffuse|shadow|all] [--json]\n"
     "                         [--builder binned|sweep] [--layout L] [--size N] [--repeat K]\n"
     "                         [--no-embree]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  MESH        a mesh (.obj)\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
     "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh,\n"
+    "              primary_packet = the primary rays as 16-ray packets of 4x4 pixel tiles (Embree:\n"
+    "              rtcIntersect16 on the same tiles; also compared with sahara's single rays),\n"
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the mesh\n"
     "  --layout L  traversal structure: wide4 (default: 4-wide BVH, leaf triangles tested 4 at a\n"
@@ -94,6 +97,45 @@ nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& ac
     return j;
 }
 
+/// The primary rays as 16-ray packets of 4x4 pixel tiles, against Embree's
+/// rtcIntersect16 on the same tiles; also compared with sahara's single rays.
+nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelerator& accel,
+                                        const EmbreeReference* embree, const std::vector<Ray>& rays,
+                                        const BenchOptions& opt) {
+    std::vector<double> ours, theirs, ours_cpu, theirs_cpu;
+    RayAnswers a, b, single;
+    for (int k = 0; k < opt.repeat; ++k) {
+        const PassTime t = trace_sahara_packets(accel, rays, opt.size, opt.size, opt.threads, true, a);
+        ours.push_back(t.wall_s);
+        ours_cpu.push_back(t.cpu_s);
+        if (!embree) continue;
+        const PassTime e = trace_embree_packets(*embree, rays, opt.size, opt.size, opt.threads, true, b);
+        theirs.push_back(e.wall_s);
+        theirs_cpu.push_back(e.cpu_s);
+    }
+    trace_sahara(accel, rays, false, opt.threads, true, single);
+    const Disagreements ds = compare_answers(a, single, rays, mesh);
+    const double count = double(rays.size());
+    nlohmann::ordered_json j = {{"count", rays.size()},
+                                {"mrays_s", count / median(ours) * 1e-6},
+                                {"mrays_cpu_s", count / median(ours_cpu) * 1e-6},
+                                {"hit_rate", rays.empty() ? 0.0 : double(a.hits()) / count},
+                                {"packet_simd", packet_simd_name(active_packet_simd())},
+                                {"disagreements_single_ray", ds.total + ds.confirmed_for_a},
+                                {"ties_single_ray", ds.ties}};
+    if (embree) {
+        const Disagreements d = compare_answers(a, b, rays, mesh);
+        j["embree_mrays_s"] = count / median(theirs) * 1e-6;
+        j["embree_mrays_cpu_s"] = count / median(theirs_cpu) * 1e-6;
+        j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
+        j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
+        j["disagreements"] = d.total;
+        j["ties"] = d.ties;
+        j["confirmed_for_sahara"] = d.confirmed_for_a;
+    }
+    return j;
+}
+
 nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     omp_set_num_threads(opt.threads);
     const TriangleMesh mesh = read_mesh_triangles(opt.mesh);
@@ -119,6 +161,10 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"build_cpu_ms", accel.build_cpu_ms()}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
     for (const std::string& set : opt.sets) {
+        if (set == "primary_packet") {
+            j["rays"][set] = bench_packet_set(mesh, accel, embree.get(), rays.primary, opt);
+            continue;
+        }
         const std::vector<Ray>& r = set == "primary"   ? rays.primary
                                     : set == "diffuse" ? rays.diffuse
                                                        : rays.shadow;
@@ -140,13 +186,13 @@ void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
     if (!embree)
         std::printf("Embree      %s\n",
                     embree_wanted ? "not available (sahara was built without Embree 3)" : "skipped");
-    std::printf("%-8s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
+    std::printf("%-14s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
     if (embree)
         std::printf(" %8s %8s %6s %6s %6s %5s %9s", "Embree", "(CPU)", "ratio", "(CPU)", "disagr", "ties",
                     "confirmed");
     std::printf("\n");
     for (const auto& [name, r] : j["rays"].items()) {
-        std::printf("%-8s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
+        std::printf("%-14s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
                     r["hit_rate"].get<double>(), r["mrays_s"].get<double>(), r["mrays_cpu_s"].get<double>());
         if (embree)
             std::printf(" %8.2f %8.2f %6.2f %6.2f %6zu %5zu %9zu", r["embree_mrays_s"].get<double>(),
@@ -221,11 +267,11 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--layout must be wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");
     if (sets == "all")
-        opt.sets = {"primary", "diffuse", "shadow"};
-    else if (sets == "primary" || sets == "diffuse" || sets == "shadow")
+        opt.sets = {"primary", "primary_packet", "diffuse", "shadow"};
+    else if (sets == "primary" || sets == "primary_packet" || sets == "diffuse" || sets == "shadow")
         opt.sets = {sets};
     else
-        return "--rays must be primary, diffuse, shadow or all";
+        return "--rays must be primary, primary_packet, diffuse, shadow or all";
     opt.embree = !args.switches.count("--no-embree");
     opt.json = args.switches.count("--json") != 0;
     return "";
