@@ -11,7 +11,10 @@
 #include "accel/packet.h"
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
+#include "render/film.h"
+#include "render/renderer.h"
 #include "scene/scene.h"
+#include "scene/scene_parser.h"
 
 using namespace sahara;
 using namespace sahara::test;
@@ -202,4 +205,46 @@ TEST_CASE("packet SIMD path names and the SAHARA_PACKETS switch") {
     set_packets_enabled(true);
     CHECK(packets_enabled());
     set_packets_enabled(was);
+}
+
+namespace {
+
+bool same_film(const Film& a, const Film& b) {
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x)
+            if (a.count(x, y) != b.count(x, y) || !(a.sum(x, y) == b.sum(x, y)) ||
+                !(a.sum_sq(x, y) == b.sum_sq(x, y)))
+                return false;
+    return true;
+}
+
+/// Renders `desc` at w x h with packets on and off and compares the films bit for bit.
+void check_packets_keep_image(SceneDesc desc, int w, int h, int spp) {
+    desc.render.width = w;
+    desc.render.height = h;
+    desc.render.spp = spp;
+    const Scene scene = build_scene(desc);
+    Film with(w, h), without(w, h), pass_with(w, h), pass_without(w, h);
+    RenderOptions o;
+    o.threads = 2;
+    const bool was = packets_enabled();
+    set_packets_enabled(true);
+    render_image(scene, with, o);
+    render_pass(scene, pass_with, 0, spp, 2, nullptr);
+    set_packets_enabled(false);
+    render_image(scene, without, o);
+    render_pass(scene, pass_without, 0, spp, 2, nullptr);
+    set_packets_enabled(was);
+    CHECK(same_film(with, without));
+    CHECK(same_film(pass_with, pass_without));
+    CHECK(same_film(with, pass_with));
+}
+
+}  // namespace
+
+TEST_CASE("renders with packets on and off are bit-identical (cornell box, default scene, showcase)") {
+    check_packets_keep_image(parse_scene_file(SAHARA_SOURCE_DIR "/scenes/cornell-box.json"), 37, 29,
+                             kSanitized ? 1 : 3);
+    check_packets_keep_image(default_scene(), 30, 22, kSanitized ? 1 : 4);
+    check_packets_keep_image(parse_scene_file(SAHARA_SOURCE_DIR "/scenes/showcase.json"), 26, 18, 1);
 }

@@ -201,6 +201,12 @@ void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
                         r["ties"].get<size_t>(), r["confirmed_for_sahara"].get<size_t>());
         std::printf("\n");
     }
+    if (j["rays"].contains("primary_packet")) {
+        const auto& r = j["rays"]["primary_packet"];
+        std::printf("primary_packet: %s kernel; against sahara's single rays %zu disagreements, %zu ties\n",
+                    r["packet_simd"].get<std::string>().c_str(), r["disagreements_single_ray"].get<size_t>(),
+                    r["ties_single_ray"].get<size_t>());
+    }
 }
 
 /// Times the flat loop against the tree on scenes of n random spheres and n random
