@@ -445,7 +445,7 @@ TEST_CASE("sahara agrees with Embree on the shared meshes (bench ray sets)") {
         Scene scene = scene_from_mesh(mesh);
         const Accelerator acc(scene);
         const EmbreeReference embree(mesh.positions, mesh.indices);
-        const BenchRaySets sets = make_bench_rays(mesh, acc, side, side);
+        const BenchRaySets sets = make_bench_rays(scene, acc, side, side);
         for (int s = 0; s < 3; ++s) {
             const std::vector<Ray>& rays = s == 0 ? sets.primary : s == 1 ? sets.diffuse : sets.shadow;
             RayAnswers a, b;

@@ -91,7 +91,7 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
 }
 
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
-    : spheres_(scene.spheres), quadrics_(scene.quadrics) {
+    : spheres_(scene.spheres), quadrics_(scene.quadrics), alpha_(scene) {
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
@@ -159,7 +159,7 @@ void Accelerator::make_leaf_blocks() {
 
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
-                         quadrics_.size() * sizeof(Quadric);
+                         quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
     // The wide4 layout traverses blocks_ instead of slots_ (kept for brute force and other kinds).
     if (layout_ == BvhLayout::wide4) return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + other;
     return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
@@ -168,7 +168,7 @@ size_t Accelerator::bytes() const {
 
 /// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in
 /// `hit`.
-template <bool kAnyHit>
+template <bool kAnyHit, bool kCutouts>
 __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr,
                                                                    uint32_t first, uint32_t count,
                                                                    float& tmax, Hit& hit) const {
@@ -180,6 +180,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
             case PrimKind::triangle: {
                 TriangleHit th;
                 if (!intersect_triangle(tr, slots_[s].tri, ray.tmin, tmax, th)) continue;
+                if constexpr (kCutouts)
+                    if (!keep_triangle_hit(ray, id, th.u, th.v)) continue;
                 t = th.t, u = th.u, v = th.v;
                 break;
             }
@@ -217,7 +219,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 
 /// The BVH4 traversal; trace_wide_avx2 is the same code compiled for AVX2
 /// (both inline this body, so each gets its own instruction selection).
-template <bool kAnyHit, bool kBlocks, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit,
                                                                         Counters& counters) const {
     const TriangleRay tr(ray);
@@ -227,9 +229,9 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
         wide_, br,
         [&](uint32_t first, uint32_t count, float& tmax) {
             if constexpr (kBlocks)
-                return test_blocks<kAnyHit>(ray, tr, first, count, tmax, best);
+                return test_blocks<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
             else
-                return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
+                return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
         },
         counters);
     if (found && !kAnyHit) {
@@ -239,20 +241,40 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
     return found;
 }
 
-template <bool kAnyHit, bool kBlocks, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
 bool Accelerator::trace_wide(Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kBlocks>(ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks>(ray, hit, counters);
 }
 
-template <bool kAnyHit, bool kBlocks, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
 __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kBlocks>(ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks>(ray, hit, counters);
+}
+
+template <bool kAnyHit>
+__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray,
+                                                                        const TriangleBlock4& block,
+                                                                        int mask, const float t[4],
+                                                                        const float u[4],
+                                                                        const float v[4]) const {
+    // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
+    while (mask) {
+        int best = __builtin_ctz(unsigned(mask));
+        if constexpr (!kAnyHit)
+            for (int m = mask & (mask - 1); m; m &= m - 1) {
+                const int l = __builtin_ctz(unsigned(m));
+                if (t[l] < t[best]) best = l;
+            }
+        if (keep_triangle_hit(ray, slots_[block.slot[best]].id, u[best], v[best])) return 1 << best;
+        mask &= ~(1 << best);
+    }
+    return 0;
 }
 
 /// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
 /// time, other kinds through test_slots; the closest hit lowers `tmax`.
-template <bool kAnyHit>
+template <bool kAnyHit, bool kCutouts>
 __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
                                                                     uint32_t first, uint32_t count,
                                                                     float& tmax, Hit& hit) const {
@@ -260,7 +282,9 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
     for (uint32_t b = first; b < first + (count + 3) / 4; ++b) {
         const TriangleBlock4& block = blocks_[b];
         float t[4], u[4], v[4];
-        const int mask = intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
+        int mask = intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
+        if constexpr (kCutouts)
+            if (mask) mask = keep_block_lanes<kAnyHit>(ray, block, mask, t, u, v);
         if (mask) {
             if constexpr (kAnyHit) return true;
             int best = __builtin_ctz(unsigned(mask));
@@ -278,7 +302,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
         for (int m = other; m; m &= m - 1) {
             const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
             if (slot == TriangleBlock4::kEmptyLane) continue;
-            if (test_slots<kAnyHit>(ray, tr, slot & ~TriangleBlock4::kOtherKind, 1, tmax, hit)) {
+            if (test_slots<kAnyHit, kCutouts>(ray, tr, slot & ~TriangleBlock4::kOtherKind, 1, tmax, hit)) {
                 if constexpr (kAnyHit) return true;
                 found = true;
             }
@@ -289,20 +313,26 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
 
 template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
+    return alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
+                          : trace_layout<kAnyHit, true>(ray, hit, counters);
+}
+
+template <bool kAnyHit, bool kCutouts, class Counters>
+bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
     const bool avx2 = active_simd_path() == SimdPath::avx2;
     if (layout_ == BvhLayout::wide4)
-        return avx2 ? trace_wide_avx2<kAnyHit, true>(ray, hit, counters)
-                    : trace_wide<kAnyHit, true>(ray, hit, counters);
+        return avx2 ? trace_wide_avx2<kAnyHit, kCutouts, true>(ray, hit, counters)
+                    : trace_wide<kAnyHit, kCutouts, true>(ray, hit, counters);
     if (layout_ == BvhLayout::wide4_slots)
-        return avx2 ? trace_wide_avx2<kAnyHit, false>(ray, hit, counters)
-                    : trace_wide<kAnyHit, false>(ray, hit, counters);
+        return avx2 ? trace_wide_avx2<kAnyHit, kCutouts, false>(ray, hit, counters)
+                    : trace_wide<kAnyHit, kCutouts, false>(ray, hit, counters);
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
     const bool found = traverse_bvh_pairs<kAnyHit>(
         pairs_, br,
         [&](uint32_t first, uint32_t count, float& tmax) {
-            return test_slots<kAnyHit>(ray, tr, first, count, tmax, best);
+            return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
         },
         counters);
     if (found && !kAnyHit) {
@@ -337,14 +367,16 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
 bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;
-    return test_slots<false>(ray, tr, slot, 1, tmax, hit);
+    return test_slots<false, false>(ray, tr, slot, 1, tmax, hit);  // packets never run with cut-outs
 }
 
 bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;
     Hit best;
-    if (!test_slots<false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)) return false;
+    const bool found = alpha_.empty() ? test_slots<false, false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)
+                                      : test_slots<false, true>(ray, tr, 0, uint32_t(slots_.size()), tmax, best);
+    if (!found) return false;
     hit = best;
     ray.tmax = best.t;
     return true;

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "accel/alpha_filter.h"
 #include "accel/bvh.h"
 #include "accel/bvh4.h"
 #include "accel/bvh4_leaf.h"
@@ -77,7 +78,8 @@ class Accelerator {
     /// Nearest hits of the active rays of a packet (accel/packet.h); on a hit,
     /// the lane's tmax becomes hit.t. Per ray the answer is intersect()'s up to
     /// ties between primitives at exactly the same distance. Layouts other than
-    /// wide4 and incoherent packets (mixed direction signs) are traced ray by ray.
+    /// wide4, scenes with cut-outs and incoherent packets (mixed direction signs
+    /// or dominant axes) are traced ray by ray.
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
     /// Tests the primitive in leaf slot `slot` alone (packet fallback for non-triangles);
     /// on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
@@ -102,25 +104,43 @@ class Accelerator {
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
     size_t primitive_count() const { return slots_.size(); }
+    /// Whether traversal runs the cut-out (alpha-tested) variant: the scene has
+    /// triangles with a cut-out material (accel/alpha_filter.h).
+    bool has_cutouts() const { return !alpha_.empty(); }
+    /// The alpha test applied to cut-out triangle hits.
+    const AlphaFilter& alpha_filter() const { return alpha_; }
     /// Bytes of the traversal tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
    private:
+    /// Picks the traversal instantiation: with the alpha test only for scenes with cut-outs.
     template <bool kAnyHit, class Counters>
     bool trace(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kBlocks, class Counters>
+    template <bool kAnyHit, bool kCutouts, class Counters>
+    bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
     bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kBlocks, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
     bool trace_wide(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kBlocks, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
     __attribute__((target("avx2"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit>
+    template <bool kAnyHit, bool kCutouts>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
     void make_leaf_blocks();
-    template <bool kAnyHit>
+    template <bool kAnyHit, bool kCutouts>
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                     Hit& hit) const;
+    /// The any-hit filter: whether a hit (barycentrics u, v) on triangle `id` is kept.
+    bool keep_triangle_hit(const Ray& ray, uint32_t id, float u, float v) const {
+        const uint32_t e = alpha_.entry_of(prim_index(id));
+        return e == AlphaFilter::kOpaque || alpha_.passes(e, ray, id, u, v);
+    }
+    /// Of the hit lanes `mask` of a triangle block, the one kept lane (the nearest
+    /// kept one; for kAnyHit the first) as a mask, or 0 when every hit is cut out.
+    template <bool kAnyHit>
+    int keep_block_lanes(const Ray& ray, const TriangleBlock4& block, int mask, const float t[4],
+                         const float u[4], const float v[4]) const;
 
     Bvh bvh_;                             ///< canonical tree (statistics, validation)
     BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
@@ -137,6 +157,7 @@ class Accelerator {
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
+    AlphaFilter alpha_;              ///< cut-out triangles (empty: traversal without the alpha test)
     Bounds3 bounds_;
     bool uses_tree_ = false;
     double build_ms_ = 0;

@@ -163,8 +163,9 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     c.bvh = &wide_;
     c.blocks = blocks_.data();
     c.accel = this;
-    // Other layouts, mixed directions and near-empty packets: single rays.
-    if (layout_ != BvhLayout::wide4 || wide_.empty || std::popcount(packet.active) < 2 ||
+    // Other layouts, scenes with cut-outs (the alpha test is single-ray only),
+    // mixed directions and near-empty packets: single rays.
+    if (layout_ != BvhLayout::wide4 || wide_.empty || has_cutouts() || std::popcount(packet.active) < 2 ||
         !packet_eligible(packet, c)) {
         for (uint32_t m = packet.active; m; m &= m - 1) {
             const int i = std::countr_zero(m);

@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
 
-#include "geometry/triangle.h"
+#include "geometry/spawn.h"
+#include "render/camera.h"
 
 namespace sahara {
 
@@ -61,22 +63,48 @@ struct SurfacePoint {
     Vec3 p, n;
 };
 
-}  // namespace
-
-BenchRaySets make_bench_rays(const TriangleMesh& mesh, const Accelerator& accel, int width, int height,
-                             uint64_t seed) {
-    BenchRaySets sets;
-    const Bounds3 b = accel.bounds();
-    const Frame f = frame_mesh(b);
+/// The primary rays of `aim` (row-major, width x height).
+std::vector<Ray> primary_rays(const Scene& scene, const Bounds3& b, int width, int height, BenchAim aim) {
     const auto count = size_t(width) * size_t(height);
-    sets.primary.resize(count);
+    std::vector<Ray> rays(count);
+    if (aim == BenchAim::scene_camera) {
+        const Camera camera(scene.camera, width, height);
+        for (size_t i = 0; i < count; ++i) {
+            const auto x = float(i % size_t(width)), y = float(i / size_t(width));
+            rays[i] = camera.generate_ray(x + 0.5f, y + 0.5f, Vec2{0.5f, 0.5f}, 0.0f);
+        }
+        return rays;
+    }
+    const Frame f = frame_mesh(b);
     for (size_t i = 0; i < count; ++i) {
         const auto x = float(i % size_t(width)), y = float(i / size_t(width));
         const float sx =
             (2.0f * (x + 0.5f) / float(width) - 1.0f) * f.tan_half_fov * float(width) / float(height);
         const float sy = (1.0f - 2.0f * (y + 0.5f) / float(height)) * f.tan_half_fov;
-        sets.primary[i] = Ray{f.eye, normalize(f.forward + f.right * sx + f.up * sy)};
+        rays[i] = Ray{f.eye, normalize(f.forward + f.right * sx + f.up * sy)};
     }
+    return rays;
+}
+
+/// The world axis (0..2) closest to the view's up direction, and its sign.
+std::pair<int, float> up_axis(const Scene& scene, int width, int height, BenchAim aim) {
+    if (aim == BenchAim::frame_bounds) return {1, 1.0f};
+    const Camera camera(scene.camera, width, height);
+    const Vec3 top = camera.generate_ray(0.5f * float(width), 0.0f, Vec2{0.5f, 0.5f}, 0.0f).dir;
+    const Vec3 bottom = camera.generate_ray(0.5f * float(width), float(height), Vec2{0.5f, 0.5f}, 0.0f).dir;
+    const Vec3 up = normalize(top) - normalize(bottom);
+    const int axis = max_dimension(abs(up));
+    return {axis, up[axis] < 0.0f ? -1.0f : 1.0f};
+}
+
+}  // namespace
+
+BenchRaySets make_bench_rays(const Scene& scene, const Accelerator& accel, int width, int height,
+                             BenchAim aim, uint64_t seed) {
+    BenchRaySets sets;
+    const Bounds3 b = accel.bounds();
+    sets.primary = primary_rays(scene, b, width, height, aim);
+    const size_t count = sets.primary.size();
     // Primary hits (not timed; the bench traces the sets again).
     const float radius = std::max(0.5f * length(b.extent()), 1e-6f);
     std::vector<SurfacePoint> per_pixel(count);
@@ -85,19 +113,26 @@ BenchRaySets make_bench_rays(const TriangleMesh& mesh, const Accelerator& accel,
     for (size_t i = 0; i < count; ++i) {
         Ray r = sets.primary[i];
         Hit h;
-        if (!accel.intersect(r, h) || prim_kind(h.prim) != PrimKind::triangle) continue;
-        Vec3 n = triangle_geometric_normal(mesh, prim_index(h.prim));
-        if (dot(n, r.dir) > 0.0f) n = -n;
-        per_pixel[i] = {r.at(h.t) + n * (1e-4f * radius), n};
+        if (!accel.intersect(r, h)) continue;
+        const SurfaceInteraction si = scene.interact(r, h);  // ng: unit, facing the ray
+        if (!is_finite(si.ng) || !is_finite(si.p)) continue;
+        per_pixel[i] = aim == BenchAim::frame_bounds
+                           ? SurfacePoint{r.at(h.t) + si.ng * (1e-4f * radius), si.ng}
+                           : SurfacePoint{offset_ray_origin(si.p, si.ng), si.ng};
         valid[i] = 1;
     }
     std::vector<SurfacePoint> points;
     for (size_t i = 0; i < count; ++i)
         if (valid[i]) points.push_back(per_pixel[i]);
     if (points.empty()) return sets;
-    // A square light of side `radius`, 1.5 radii above the top of the bounds.
-    const Vec3 light_corner(b.center().x - 0.5f * radius, b.hi.y + 1.5f * radius,
-                            b.center().z - 0.5f * radius);
+    // A square light of side `radius`, 1.5 radii beyond the bounds along the up axis
+    // (+y when framing the bounds).
+    const auto [axis, sign] = up_axis(scene, width, height, aim);
+    const int au = (axis + 2) % 3, av = (axis + 1) % 3;  // y up: u = x, v = z
+    Vec3 light_corner(0.0f);
+    light_corner[axis] = sign > 0.0f ? b.hi[axis] + 1.5f * radius : b.lo[axis] - 1.5f * radius;
+    light_corner[au] = b.center()[au] - 0.5f * radius;
+    light_corner[av] = b.center()[av] - 0.5f * radius;
     sets.diffuse.resize(count);
     sets.shadow.resize(count);
     for (size_t i = 0; i < count; ++i) {
@@ -106,7 +141,9 @@ BenchRaySets make_bench_rays(const TriangleMesh& mesh, const Accelerator& accel,
         const float u1 = d.next(), u2 = d.next();
         sets.diffuse[i] = Ray{sp.p, cosine_direction(sp.n, u1, u2)};
         const float l1 = s.next(), l2 = s.next();
-        const Vec3 target = light_corner + Vec3(l1 * radius, 0.0f, l2 * radius);
+        Vec3 target = light_corner;
+        target[au] += l1 * radius;
+        target[av] += l2 * radius;
         sets.shadow[i] = Ray{sp.p, target - sp.p, 0.0f, 1.0f - 1e-4f};
     }
     return sets;

@@ -1,5 +1,6 @@
-/// `sahara bench`: builds the BVH over a mesh, traces fixed seeded ray sets and
-/// reports throughput, with Embree 3 on the same rays as the yardstick.
+/// `sahara bench`: builds the BVH over a mesh or a scene file, traces fixed seeded
+/// ray sets and reports throughput, with Embree 3 on the same rays as the
+/// yardstick (triangles only: skipped for scenes with other primitives).
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
@@ -21,17 +22,23 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBenchUsage =
-    "usage: sahara bench MESH [--threads N] [--rays primary|primary_packet|diffuse|shadow|all] [--json]\n"
+    "usage: sahara bench FILE [--threads N] [--rays primary|primary_packet|diffuse|shadow|all]\n"
+    "                         [--json]\n"
     "                         [--builder binned|sweep] [--layout L] [--size N] [--repeat K]\n"
     "                         [--no-embree]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
-    "  MESH        a mesh (.obj)\n"
+    "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
+    "              its triangles, spheres, boxes and quadrics (planes are unbounded: not in the\n"
+    "              tree, not traced), primary rays come from the scene's camera (lens centre), and\n"
+    "              the Embree comparison runs only if every bounded primitive is a triangle\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
-    "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh,\n"
-    "              primary_packet = the primary rays as 16-ray packets of 4x4 pixel tiles (Embree:\n"
-    "              rtcIntersect16 on the same tiles; also compared with sahara's single rays),\n"
+    "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh\n"
+    "              (a scene: its camera), primary_packet = the primary rays as 16-ray packets of\n"
+    "              4x4 pixel tiles (Embree: rtcIntersect16 on the same tiles; also compared with\n"
+    "              sahara's single rays),\n"
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
-    "              rays from the primary hits to a square light above the mesh\n"
+    "              rays from the primary hits to a square light above the geometry (a scene: along\n"
+    "              the camera's up axis)\n"
     "  --layout L  traversal structure: wide4 (default: 4-wide BVH, leaf triangles tested 4 at a\n"
     "              time), wide4-slots (4-wide BVH, one leaf slot at a time) or pairs (binary BVH);\n"
     "              the wide layouts use AVX2 when the CPU has it, SSE2 with SAHARA_SIMD=sse2\n"
@@ -136,21 +143,40 @@ nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelera
     return j;
 }
 
+/// "compared" when Embree will run on the same triangles, else why not. Embree
+/// (accel/embree_reference.h) holds triangles only, so a scene with spheres,
+/// boxes or quadrics would compare different geometry.
+std::string embree_plan(const BenchOptions& opt, const Scene& scene) {
+    if (!opt.embree) return "skipped: --no-embree";
+    if (!EmbreeReference::available()) return "skipped: sahara was built without Embree 3";
+    if (scene.spheres.size() + scene.boxes.size() + scene.quadrics.size() > 0)
+        return "skipped: scene has " + primitive_kinds_text(scene, false) +
+               " (Embree reference holds triangles only)";
+    return "compared";
+}
+
 nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     omp_set_num_threads(opt.threads);
-    const TriangleMesh mesh = read_mesh_triangles(opt.mesh);
-    const Scene scene = scene_from_mesh(mesh);
+    const ToolInput input = read_tool_input(opt.mesh);
+    const Scene& scene = input.scene;
+    const TriangleMesh& mesh = input.triangles;
     AcceleratorOptions aopt;
     aopt.builder = opt.builder;
     aopt.layout = opt.layout;
     const Accelerator accel(scene, aopt);
     std::unique_ptr<EmbreeReference> embree;
-    if (opt.embree && EmbreeReference::available())
-        embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices);
-    const BenchRaySets rays = make_bench_rays(mesh, accel, opt.size, opt.size);
+    const std::string embree_status = embree_plan(opt, scene);
+    if (embree_status == "compared") embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices);
+    const BenchRaySets rays =
+        make_bench_rays(scene, accel, opt.size, opt.size,
+                        input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     nlohmann::ordered_json j = {
         {"mesh", opt.mesh},
+        {"input", input.from_scene_file ? "scene" : "mesh"},
         {"primitives", accel.primitive_count()},
+        {"primitive_kinds", primitive_kinds_text(scene)},
+        {"planes_outside_tree", scene.planes.size()},
+        {"embree", embree_status},
         {"threads", opt.threads},
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
@@ -173,9 +199,13 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     return j;
 }
 
-void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
-    std::printf("mesh        %s\nprimitives  %zu\nthreads     %d\n", j["mesh"].get<std::string>().c_str(),
-                j["primitives"].get<size_t>(), j["threads"].get<int>());
+void print_text(const nlohmann::ordered_json& j) {
+    std::printf("%-11s %s\nprimitives  %zu (%s)\n", j["input"].get<std::string>().c_str(),
+                j["mesh"].get<std::string>().c_str(), j["primitives"].get<size_t>(),
+                j["primitive_kinds"].get<std::string>().c_str());
+    if (const auto planes = j["planes_outside_tree"].get<size_t>())
+        std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
+    std::printf("threads     %d\n", j["threads"].get<int>());
     std::printf("build       %.1f ms, CPU %.1f ms (%s SAH, %s layout, %s)", j["build_ms"].get<double>(),
                 j["build_cpu_ms"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
@@ -183,9 +213,7 @@ void print_text(const nlohmann::ordered_json& j, bool embree_wanted) {
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n",
                 j["tree_bytes_per_primitive"].get<double>());
     const bool embree = j.contains("embree_build_ms");
-    if (!embree)
-        std::printf("Embree      %s\n",
-                    embree_wanted ? "not available (sahara was built without Embree 3)" : "skipped");
+    if (!embree) std::printf("Embree      %s\n", j["embree"].get<std::string>().c_str());
     std::printf("%-14s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
     if (embree)
         std::printf(" %8s %8s %6s %6s %6s %5s %9s", "Embree", "(CPU)", "ratio", "(CPU)", "disagr", "ties",
@@ -258,7 +286,7 @@ int run_small_scenes() {
 
 /// Fills `opt` from the flags; returns an error message (empty on success).
 std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
-    if (args.positional.size() != 1) return "expected one mesh file";
+    if (args.positional.size() != 1) return "expected one mesh or scene file";
     opt.mesh = args.positional[0];
     opt.threads = omp_get_num_procs();
     if (args.has("--threads") && !parse_positive_int(args.values.at("--threads"), opt.threads))
@@ -304,7 +332,7 @@ int run_bench_command(int argc, char** argv) {
         if (opt.json)
             std::printf("%s\n", j.dump().c_str());
         else
-            print_text(j, opt.embree);
+            print_text(j);
     } catch (const InputError& e) {
         std::fprintf(stderr, "sahara bench: %s\n", e.what());
         return 2;

@@ -1,4 +1,5 @@
-/// `sahara bvh`: builds the BVH over a mesh and prints its statistics, plus
+/// `sahara bvh`: builds the BVH over a mesh or a scene file's bounded primitives
+/// and prints its statistics, plus
 /// the mean traversal work per ray for primary and diffuse-bounce rays.
 #include <nlohmann/json.hpp>
 
@@ -19,9 +20,12 @@ namespace {
 
 constexpr const char* kBvhUsage =
     "usage: sahara bvh FILE [--builder binned|sweep] [--size N] [--json]\n"
-    "  FILE        a mesh (.obj, .gltf, .glb); OBJ polygons are fan-split, degenerate triangles kept\n"
+    "  FILE        a mesh (.obj, .gltf, .glb; OBJ polygons are fan-split, degenerate triangles kept)\n"
+    "              or a scene file (.json): the tree holds its triangles, spheres, boxes and quadrics;\n"
+    "              planes are unbounded, stay outside the tree and are not traced here\n"
     "  --builder   binned (default: binned SAH, parallel) or sweep (exact sweep SAH)\n"
-    "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays\n"
+    "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays;\n"
+    "              a mesh is framed from (0.4, 0.3, 1), a scene is seen through its own camera\n"
     "  --json      print one JSON object instead of text\n"
     "SAH costs: traversal 1, primitive intersection 1 (relative), normalised to the root's area.\n";
 
@@ -50,9 +54,17 @@ nlohmann::ordered_json work_json(const TraversalCounters& c, size_t rays) {
             {"prims_tested", double(c.prims_tested) / n}};
 }
 
+/// Bounded primitives by kind, as held by the tree.
+nlohmann::ordered_json primitive_kinds_json(const Scene& scene) {
+    return {{"triangles", scene.triangles.size()},
+            {"spheres", scene.spheres.size()},
+            {"boxes", scene.boxes.size()},
+            {"quadrics", scene.quadrics.size()}};
+}
+
 nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, int size) {
-    const TriangleMesh mesh = read_mesh_triangles(file);
-    const Scene scene = scene_from_mesh(mesh);
+    const ToolInput input = read_tool_input(file);
+    const Scene& scene = input.scene;
     AcceleratorOptions opt;
     opt.builder = builder;
     const Accelerator accel(scene, opt);
@@ -60,12 +72,17 @@ nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, i
     BvhBuildParams built = opt.params;
     if (opt.layout == BvhLayout::wide4) built.intersection_cost *= opt.wide4_leaf_cost_scale;
     const BvhStats s = compute_bvh_stats(accel.bvh(), built);
-    const BenchRaySets rays = make_bench_rays(mesh, accel, size, size);
+    const BenchRaySets rays = make_bench_rays(
+        scene, accel, size, size, input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     const size_t prims = accel.primitive_count();
     nlohmann::ordered_json j = {
         {"mesh", file},
+        {"input", input.from_scene_file ? "scene" : "mesh"},
         {"builder", bvh_builder_name(builder)},
         {"primitives", prims},
+        {"primitives_by_kind", primitive_kinds_json(scene)},
+        {"primitive_kinds", primitive_kinds_text(scene)},
+        {"planes_outside_tree", scene.planes.size()},
         {"nodes", s.nodes},
         {"leaves", s.leaves},
         {"max_depth", s.max_depth},
@@ -88,9 +105,12 @@ nlohmann::ordered_json bvh_report(const std::string& file, BvhBuilder builder, i
 }
 
 void print_text(const nlohmann::ordered_json& j) {
-    std::printf("mesh              %s\n", j["mesh"].get<std::string>().c_str());
+    std::printf("%-17s %s\n", j["input"].get<std::string>().c_str(), j["mesh"].get<std::string>().c_str());
     std::printf("builder           %s\n", j["builder"].get<std::string>().c_str());
-    std::printf("primitives        %zu\n", j["primitives"].get<size_t>());
+    std::printf("primitives        %zu (%s)\n", j["primitives"].get<size_t>(),
+                j["primitive_kinds"].get<std::string>().c_str());
+    if (const auto planes = j["planes_outside_tree"].get<size_t>())
+        std::printf("planes            %zu, unbounded: not in the tree, not traced here\n", planes);
     std::printf("nodes             %zu (%zu leaves)\n", j["nodes"].get<size_t>(), j["leaves"].get<size_t>());
     std::printf("leaf depth        max %d, mean %.2f\n", j["max_depth"].get<int>(),
                 j["mean_leaf_depth"].get<double>());
@@ -124,7 +144,7 @@ int run_bvh_command(int argc, char** argv) {
         std::fputs(kBvhUsage, stdout);
         return 0;
     }
-    if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh file", kBvhUsage);
+    if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh or scene file", kBvhUsage);
     BvhBuilder builder = BvhBuilder::binned;
     if (!parse_bvh_builder(args.value_or("--builder", "binned"), builder))
         return usage_error("bvh", "--builder must be binned or sweep", kBvhUsage);

@@ -26,7 +26,8 @@ static_assert(std::endian::native == std::endian::little, "ray and hit files are
 
 constexpr const char* kTraceUsage =
     "usage: sahara trace MESH --rays IN.rays --hits OUT.hits [--occlusion OUT.occl]\n"
-    "  MESH         a mesh (.obj)\n"
+    "  MESH         a mesh (.obj); not a scene file: ray files index OBJ triangles only (use\n"
+    "               `sahara bvh` / `sahara bench` for scene files)\n"
     "  --rays       raw little-endian float32 x 8 per ray: ox oy oz dx dy dz tmin tmax (32 bytes)\n"
     "  --hits       written: per ray float32 t and uint32 primitive index (miss: +inf, 0xFFFFFFFF)\n"
     "  --occlusion  written: one byte per ray, 1 = something blocks (tmin, tmax)\n"
@@ -80,6 +81,9 @@ void write_atomically(const std::string& path, const std::vector<char>& bytes) {
 }
 
 int trace(const ToolArgs& args) {
+    if (is_scene_file(args.positional[0]))
+        throw input_error(args.positional[0], "",
+                          "trace reads meshes only (primitive indices are OBJ triangle indices)");
     const std::vector<Ray> rays = read_ray_file(args.values.at("--rays"));
     const Scene scene = scene_from_mesh(read_obj_triangles(args.positional[0]));
     const Accelerator accel(scene);

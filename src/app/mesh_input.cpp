@@ -7,6 +7,7 @@
 #include "base/error.h"
 
 #include "io/model_loader.h"
+#include "scene/scene_parser.h"
 
 namespace sahara {
 
@@ -73,6 +74,39 @@ Scene scene_from_mesh(const TriangleMesh& mesh) {
     scene.triangles.indices = mesh.indices;
     scene.triangles.material.assign(mesh.triangle_count(), mesh.material);
     return scene;
+}
+
+bool is_scene_file(const std::filesystem::path& file) { return file.extension() == ".json"; }
+
+ToolInput read_tool_input(const std::filesystem::path& file) {
+    ToolInput in;
+    if (!is_scene_file(file)) {
+        in.triangles = read_mesh_triangles(file);
+        in.scene = scene_from_mesh(in.triangles);
+        return in;
+    }
+    if (!std::filesystem::is_regular_file(file)) throw input_error(file.string(), "", "no such file");
+    in.scene = build_scene(parse_scene_file(file));
+    in.from_scene_file = true;
+    in.triangles.name = file.string();
+    in.triangles.positions = in.scene.triangles.positions;
+    in.triangles.indices = in.scene.triangles.indices;
+    return in;
+}
+
+std::string primitive_kinds_text(const Scene& scene, bool with_triangles) {
+    const std::pair<size_t, const char*> kinds[] = {{with_triangles ? scene.triangles.size() : 0, "triangle"},
+                                                    {scene.spheres.size(), "sphere"},
+                                                    {scene.boxes.size(), "box"},
+                                                    {scene.quadrics.size(), "quadric"}};
+    std::string text;
+    for (const auto& [count, name] : kinds) {
+        if (count == 0) continue;
+        if (!text.empty()) text += ", ";
+        text += std::to_string(count) + " " + name;
+        if (count != 1) text += std::string(name) == "box" ? "es" : "s";
+    }
+    return text.empty() ? "none" : text;
 }
 
 }  // namespace sahara

@@ -40,7 +40,7 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
     return packets_enabled() && scene.render.integrator == IntegratorType::path && accel &&
-           accel->layout() == BvhLayout::wide4 && accel->uses_tree();
+           accel->layout() == BvhLayout::wide4 && accel->uses_tree() && !accel->has_cutouts();
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4
