@@ -36,10 +36,15 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 }
 
 /// Whether camera rays are traced as packets: the path integrator (which can
-/// take a first hit) over the wide4 BVH, unless SAHARA_PACKETS=0.
+/// take a first hit) over the wide4 BVH without cut-outs, unless
+/// SAHARA_PACKETS=0, and only with the AVX-512 kernel: the AVX2 and SSE2
+/// kernels trace primary rays slower than single rays (`sahara bench` on the
+/// bunny, 1 thread, 2026-11-22: AVX2 packets 6.5 MRays/s CPU against about 10
+/// for single rays; AVX-512 packets 17-23), so they stay for tests and bench.
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
-    return packets_enabled() && scene.render.integrator == IntegratorType::path && accel &&
+    return packets_enabled() && active_packet_simd() == PacketSimd::avx512 &&
+           scene.render.integrator == IntegratorType::path && accel &&
            accel->layout() == BvhLayout::wide4 && accel->uses_tree() && !accel->has_cutouts();
 }
 
