@@ -68,13 +68,14 @@ void compare_packet(const Accelerator& acc, RayPacket packet, Agreement& a) {
         a.hits += hit;
         const Hit ph = hp.hit(i);
         if (hit != ph.hit()) {
-            if (a.mismatches < 3) MESSAGE("lane " << i << " single " << hit << " t " << h.t << " packet t " << ph.t << " prim " << ph.prim);
+            if (a.mismatches < 3)
+                MESSAGE("lane " << i << " single " << hit << " t " << h.t << " packet t " << ph.t << " prim "
+                                << ph.prim);
             ++a.mismatches;
             continue;
         }
         if (!hit) continue;
-        if (std::bit_cast<uint32_t>(h.t) != std::bit_cast<uint32_t>(ph.t) ||
-            packet.tmax[i] != ph.t) {
+        if (std::bit_cast<uint32_t>(h.t) != std::bit_cast<uint32_t>(ph.t) || packet.tmax[i] != ph.t) {
             ++a.mismatches;
         } else if (h.prim != ph.prim) {
             ++a.ties;  // another primitive at exactly the same distance
@@ -94,7 +95,8 @@ std::vector<RayPacket> camera_packets(Vec3 eye, int n, float fov_tan) {
             RayPacket p;
             for (int i = 0; i < kPacketSize; ++i) {
                 const float x = float(tx + i % 4) + 0.5f, y = float(ty + i / 4) + 0.5f;
-                const float sx = (2.0f * x / float(n) - 1.0f) * fov_tan, sy = (1.0f - 2.0f * y / float(n)) * fov_tan;
+                const float sx = (2.0f * x / float(n) - 1.0f) * fov_tan,
+                            sy = (1.0f - 2.0f * y / float(n)) * fov_tan;
                 p.set(i, Ray{eye, normalize(fwd + right * sx + up * sy)});
             }
             out.push_back(p);
@@ -140,7 +142,8 @@ TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactiv
             // Same-octant bundles (kernel path) with jittered origins, or fully random rays (fallback).
             const Vec3 base_o(3.0f * u(rng), 3.0f * u(rng), 4.0f);
             // kind 0: non-negative x and y, so the +0 components of the axis rays share the octant.
-            const float ux = kind == 0 ? std::fabs(u(rng)) : u(rng), uy = kind == 0 ? std::fabs(u(rng)) : u(rng);
+            const float ux = kind == 0 ? std::fabs(u(rng)) : u(rng),
+                        uy = kind == 0 ? std::fabs(u(rng)) : u(rng);
             const Vec3 base_d = normalize(Vec3(0.3f * ux, 0.3f * uy, -1.0f));
             const uint32_t active = kind == 3 ? uint32_t(rng()) & 0xFFFFu : 0xFFFFu;
             for (int i = 0; i < kPacketSize; ++i) {
@@ -151,7 +154,7 @@ TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactiv
                     r = Ray{base_o + Vec3(0.05f * u(rng), 0.05f * u(rng), 0.0f),
                             base_d + Vec3(0.02f * std::fabs(u(rng)), 0.02f * std::fabs(u(rng)), 0.0f)};
                 }
-                if (kind == 2) r.tmax = 3.0f + 2.0f * u(rng);  // some end before the geometry
+                if (kind == 2) r.tmax = 3.0f + 2.0f * u(rng);                  // some end before the geometry
                 if (kind == 0 && i % 5 == 0) r.dir = Vec3(0.0f, 0.0f, -1.0f);  // zero components
                 if (kind == 0 && i % 7 == 0) r.tmin = 3.0f;
                 if (active >> i & 1) p.set(i, r);
@@ -182,8 +185,7 @@ TEST_CASE("packets on the bunny and on the pairs layout (ray-by-ray fallback) ag
         CAPTURE(name);
         Agreement a, b;
         for (RayPacket p : camera_packets(Vec3(0.4f, 0.3f, 1.0f) * (2.0f * r), n, 0.5f)) {
-            for (int i = 0; i < kPacketSize; ++i)
-                p.org[0][i] += c.x, p.org[1][i] += c.y, p.org[2][i] += c.z;
+            for (int i = 0; i < kPacketSize; ++i) p.org[0][i] += c.x, p.org[1][i] += c.y, p.org[2][i] += c.z;
             compare_packet(wide, p, a);
             compare_packet(pair, p, b);
         }

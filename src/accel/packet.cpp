@@ -22,11 +22,11 @@ struct PacketContext {
     const Bvh4* bvh;
     const TriangleBlock4* blocks;
     const Accelerator* accel;
-    int kx, ky, kz;       ///< watertight-test axis permutation, common to all active rays
-    int neg[3];           ///< direction sign per axis, common to all active rays
-    int near_off[3];      ///< float offset of each axis's near planes in a Bvh4Node
-    int far_off[3];       ///< float offset of each axis's far planes
-    int first;            ///< first active lane
+    int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
+    int neg[3];       ///< direction sign per axis, common to all active rays
+    int near_off[3];  ///< float offset of each axis's near planes in a Bvh4Node
+    int far_off[3];   ///< float offset of each axis's far planes
+    int first;        ///< first active lane
 };
 
 /// Fills the common permutation and signs; false when the active rays do not
@@ -40,7 +40,8 @@ bool packet_eligible(const RayPacket& p, PacketContext& c) {
         if (!is_finite(d)) return false;
         const int kz = max_dimension(abs(d));
         if (!(std::fabs(d[kz]) > 0.0f)) return false;
-        const int k = kz | (std::signbit(d.x) ? 4 : 0) | (std::signbit(d.y) ? 8 : 0) | (std::signbit(d.z) ? 16 : 0);
+        const int k =
+            kz | (std::signbit(d.x) ? 4 : 0) | (std::signbit(d.y) ? 8 : 0) | (std::signbit(d.z) ? 16 : 0);
         if (key >= 0 && k != key) return false;
         key = k;
     }

@@ -89,13 +89,13 @@ PassTime timed_tile_pass(const std::vector<Ray>& rays, int width, int height, in
 
 PassTime trace_sahara_packets(const Accelerator& accel, const std::vector<Ray>& rays, int width, int height,
                               int threads, bool ftz, RayAnswers& out) {
-    return timed_tile_pass(rays, width, height, threads, ftz, out,
-                           [&](RayPacket& p, float* t, uint32_t* prim) {
-                               HitPacket h;
-                               accel.intersect_packet(p, h);
-                               for (int i = 0; i < kPacketSize; ++i)
-                                   t[i] = h.t[i], prim[i] = h.prim[i] == kNoPrim ? kNoPrim : prim_index(h.prim[i]);
-                           });
+    return timed_tile_pass(
+        rays, width, height, threads, ftz, out, [&](RayPacket& p, float* t, uint32_t* prim) {
+            HitPacket h;
+            accel.intersect_packet(p, h);
+            for (int i = 0; i < kPacketSize; ++i)
+                t[i] = h.t[i], prim[i] = h.prim[i] == kNoPrim ? kNoPrim : prim_index(h.prim[i]);
+        });
 }
 
 PassTime trace_embree_packets(const EmbreeReference& embree, const std::vector<Ray>& rays, int width,

@@ -44,8 +44,8 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
     return packets_enabled() && active_packet_simd() == PacketSimd::avx512 &&
-           scene.render.integrator == IntegratorType::path && accel &&
-           accel->layout() == BvhLayout::wide4 && accel->uses_tree() && !accel->has_cutouts();
+           scene.render.integrator == IntegratorType::path && accel && accel->layout() == BvhLayout::wide4 &&
+           accel->uses_tree() && !accel->has_cutouts();
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4
@@ -58,7 +58,8 @@ uint64_t render_block(const Scene& scene, const Camera& camera, Film& film, Samp
     uint32_t lo = ~0u, hi = 0;
     uint64_t taken = 0;
     for (int i = 0; i < kPacketSize; ++i)
-        if (end[i] > begin[i]) lo = std::min(lo, begin[i]), hi = std::max(hi, end[i]), taken += end[i] - begin[i];
+        if (end[i] > begin[i])
+            lo = std::min(lo, begin[i]), hi = std::max(hi, end[i]), taken += end[i] - begin[i];
     Ray rays[kPacketSize];
     for (uint32_t s = lo; s < hi; ++s) {
         RayPacket packet;
@@ -84,7 +85,8 @@ uint64_t render_block(const Scene& scene, const Camera& camera, Film& film, Samp
             sampler.next_2d();
             sampler.next_1d();
             const Hit first = hits.hit(i);
-            film.add_sample(x, y, path_trace_first_hit(scene, rays[i], &first, sampler, scene.render.max_depth));
+            film.add_sample(x, y,
+                            path_trace_first_hit(scene, rays[i], &first, sampler, scene.render.max_depth));
         }
     }
     for (int i = 0; i < kPacketSize; ++i)
@@ -149,11 +151,13 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
             if (packets) {
                 render_tile_packets(
                     scene, camera, film, sampler, r,
-                    [&](int, int, uint32_t& b, uint32_t& e) { b = uint32_t(sample_begin), e = uint32_t(sample_end); },
+                    [&](int, int, uint32_t& b, uint32_t& e) {
+                        b = uint32_t(sample_begin), e = uint32_t(sample_end);
+                    },
                     nullptr);
             } else {
                 for (int y = r.y0; y < r.y1; ++y)
-                for (int x = r.x0; x < r.x1; ++x)
+                    for (int x = r.x0; x < r.x1; ++x)
                         render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin),
                                      uint32_t(sample_end));
             }
