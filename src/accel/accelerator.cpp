@@ -410,6 +410,15 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
     return found;
 }
 
+/// Packet fallback for a non-triangle lane of a wide4 leaf block (packets run only on wide4, without cut-outs).
+bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
+    const uint32_t id = ids_[slot];
+    float t = 0.0f, u = 0.0f;
+    if (!intersect_other(ray, id, ray.tmax, t, u)) return false;
+    hit = Hit{t, id, u, 0.0f};
+    return true;
+}
+
 bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;

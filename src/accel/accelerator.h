@@ -26,6 +26,8 @@
 namespace sahara {
 
 class Scene;
+struct RayPacket;
+struct HitPacket;
 
 /// Largest primitive count for which the accelerator skips the SAH build and
 /// tests everything in one root leaf (a flat loop). Decided by measurement,
@@ -78,6 +80,17 @@ class Accelerator {
     bool intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const;
     /// occluded() that also counts node visits and primitive tests into `counters`.
     bool occluded_counted(const Ray& ray, TraversalCounters& counters) const;
+    /// Nearest hits of the active rays of a packet (accel/packet.h); on a hit,
+    /// the lane's tmax becomes hit.t. Per ray the answer is intersect()'s up to
+    /// ties between primitives at exactly the same distance. Layouts other than
+    /// wide4, scenes with cut-outs and incoherent packets (mixed direction signs
+    /// or dominant axes) are traced ray by ray.
+    void intersect_packet(RayPacket& packet, HitPacket& hits) const;
+    /// Tests the non-triangle primitive in wide4 leaf slot `slot` alone (packet
+    /// fallback); on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
+    bool intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const;
+    /// Primitive id held by wide4 leaf slot `slot`.
+    uint32_t slot_prim(uint32_t slot) const { return ids_[slot]; }
     /// Reference answer: tests every primitive, no tree (for tests).
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
 

@@ -93,6 +93,38 @@ bool EmbreeReference::intersect(const Ray& ray, float& t, uint32_t& prim) const 
     return true;
 }
 
+void EmbreeReference::intersect16(const RayPacket& packet, float t[kPacketSize],
+                                  uint32_t prim[kPacketSize]) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) int valid[kPacketSize];
+    alignas(64) RTCRayHit16 rh;
+    for (int i = 0; i < kPacketSize; ++i) {
+        const bool on = packet.active >> i & 1;
+        valid[i] = on ? -1 : 0;
+        rh.ray.org_x[i] = on ? packet.org[0][i] : 0.0f;
+        rh.ray.org_y[i] = on ? packet.org[1][i] : 0.0f;
+        rh.ray.org_z[i] = on ? packet.org[2][i] : 0.0f;
+        rh.ray.dir_x[i] = on ? packet.dir[0][i] : 0.0f;
+        rh.ray.dir_y[i] = on ? packet.dir[1][i] : 0.0f;
+        rh.ray.dir_z[i] = on ? packet.dir[2][i] : 1.0f;
+        rh.ray.tnear[i] = on ? packet.tmin[i] : 0.0f;
+        rh.ray.tfar[i] = on ? packet.tmax[i] : 0.0f;
+        rh.ray.time[i] = on ? packet.time[i] : 0.0f;
+        rh.ray.mask[i] = 0xFFFFFFFFu;
+        rh.ray.id[i] = 0;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, impl_->scene, &ctx, &rh);
+    for (int i = 0; i < kPacketSize; ++i) {
+        const bool hit = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        t[i] = hit ? rh.ray.tfar[i] : kInfinity;
+        prim[i] = hit ? rh.hit.primID[i] : kNoPrim;
+    }
+}
+
 bool EmbreeReference::occluded(const Ray& ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -111,6 +143,7 @@ EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t
 }
 EmbreeReference::~EmbreeReference() = default;
 bool EmbreeReference::intersect(const Ray&, float&, uint32_t&) const { return false; }
+void EmbreeReference::intersect16(const RayPacket&, float[kPacketSize], uint32_t[kPacketSize]) const {}
 bool EmbreeReference::occluded(const Ray&) const { return false; }
 
 #endif

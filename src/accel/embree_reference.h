@@ -7,6 +7,7 @@
 #include <memory>
 #include <span>
 
+#include "accel/packet.h"
 #include "math/ray.h"
 #include "math/vec3.h"
 
@@ -26,6 +27,9 @@ class EmbreeReference {
 
     /// Nearest hit in [ray.tmin, ray.tmax]: t and triangle index; false on a miss.
     bool intersect(const Ray& ray, float& t, uint32_t& prim) const;
+    /// rtcIntersect16 on the active lanes of `packet` (valid mask): per lane t
+    /// (+inf on a miss) and triangle index (kNoPrim on a miss).
+    void intersect16(const RayPacket& packet, float t[kPacketSize], uint32_t prim[kPacketSize]) const;
     /// Whether anything blocks the ray.
     bool occluded(const Ray& ray) const;
     double build_ms() const { return build_ms_; }

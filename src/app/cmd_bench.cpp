@@ -14,6 +14,7 @@
 #include "app/mesh_input.h"
 #include "app/ray_batch.h"
 #include "app/tool_args.h"
+#include "accel/packet.h"
 #include "base/error.h"
 
 namespace sahara {
@@ -21,7 +22,8 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBenchUsage =
-    "usage: sahara bench FILE [--threads N] [--rays primary|diffuse|shadow|all] [--json]\n"
+    "usage: sahara bench FILE [--threads N] [--rays primary|primary_packet|diffuse|shadow|all]\n"
+    "                         [--json]\n"
     "                         [--builder binned|sweep|reinsert] [--layout L] [--size N] [--repeat K]\n"
     "                         [--no-embree]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
@@ -31,7 +33,9 @@ constexpr const char* kBenchUsage =
     "              the Embree comparison runs only if every bounded primitive is a triangle\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
     "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh\n"
-    "              (a scene: its camera),\n"
+    "              (a scene: its camera), primary_packet = the primary rays as 16-ray packets of\n"
+    "              4x4 pixel tiles (Embree: rtcIntersect16 on the same tiles; also compared with\n"
+    "              sahara's single rays),\n"
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
     "              the camera's up axis)\n"
@@ -100,6 +104,45 @@ nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& ac
     return j;
 }
 
+/// The primary rays as 16-ray packets of 4x4 pixel tiles, against Embree's
+/// rtcIntersect16 on the same tiles; also compared with sahara's single rays.
+nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelerator& accel,
+                                        const EmbreeReference* embree, const std::vector<Ray>& rays,
+                                        const BenchOptions& opt) {
+    std::vector<double> ours, theirs, ours_cpu, theirs_cpu;
+    RayAnswers a, b, single;
+    for (int k = 0; k < opt.repeat; ++k) {
+        const PassTime t = trace_sahara_packets(accel, rays, opt.size, opt.size, opt.threads, true, a);
+        ours.push_back(t.wall_s);
+        ours_cpu.push_back(t.cpu_s);
+        if (!embree) continue;
+        const PassTime e = trace_embree_packets(*embree, rays, opt.size, opt.size, opt.threads, true, b);
+        theirs.push_back(e.wall_s);
+        theirs_cpu.push_back(e.cpu_s);
+    }
+    trace_sahara(accel, rays, false, opt.threads, true, single);
+    const Disagreements ds = compare_answers(a, single, rays, mesh);
+    const double count = double(rays.size());
+    nlohmann::ordered_json j = {{"count", rays.size()},
+                                {"mrays_s", count / median(ours) * 1e-6},
+                                {"mrays_cpu_s", count / median(ours_cpu) * 1e-6},
+                                {"hit_rate", rays.empty() ? 0.0 : double(a.hits()) / count},
+                                {"packet_simd", packet_simd_name(active_packet_simd())},
+                                {"disagreements_single_ray", ds.total + ds.confirmed_for_a},
+                                {"ties_single_ray", ds.ties}};
+    if (embree) {
+        const Disagreements d = compare_answers(a, b, rays, mesh);
+        j["embree_mrays_s"] = count / median(theirs) * 1e-6;
+        j["embree_mrays_cpu_s"] = count / median(theirs_cpu) * 1e-6;
+        j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
+        j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
+        j["disagreements"] = d.total;
+        j["ties"] = d.ties;
+        j["confirmed_for_sahara"] = d.confirmed_for_a;
+    }
+    return j;
+}
+
 /// "compared" when Embree will run on the same triangles, else why not. Embree
 /// (accel/embree_reference.h) holds triangles only, so a scene with spheres,
 /// boxes or quadrics would compare different geometry.
@@ -149,6 +192,10 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
     if (embree) j["embree_build_ms"] = embree->build_ms();
     for (const std::string& set : opt.sets) {
+        if (set == "primary_packet") {
+            j["rays"][set] = bench_packet_set(mesh, accel, embree.get(), rays.primary, opt);
+            continue;
+        }
         const std::vector<Ray>& r = set == "primary"   ? rays.primary
                                     : set == "diffuse" ? rays.diffuse
                                                        : rays.shadow;
@@ -173,13 +220,13 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["tree_bytes_per_primitive"].get<double>());
     const bool embree = j.contains("embree_build_ms");
     if (!embree) std::printf("Embree      %s\n", j["embree"].get<std::string>().c_str());
-    std::printf("%-8s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
+    std::printf("%-14s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
     if (embree)
         std::printf(" %8s %8s %6s %6s %6s %5s %9s", "Embree", "(CPU)", "ratio", "(CPU)", "disagr", "ties",
                     "confirmed");
     std::printf("\n");
     for (const auto& [name, r] : j["rays"].items()) {
-        std::printf("%-8s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
+        std::printf("%-14s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
                     r["hit_rate"].get<double>(), r["mrays_s"].get<double>(), r["mrays_cpu_s"].get<double>());
         if (embree)
             std::printf(" %8.2f %8.2f %6.2f %6.2f %6zu %5zu %9zu", r["embree_mrays_s"].get<double>(),
@@ -187,6 +234,12 @@ void print_text(const nlohmann::ordered_json& j) {
                         r["ratio_cpu"].get<double>(), r["disagreements"].get<size_t>(),
                         r["ties"].get<size_t>(), r["confirmed_for_sahara"].get<size_t>());
         std::printf("\n");
+    }
+    if (j["rays"].contains("primary_packet")) {
+        const auto& r = j["rays"]["primary_packet"];
+        std::printf("primary_packet: %s kernel; against sahara's single rays %zu disagreements, %zu ties\n",
+                    r["packet_simd"].get<std::string>().c_str(), r["disagreements_single_ray"].get<size_t>(),
+                    r["ties_single_ray"].get<size_t>());
     }
 }
 
@@ -254,11 +307,11 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--layout must be wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");
     if (sets == "all")
-        opt.sets = {"primary", "diffuse", "shadow"};
-    else if (sets == "primary" || sets == "diffuse" || sets == "shadow")
+        opt.sets = {"primary", "primary_packet", "diffuse", "shadow"};
+    else if (sets == "primary" || sets == "primary_packet" || sets == "diffuse" || sets == "shadow")
         opt.sets = {sets};
     else
-        return "--rays must be primary, diffuse, shadow or all";
+        return "--rays must be primary, primary_packet, diffuse, shadow or all";
     opt.embree = !args.switches.count("--no-embree");
     opt.json = args.switches.count("--json") != 0;
     return "";

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 
+#include "accel/packet.h"
+
 namespace sahara {
 
 size_t RayAnswers::hits() const {
@@ -44,7 +46,63 @@ PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceO
     return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
 }
 
+/// Runs `trace_tile(packet, lane_to_ray)` for every 4x4 tile of the image on
+/// `threads` threads and times the pass; the functor stores per-ray answers.
+template <class TraceTile>
+PassTime timed_tile_pass(const std::vector<Ray>& rays, int width, int height, int threads, bool ftz,
+                         RayAnswers& out, TraceTile&& trace_tile) {
+    out.t.assign(rays.size(), kInfinity);
+    out.prim.assign(rays.size(), kNoPrim);
+    const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
+    const int tiles = tiles_x * tiles_y;
+    double cpu = 0;
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel num_threads(threads) reduction(+ : cpu)
+    {
+        const double cpu_start = thread_cpu_seconds();
+        set_flush_denormals(ftz);
+        // 64 tiles = 1024 rays per chunk, as the single-ray passes.
+#pragma omp for schedule(dynamic, 64) nowait
+        for (int tile = 0; tile < tiles; ++tile) {
+            const int x0 = 4 * (tile % tiles_x), y0 = 4 * (tile / tiles_x);
+            RayPacket p;
+            size_t index[kPacketSize] = {};
+            for (int i = 0; i < kPacketSize; ++i) {
+                const int x = x0 + i % 4, y = y0 + i / 4;
+                if (x >= width || y >= height) continue;
+                index[i] = size_t(y) * size_t(width) + size_t(x);
+                p.set(i, rays[index[i]]);
+            }
+            float t[kPacketSize];
+            uint32_t prim[kPacketSize];
+            trace_tile(p, t, prim);
+            for (int i = 0; i < kPacketSize; ++i)
+                if (p.active >> i & 1) out.t[index[i]] = t[i], out.prim[index[i]] = prim[i];
+        }
+        set_flush_denormals(false);
+        cpu += thread_cpu_seconds() - cpu_start;
+    }
+    return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
+}
+
 }  // namespace
+
+PassTime trace_sahara_packets(const Accelerator& accel, const std::vector<Ray>& rays, int width, int height,
+                              int threads, bool ftz, RayAnswers& out) {
+    return timed_tile_pass(
+        rays, width, height, threads, ftz, out, [&](RayPacket& p, float* t, uint32_t* prim) {
+            HitPacket h;
+            accel.intersect_packet(p, h);
+            for (int i = 0; i < kPacketSize; ++i)
+                t[i] = h.t[i], prim[i] = h.prim[i] == kNoPrim ? kNoPrim : prim_index(h.prim[i]);
+        });
+}
+
+PassTime trace_embree_packets(const EmbreeReference& embree, const std::vector<Ray>& rays, int width,
+                              int height, int threads, bool ftz, RayAnswers& out) {
+    return timed_tile_pass(rays, width, height, threads, ftz, out,
+                           [&](RayPacket& p, float* t, uint32_t* prim) { embree.intersect16(p, t, prim); });
+}
 
 PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads,
                       bool ftz, RayAnswers& out) {

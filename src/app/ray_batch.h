@@ -31,6 +31,14 @@ PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bo
 PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion,
                       int threads, bool ftz, RayAnswers& out);
 
+/// Traces row-major `width` x `height` camera rays as 16-ray packets of 4x4
+/// pixel tiles (Accelerator::intersect_packet; edge tiles have inactive lanes).
+PassTime trace_sahara_packets(const Accelerator& accel, const std::vector<Ray>& rays, int width, int height,
+                              int threads, bool ftz, RayAnswers& out);
+/// The same tiles with Embree's rtcIntersect16.
+PassTime trace_embree_packets(const EmbreeReference& embree, const std::vector<Ray>& rays, int width,
+                              int height, int threads, bool ftz, RayAnswers& out);
+
 struct Disagreements {
     size_t total = 0;  ///< hit/miss differ, t differs beyond tolerance, or another primitive at a different t
     size_t ties = 0;   ///< another primitive at t equal within 1e-6 relative (not counted in total)

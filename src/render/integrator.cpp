@@ -120,7 +120,7 @@ Rgb escaped(const Scene& scene, const Ray& ray, const PrevVertex& prev) {
 /// One path. D rays at most, camera ray included; a shadow ray counts as the
 /// next ray, so direct light is gathered only below max_depth.
 template <Strategy S, bool kLambertOnly>
-Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
+Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, const Hit* first = nullptr) {
     // The plain Lambertian kernel is chosen only for scenes without any emission.
     constexpr bool kEmission = !(S == Strategy::none && kLambertOnly);
     Rgb radiance(0.0f), beta(1.0f);
@@ -128,7 +128,15 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
     PrevVertex prev;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
-        if (!scene.intersect(ray, hit)) {
+        bool found;
+        if (depth == 1 && first) {  // the camera ray, already traced in a packet
+            hit = *first;
+            found = hit.hit();
+            if (found) ray.tmax = hit.t;
+        } else {
+            found = scene.intersect(ray, hit);
+        }
+        if (!found) {
             radiance += beta * escaped<S>(scene, ray, prev);
             break;
         }
@@ -178,22 +186,26 @@ PathKernel choose_kernel(const SceneFeatures& f) {
 
 }  // namespace
 
-Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
+Rgb path_trace_first_hit(const Scene& scene, Ray ray, const Hit* first, Sampler& sampler, int max_depth) {
     switch (choose_kernel(scene.features)) {
         case PathKernel::plain_lambert:
-            return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::plain:
-            return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth, first);
         case PathKernel::delta_lambert:
-            return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::delta:
-            return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth, first);
         case PathKernel::mis_lambert:
-            return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::mis:
             break;
     }
-    return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
+    return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth, first);
+}
+
+Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
+    return path_trace_first_hit(scene, ray, nullptr, sampler, max_depth);
 }
 
 Rgb path_trace_with(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, LightStrategy strategy) {

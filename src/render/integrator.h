@@ -15,6 +15,9 @@ Rgb estimate_radiance(const Scene& scene, Ray ray, Sampler& sampler, int max_dep
 /// Runs the kernel specialised for the scene's features (see path_kernel_name).
 Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth);
 
+/// path_trace() whose camera ray was already traced (in a packet): `first` is
+/// its Scene::intersect answer (a miss when !first->hit()); nullptr traces it here.
+Rgb path_trace_first_hit(const Scene& scene, Ray ray, const Hit* first, Sampler& sampler, int max_depth);
 /// How path tracing gathers light from sampled emitters (for tests comparing strategies).
 enum class LightStrategy : uint8_t {
     mis,         ///< light sampling and BSDF sampling, power heuristic

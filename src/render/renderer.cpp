@@ -8,6 +8,8 @@
 #include <exception>
 #include <thread>
 
+#include "accel/accelerator.h"
+#include "accel/packet.h"
 #include "base/counters.h"
 #include "render/camera.h"
 #include "render/integrator.h"
@@ -31,6 +33,84 @@ double luminance_d(const Vec3d& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722
 void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x, int y,
                   uint32_t begin, uint32_t end) {
     render_pixel_samples(scene, camera, film, sampler, x, y, x, y, begin, end);
+}
+
+/// Whether camera rays are traced as packets: the path integrator (which can
+/// take a first hit) over the wide4 BVH without cut-outs, unless
+/// SAHARA_PACKETS=0, and only with the AVX-512 kernel: the AVX2 and SSE2
+/// kernels trace primary rays slower than single rays (`sahara bench` on the
+/// bunny, 1 thread, 2026-11-22: AVX2 packets 6.5 MRays/s CPU against about 10
+/// for single rays; AVX-512 packets 17-23), so they stay for tests and bench.
+bool use_packets(const Scene& scene) {
+    const Accelerator* accel = scene.accelerator();
+    return packets_enabled() && active_packet_simd() == PacketSimd::avx512 &&
+           scene.render.integrator == IntegratorType::path && accel && accel->layout() == BvhLayout::wide4 &&
+           accel->uses_tree() && !accel->has_cutouts();
+}
+
+/// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4
+/// pixels at (x0, y0) (lane i = pixel (x0 + i % 4, y0 + i / 4), only those
+/// inside `r`). The camera rays of one sample index go through the scene as
+/// one packet; each pixel's sampler stream and sample order are those of
+/// render_pixel_samples, so the image is bit-identical to single rays.
+uint64_t render_block(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler, int x0, int y0,
+                      const uint32_t begin[kPacketSize], const uint32_t end[kPacketSize]) {
+    uint32_t lo = ~0u, hi = 0;
+    uint64_t taken = 0;
+    for (int i = 0; i < kPacketSize; ++i)
+        if (end[i] > begin[i])
+            lo = std::min(lo, begin[i]), hi = std::max(hi, end[i]), taken += end[i] - begin[i];
+    Ray rays[kPacketSize];
+    for (uint32_t s = lo; s < hi; ++s) {
+        RayPacket packet;
+        for (int i = 0; i < kPacketSize; ++i) {
+            if (s < begin[i] || s >= end[i]) continue;
+            const int x = x0 + i % 4, y = y0 + i / 4;
+            sampler.start(uint32_t(x), uint32_t(y), s);
+            const Vec2 jitter = sampler.next_2d();
+            const Vec2 lens = sampler.next_2d();
+            const float time_u = sampler.next_1d();
+            rays[i] = camera.generate_ray(float(x) + jitter.x, float(y) + jitter.y, lens, time_u);
+            packet.set(i, rays[i]);
+            count_ray(RayKind::camera);
+        }
+        HitPacket hits;
+        scene.intersect_packet(packet, hits);
+        for (uint32_t m = packet.active; m; m &= m - 1) {
+            const int i = __builtin_ctz(m);
+            const int x = x0 + i % 4, y = y0 + i / 4;
+            // Replay the camera dimensions so the path continues the pixel's own stream.
+            sampler.start(uint32_t(x), uint32_t(y), s);
+            sampler.next_2d();
+            sampler.next_2d();
+            sampler.next_1d();
+            const Hit first = hits.hit(i);
+            film.add_sample(x, y,
+                            path_trace_first_hit(scene, rays[i], &first, sampler, scene.render.max_depth));
+        }
+    }
+    for (int i = 0; i < kPacketSize; ++i)
+        if (end[i] > begin[i]) film.add_count(x0 + i % 4, y0 + i / 4, end[i] - begin[i]);
+    return taken;
+}
+
+/// Renders tile `r` in 4x4 blocks; `range(x, y, begin, end)` gives each pixel's
+/// samples; stops between blocks when `stop` is set. Returns the samples taken.
+template <class RangeFn>
+uint64_t render_tile_packets(const Scene& scene, const Camera& camera, Film& film, Sampler& sampler,
+                             const TileRect& r, RangeFn&& range, const std::atomic<bool>* stop) {
+    uint64_t taken = 0;
+    for (int y0 = r.y0; y0 < r.y1; y0 += 4)
+        for (int x0 = r.x0; x0 < r.x1; x0 += 4) {
+            if (stop && stop->load(std::memory_order_relaxed)) return taken;
+            uint32_t begin[kPacketSize] = {}, end[kPacketSize] = {};
+            for (int i = 0; i < kPacketSize; ++i) {
+                const int x = x0 + i % 4, y = y0 + i / 4;
+                if (x < r.x1 && y < r.y1) range(x, y, begin[i], end[i]);
+            }
+            taken += render_block(scene, camera, film, sampler, x0, y0, begin, end);
+        }
+    return taken;
 }
 
 std::vector<TileRect> make_tiles(int w, int h) {
@@ -76,16 +156,26 @@ void render_pass(const Scene& scene, Film& film, int sample_begin, int sample_en
                  Progress* progress) {
     const Camera camera(scene.camera, film.width(), film.height());
     const std::vector<TileRect> tiles = make_tiles(film.width(), film.height());
+    const bool packets = use_packets(scene);
 #pragma omp parallel num_threads(threads)
     {
 #pragma omp for schedule(dynamic, 1) nowait
         for (size_t t = 0; t < tiles.size(); ++t) {
             Sampler sampler(scene.render.seed, scene.render.sampler);
             const TileRect& r = tiles[t];
-            for (int y = r.y0; y < r.y1; ++y)
-                for (int x = r.x0; x < r.x1; ++x)
-                    render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin),
-                                 uint32_t(sample_end));
+            if (packets) {
+                render_tile_packets(
+                    scene, camera, film, sampler, r,
+                    [&](int, int, uint32_t& b, uint32_t& e) {
+                        b = uint32_t(sample_begin), e = uint32_t(sample_end);
+                    },
+                    nullptr);
+            } else {
+                for (int y = r.y0; y < r.y1; ++y)
+                    for (int x = r.x0; x < r.x1; ++x)
+                        render_pixel(scene, camera, film, sampler, x, y, uint32_t(sample_begin),
+                                     uint32_t(sample_end));
+            }
             const uint64_t n =
                 uint64_t(r.x1 - r.x0) * uint64_t(r.y1 - r.y0) * uint64_t(sample_end - sample_begin);
             if (progress) progress->advance(n, n);
@@ -134,6 +224,17 @@ uint64_t RenderSession::render_tile(size_t tile, const std::vector<uint32_t>* ta
     const TileRect& r = tiles_[tile];
     uint64_t taken = 0;
     std::lock_guard lock(tile_locks_[tile]);
+    if (use_packets(scene_)) {
+        taken = render_tile_packets(
+            scene_, camera, film_, sampler, r,
+            [&](int x, int y, uint32_t& b, uint32_t& e) {
+                b = film_.count(x, y);
+                e = targets ? (*targets)[size_t(y) * size_t(film_.width()) + size_t(x)] : uniform_target;
+            },
+            &stop_);
+        tile_generation_[tile].fetch_add(1, std::memory_order_release);
+        return taken;
+    }
     for (int y = r.y0; y < r.y1 && !stop_.load(std::memory_order_relaxed); ++y)
         for (int x = r.x0; x < r.x1 && !stop_.load(std::memory_order_relaxed); ++x) {
             const uint32_t begin = film_.count(x, y);

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "accel/accelerator.h"
+#include "accel/packet.h"
 #include "base/counters.h"
 
 namespace sahara {
@@ -52,6 +53,25 @@ bool Scene::intersect(Ray& ray, Hit& hit) const {
     bool found = accel_ ? accel_->intersect(ray, hit) : false;
     found |= intersect_planes(planes, ray, hit);
     return found;
+}
+
+void Scene::intersect_packet(RayPacket& packet, HitPacket& hits) const {
+    if (accel_) {
+        accel_->intersect_packet(packet, hits);
+    } else {
+        for (int i = 0; i < kPacketSize; ++i) hits.prim[i] = kNoPrim, hits.t[i] = kInfinity;
+    }
+    for (uint32_t m = packet.active; m; m &= m - 1) {
+        const int i = __builtin_ctz(m);
+        count_ray(RayKind::closest_hit);
+        if (planes.empty()) continue;
+        Ray r = packet.ray(i);
+        Hit h = hits.hit(i);
+        if (intersect_planes(planes, r, h)) {
+            hits.t[i] = h.t, hits.prim[i] = h.prim, hits.u[i] = h.u, hits.v[i] = h.v;
+            packet.tmax[i] = h.t;
+        }
+    }
 }
 
 bool Scene::occluded(const Ray& ray) const {

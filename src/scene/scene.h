@@ -69,6 +69,8 @@ struct Emitter {
 inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
 
 class Accelerator;  // accel/: the BVH over bounded primitives
+struct RayPacket;   // accel/packet.h
+struct HitPacket;
 
 class Scene {
    public:
@@ -79,6 +81,9 @@ class Scene {
 
     /// Nearest hit with t in (ray.tmin, ray.tmax); on a hit, ray.tmax becomes hit.t.
     bool intersect(Ray& ray, Hit& hit) const;
+    /// intersect() for the active lanes of a 16-ray packet (accel/packet.h):
+    /// the same hits, up to ties between primitives at exactly the same distance.
+    void intersect_packet(RayPacket& packet, HitPacket& hits) const;
     /// Whether anything blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
     /// Shading data for an accepted hit.

@@ -1,0 +1,84 @@
+#pragma once
+/// Coherent ray packets: 16 rays (typically a 4x4 pixel tile of camera rays)
+/// traced together through the 4-wide BVH. Each node's child boxes are tested
+/// against all active rays at once and leaf triangles are broadcast against
+/// the rays (Wald, Slusallek, Benthin and Wagner, "Interactive Rendering with
+/// Coherent Ray Tracing", 2001; Wald, Benthin and Boulos, "Getting Rid of
+/// Packets", 2008, for the wide-node variant). Per ray, the box test and the
+/// watertight triangle test (Woop, Benthin and Wald 2013) perform exactly the
+/// float operations of the single-ray code, so every ray gets the hit
+/// distance a single ray gets; only which of two primitives at exactly the
+/// same distance wins may differ (traversal order differs).
+///
+/// The SIMD width is chosen at run time: AVX-512 (one 16-lane register),
+/// AVX2 (two 8-lane halves) or SSE2 (four 4-lane quarters).
+#include <cstdint>
+
+#include "geometry/hit.h"
+#include "math/ray.h"
+
+namespace sahara {
+
+/// Rays per packet.
+inline constexpr int kPacketSize = 16;
+
+/// 16 rays in structure-of-arrays form; lanes whose bit is clear in `active` are ignored.
+struct alignas(64) RayPacket {
+    float org[3][kPacketSize];
+    float dir[3][kPacketSize];
+    float tmin[kPacketSize];
+    float tmax[kPacketSize];  ///< lowered to the hit distance by intersect_packet
+    float time[kPacketSize];
+    uint32_t active = 0;  ///< bit i: lane i holds a ray
+
+    /// Stores `r` in lane `i` and marks it active.
+    void set(int i, const Ray& r) {
+        org[0][i] = r.origin.x, org[1][i] = r.origin.y, org[2][i] = r.origin.z;
+        dir[0][i] = r.dir.x, dir[1][i] = r.dir.y, dir[2][i] = r.dir.z;
+        tmin[i] = r.tmin, tmax[i] = r.tmax, time[i] = r.time;
+        active |= 1u << i;
+    }
+    /// The ray of lane `i`.
+    Ray ray(int i) const {
+        return Ray{Vec3(org[0][i], org[1][i], org[2][i]), Vec3(dir[0][i], dir[1][i], dir[2][i]), tmin[i],
+                   tmax[i], time[i]};
+    }
+};
+
+/// Per-lane results of a packet trace (prim[i] == kNoPrim: lane i missed or was inactive).
+struct alignas(64) HitPacket {
+    float t[kPacketSize];
+    float u[kPacketSize];
+    float v[kPacketSize];
+    uint32_t prim[kPacketSize];
+
+    /// The hit of lane `i` as a single-ray Hit.
+    Hit hit(int i) const { return Hit{t[i], prim[i], u[i], v[i]}; }
+};
+
+/// Instruction set of the packet kernels.
+enum class PacketSimd : uint8_t {
+    sse2,    ///< four 4-lane quarters
+    avx2,    ///< two 8-lane halves
+    avx512,  ///< one 16-lane register
+};
+
+/// The widest path this CPU runs, unless SAHARA_SIMD (sse2, avx2, avx512) asks
+/// for a narrower one or force_packet_simd() was called.
+PacketSimd active_packet_simd();
+/// Forces a path (tests); a request the CPU cannot run falls back to the widest it can.
+void force_packet_simd(PacketSimd path);
+/// Clears a forced path (back to the CPU / environment choice).
+void clear_forced_packet_simd();
+/// Whether this CPU can run `path`.
+bool cpu_supports_packet_simd(PacketSimd path);
+/// "sse2", "avx2" or "avx512".
+const char* packet_simd_name(PacketSimd path);
+
+/// Whether packets are enabled for rendering: true unless SAHARA_PACKETS=0 is
+/// set or set_packets_enabled(false) was called.
+bool packets_enabled();
+/// Overrides the environment (tests, --no-packets).
+void set_packets_enabled(bool on);
+
+}  // namespace sahara
