@@ -299,7 +299,11 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
     for (uint32_t b = first; b < first + (count + 3) / 4; ++b) {
         const TriangleBlock4& block = blocks_[b];
         float t[4], u[4], v[4];
-        int mask = intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
+        // Sign bits of the slots: lanes of other kinds and padding. A block with
+        // no triangle lane (e.g. a leaf of spheres) skips the triangle test.
+        const int other =
+            _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+        int mask = other == 0xF ? 0 : intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
         if constexpr (kCutouts)
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, block, mask, t, u, v);
         if (mask) {
@@ -313,9 +317,6 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             hit = Hit{t[best], ids_[block.slot[best]], u[best], v[best]};
             found = true;
         }
-        // Sign bits of the slots: lanes of other kinds (and padding, skipped).
-        const int other =
-            _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
         for (int m = other; m; m &= m - 1) {
             const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
             if (slot == TriangleBlock4::kEmptyLane) continue;
