@@ -634,7 +634,8 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     const auto reinsert = run_captured(
         run_bvh_command, {"bvh", mesh, "--builder", "reinsert", "--threads", "1", "--size", "16", "--json"});
     REQUIRE(reinsert.first == 0);
-    for (const char* key : {"\"builder\":\"reinsert\"", "\"build_threads\":1", "\"mprims_s\"", "\"mprims_cpu_s\""})
+    for (const char* key :
+         {"\"builder\":\"reinsert\"", "\"build_threads\":1", "\"mprims_s\"", "\"mprims_cpu_s\""})
         CHECK(reinsert.second.find(key) != std::string::npos);
     CHECK(run_captured(run_bvh_command, {"bvh", mesh, "--threads", "0"}).first == 2);
     CHECK(run_captured(run_bvh_command, {"bvh"}).first == 2);

@@ -147,9 +147,8 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
-            INFO(mesh.name, " layout ", bvh_layout_name(layout), " builder ", bvh_builder_name(builder), " path ",
-                 simd_path_name(path), " rays ",
-                 rays.size());
+            INFO(mesh.name, " layout ", bvh_layout_name(layout), " builder ", bvh_builder_name(builder),
+                 " path ", simd_path_name(path), " rays ", rays.size());
             CHECK(active_simd_path() == path);
             CHECK(disagreements(acc, rays) == 0);
         }

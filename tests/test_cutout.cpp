@@ -63,8 +63,8 @@ TriangleMesh unit_grid(int n, float z, uint32_t material) {
     const auto at = [n](int i, int j) { return uint32_t(j * (n + 1) + i); };
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i)
-            m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1),
-                                               at(i, j + 1)});
+            m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
+                                               at(i + 1, j + 1), at(i, j + 1)});
     return m;
 }
 
@@ -114,7 +114,8 @@ bool near_square_edge(Vec2 q, float eps) {
 std::vector<Vec2> square_centres() {
     std::vector<Vec2> c;
     for (int j = 0; j < kChecker; ++j)
-        for (int i = 0; i < kChecker; ++i) c.push_back({(float(i) + 0.5f) / kChecker, (float(j) + 0.5f) / kChecker});
+        for (int i = 0; i < kChecker; ++i)
+            c.push_back({(float(i) + 0.5f) / kChecker, (float(j) + 0.5f) / kChecker});
     return c;
 }
 
@@ -150,8 +151,10 @@ TEST_CASE("cut-outs: shadow rays pass exactly the transparent checker squares") 
             AcceleratorOptions opt;
             opt.layout = layout;
             const Accelerator acc(scene, opt);
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ", std::string(simd_path_name(path)));
-            for (Vec2 c : square_centres()) CHECK(acc.occluded(ray_through(point, c)) != checker_transparent(c.x, c.y));
+            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
+                 std::string(simd_path_name(path)));
+            for (Vec2 c : square_centres())
+                CHECK(acc.occluded(ray_through(point, c)) != checker_transparent(c.x, c.y));
             int through = 0, wrong = 0;
             for (Vec2 q : pts) {
                 const bool open = !acc.occluded(ray_through(point, q));
@@ -184,7 +187,8 @@ TEST_CASE("cut-outs: camera rays reach the background through the transparent sq
             AcceleratorOptions opt;
             opt.layout = layout;
             const Accelerator acc(scene, opt);
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ", std::string(simd_path_name(path)));
+            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
+                 std::string(simd_path_name(path)));
             int background = 0, wrong = 0;
             for (Vec2 q : uniform_points(n, 11)) {
                 Ray r = ray_through(eye, q);
@@ -277,7 +281,8 @@ void write_gltf_quad(const fs::path& dir) {
     bin.write(reinterpret_cast<const char*>(uv), sizeof uv);
     bin.write(reinterpret_cast<const char*>(idx), sizeof idx);
     bin.close();
-    std::ofstream(dir / "quad.gltf") << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    std::ofstream(dir / "quad.gltf")
+        << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
  "nodes": [{"mesh": 0}],
  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "alphaMode": "MASK", "alphaCutoff": 0.5}],
@@ -309,9 +314,10 @@ TEST_CASE("cut-outs: glTF alphaMode MASK and OBJ map_d load see-through") {
     write_obj_quad(dir);
     for (const char* model : {"quad.gltf", "quad.obj"}) {
         INFO(model);
-        std::ofstream(dir / "scene.json") << R"({"format": "scene/1", "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0]},
- "objects": [{"type": "mesh", "file": ")" << model
-                                          << "\"}]}";
+        std::ofstream(dir / "scene.json")
+            << R"({"format": "scene/1", "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0]},
+ "objects": [{"type": "mesh", "file": ")"
+            << model << "\"}]}";
         const Scene scene = build_scene(parse_scene_file(dir / "scene.json"));
         REQUIRE(scene.accelerator()->has_cutouts());
         int open = 0;
@@ -364,7 +370,8 @@ TEST_CASE("cut-outs: BVH layouts agree with brute force with the filter on") {
             opt.layout = layout;
             const Accelerator acc(scene, opt);
             REQUIRE(acc.has_cutouts());
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ", std::string(simd_path_name(path)));
+            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
+                 std::string(simd_path_name(path)));
             int bad = 0;
             for (const Ray& r0 : rays) {
                 Ray a = r0, b = r0;

@@ -150,8 +150,7 @@ void Accelerator::make_leaf_blocks(const std::vector<uint32_t>& ids, const std::
                                      : slot | TriangleBlock4::kOtherKind;
                 for (int v = 0; v < 3; ++v)
                     for (int a = 0; a < 3; ++a)
-                        b.p[v][a][l] =
-                            tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
+                        b.p[v][a][l] = tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
             }
             blocks_.push_back(b);
         }
@@ -271,9 +270,8 @@ __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit&
 
 template <bool kAnyHit>
 __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray,
-                                                                        const TriangleBlock4& block,
-                                                                        int mask, const float t[4],
-                                                                        const float u[4],
+                                                                        const TriangleBlock4& block, int mask,
+                                                                        const float t[4], const float u[4],
                                                                         const float v[4]) const {
     // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
     while (mask) {
@@ -411,7 +409,8 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
     return found;
 }
 
-/// Packet fallback for a non-triangle lane of a wide4 leaf block (packets run only on wide4, without cut-outs).
+/// Packet fallback for a non-triangle lane of a wide4 leaf block (packets run only on wide4, without
+/// cut-outs).
 bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
     const uint32_t id = ids_[slot];
     float t = 0.0f, u = 0.0f;

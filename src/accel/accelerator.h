@@ -160,7 +160,8 @@ class Accelerator {
         TriangleVerts tri;  ///< 36 bytes; zero for other kinds
         uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
     };
-    std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive bvh_.prim_indices[s]
+    std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive
+                               ///< bvh_.prim_indices[s]
     /// wide4 layout: the primitive id of each slot (the vertices live only in blocks_).
     std::vector<uint32_t> ids_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)

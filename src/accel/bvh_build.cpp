@@ -145,8 +145,8 @@ class BvhBuildJob {
         for (uint32_t i = begin; i < end; ++i) {
             const uint32_t p = out_.prim_indices[i];
             for (int axis = 0; axis < 3; ++axis) {
-                Bin& target =
-                    bins[size_t(axis) * params_.bin_count + bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
+                Bin& target = bins[size_t(axis) * params_.bin_count +
+                                   bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
                 target.box.extend(in_.boxes[p]);
                 ++target.count;
             }

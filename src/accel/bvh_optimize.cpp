@@ -55,7 +55,8 @@ class LinkedTree {
     double sah(double traversal, double intersection) const {
         double cost = 0;
         for (uint32_t n = 0; n < size(); ++n)
-            if (parent_[n] != kNone || n == root_) cost += area(box_[n]) * (is_leaf(n) ? intersection : traversal);
+            if (parent_[n] != kNone || n == root_)
+                cost += area(box_[n]) * (is_leaf(n) ? intersection : traversal);
         return cost;
     }
 

@@ -72,35 +72,47 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+/// Wall and CPU seconds of the repeated passes over one ray set.
+struct PassTimes {
+    std::vector<double> wall, cpu;
+    void add(const PassTime& t) {
+        wall.push_back(t.wall_s);
+        cpu.push_back(t.cpu_s);
+    }
+};
+
+/// Median throughput and hit rate of sahara's passes over `count` rays.
+nlohmann::ordered_json throughput_json(double count, const PassTimes& ours, const RayAnswers& a) {
+    return {{"count", size_t(count)},
+            {"mrays_s", count / median(ours.wall) * 1e-6},
+            {"mrays_cpu_s", count / median(ours.cpu) * 1e-6},
+            {"hit_rate", count == 0.0 ? 0.0 : double(a.hits()) / count}};
+}
+
+/// Adds Embree's median throughput, the ratios and the disagreements to `j`.
+void add_embree_json(nlohmann::ordered_json& j, double count, const PassTimes& theirs,
+                     const Disagreements& d) {
+    j["embree_mrays_s"] = count / median(theirs.wall) * 1e-6;
+    j["embree_mrays_cpu_s"] = count / median(theirs.cpu) * 1e-6;
+    j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
+    j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
+    j["disagreements"] = d.total;
+    j["ties"] = d.ties;
+    j["confirmed_for_sahara"] = d.confirmed_for_a;
+}
+
 nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& accel,
                                  const EmbreeReference* embree, const std::vector<Ray>& rays, bool occlusion,
                                  const BenchOptions& opt) {
-    std::vector<double> ours, theirs, ours_cpu, theirs_cpu;
+    PassTimes ours, theirs;
     RayAnswers a, b;
     for (int k = 0; k < opt.repeat; ++k) {
-        const PassTime t = trace_sahara(accel, rays, occlusion, opt.threads, true, a);
-        ours.push_back(t.wall_s);
-        ours_cpu.push_back(t.cpu_s);
-        if (!embree) continue;
-        const PassTime e = trace_embree(*embree, rays, occlusion, opt.threads, true, b);
-        theirs.push_back(e.wall_s);
-        theirs_cpu.push_back(e.cpu_s);
+        ours.add(trace_sahara(accel, rays, occlusion, opt.threads, true, a));
+        if (embree) theirs.add(trace_embree(*embree, rays, occlusion, opt.threads, true, b));
     }
     const double count = double(rays.size());
-    nlohmann::ordered_json j = {{"count", rays.size()},
-                                {"mrays_s", count / median(ours) * 1e-6},
-                                {"mrays_cpu_s", count / median(ours_cpu) * 1e-6},
-                                {"hit_rate", rays.empty() ? 0.0 : double(a.hits()) / count}};
-    if (embree) {
-        const Disagreements d = compare_answers(a, b, rays, mesh);
-        j["embree_mrays_s"] = count / median(theirs) * 1e-6;
-        j["embree_mrays_cpu_s"] = count / median(theirs_cpu) * 1e-6;
-        j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
-        j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
-        j["disagreements"] = d.total;
-        j["ties"] = d.ties;
-        j["confirmed_for_sahara"] = d.confirmed_for_a;
-    }
+    nlohmann::ordered_json j = throughput_json(count, ours, a);
+    if (embree) add_embree_json(j, count, theirs, compare_answers(a, b, rays, mesh));
     return j;
 }
 
@@ -109,37 +121,20 @@ nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& ac
 nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelerator& accel,
                                         const EmbreeReference* embree, const std::vector<Ray>& rays,
                                         const BenchOptions& opt) {
-    std::vector<double> ours, theirs, ours_cpu, theirs_cpu;
+    PassTimes ours, theirs;
     RayAnswers a, b, single;
     for (int k = 0; k < opt.repeat; ++k) {
-        const PassTime t = trace_sahara_packets(accel, rays, opt.size, opt.size, opt.threads, true, a);
-        ours.push_back(t.wall_s);
-        ours_cpu.push_back(t.cpu_s);
-        if (!embree) continue;
-        const PassTime e = trace_embree_packets(*embree, rays, opt.size, opt.size, opt.threads, true, b);
-        theirs.push_back(e.wall_s);
-        theirs_cpu.push_back(e.cpu_s);
+        ours.add(trace_sahara_packets(accel, rays, opt.size, opt.size, opt.threads, true, a));
+        if (embree) theirs.add(trace_embree_packets(*embree, rays, opt.size, opt.size, opt.threads, true, b));
     }
     trace_sahara(accel, rays, false, opt.threads, true, single);
     const Disagreements ds = compare_answers(a, single, rays, mesh);
     const double count = double(rays.size());
-    nlohmann::ordered_json j = {{"count", rays.size()},
-                                {"mrays_s", count / median(ours) * 1e-6},
-                                {"mrays_cpu_s", count / median(ours_cpu) * 1e-6},
-                                {"hit_rate", rays.empty() ? 0.0 : double(a.hits()) / count},
-                                {"packet_simd", packet_simd_name(active_packet_simd())},
-                                {"disagreements_single_ray", ds.total + ds.confirmed_for_a},
-                                {"ties_single_ray", ds.ties}};
-    if (embree) {
-        const Disagreements d = compare_answers(a, b, rays, mesh);
-        j["embree_mrays_s"] = count / median(theirs) * 1e-6;
-        j["embree_mrays_cpu_s"] = count / median(theirs_cpu) * 1e-6;
-        j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
-        j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
-        j["disagreements"] = d.total;
-        j["ties"] = d.ties;
-        j["confirmed_for_sahara"] = d.confirmed_for_a;
-    }
+    nlohmann::ordered_json j = throughput_json(count, ours, a);
+    j["packet_simd"] = packet_simd_name(active_packet_simd());
+    j["disagreements_single_ray"] = ds.total + ds.confirmed_for_a;
+    j["ties_single_ray"] = ds.ties;
+    if (embree) add_embree_json(j, count, theirs, compare_answers(a, b, rays, mesh));
     return j;
 }
 

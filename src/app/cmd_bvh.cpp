@@ -149,7 +149,8 @@ void print_text(const nlohmann::ordered_json& j) {
 
 int run_bvh_command(int argc, char** argv) {
     ToolArgs args;
-    const std::string err = parse_tool_args(argc, argv, {"--builder", "--size", "--threads"}, {"--json"}, args);
+    const std::string err =
+        parse_tool_args(argc, argv, {"--builder", "--size", "--threads"}, {"--json"}, args);
     if (!err.empty()) return usage_error("bvh", err, kBvhUsage);
     if (args.help) {
         std::fputs(kBvhUsage, stdout);

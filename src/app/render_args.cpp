@@ -144,7 +144,8 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
     else if (a == "--builder") {
         const std::string& v = flag_value(args, i);
         BvhBuilder b{};
-        if (!parse_bvh_builder(v, b)) throw UsageError(a + ": expected binned|sweep|reinsert, got '" + v + "'");
+        if (!parse_bvh_builder(v, b))
+            throw UsageError(a + ": expected binned|sweep|reinsert, got '" + v + "'");
         o.bvh_builder = b;
     } else if (a == "--sampler")
         o.sampler = parse_sampler_name(a, flag_value(args, i));

@@ -185,7 +185,7 @@ struct RenderSettings {
     std::optional<double> target_error;
     float exposure = 0.0f;  ///< stops
     Tonemap tonemap = Tonemap::clamp;
-    SamplerType sampler = SamplerType::sobol;  ///< command line only (--sampler)
+    SamplerType sampler = SamplerType::sobol;     ///< command line only (--sampler)
     BvhBuilder bvh_builder = kDefaultBvhBuilder;  ///< "bvh_builder" / --builder
 };
 
