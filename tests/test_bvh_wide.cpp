@@ -7,7 +7,7 @@
 #include <string>
 
 #include "accel/accelerator.h"
-#include "accel/bvh4.h"
+#include "accel/bvh_wide.h"
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"
@@ -31,17 +31,14 @@ std::vector<TriangleMesh> procedural() {
 
 /// Restores automatic SIMD path selection when a test ends.
 struct SimdPathGuard {
-    ~SimdPathGuard() { force_simd_path(cpu_has_avx2() ? SimdPath::avx2 : SimdPath::sse2); }
+    ~SimdPathGuard() { force_simd_path(best_simd_path()); }
 };
 
 /// The SIMD paths this CPU can run (SSE2 always).
-std::vector<SimdPath> runnable_paths() {
-    std::vector<SimdPath> paths{SimdPath::sse2};
-    if (cpu_has_avx2()) paths.push_back(SimdPath::avx2);
-    return paths;
-}
+std::vector<SimdPath> runnable_paths() { return runnable_simd_paths(); }
 
-Bounds3 child_box(const Bvh4Node& n, int c) {
+template <int N>
+Bounds3 child_box(const BvhWideNode<N>& n, int c) {
     return {{n.lo_x[c], n.lo_y[c], n.lo_z[c]}, {n.hi_x[c], n.hi_y[c], n.hi_z[c]}};
 }
 
@@ -54,7 +51,7 @@ bool inside(const Bounds3& inner, const Bounds3& outer) {
 
 /// Marks the slots of one leaf (first slot or, with leaf blocks, first block; count slots).
 void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vector<int>& slot_uses) {
-    if (acc.layout() != BvhLayout::wide4) {
+    if (!layout_has_blocks(acc.layout())) {
         REQUIRE(first + count <= slot_uses.size());
         for (uint32_t s = 0; s < count; ++s) ++slot_uses[first + s];
         return;
@@ -74,8 +71,8 @@ void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vecto
 }
 
 /// Every slot in exactly one leaf, every node reached once, child boxes inside the parent's box.
-void check_bvh4_valid(const Accelerator& acc) {
-    const Bvh4& t = acc.bvh4();
+template <int N>
+void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
     REQUIRE_FALSE(t.empty);
     std::vector<int> slot_uses(acc.primitive_count(), 0), node_uses(t.nodes.size(), 0);
     if (t.root.is_leaf()) {
@@ -87,9 +84,9 @@ void check_bvh4_valid(const Accelerator& acc) {
             stack.pop_back();
             REQUIRE(index < t.nodes.size());
             ++node_uses[index];
-            const Bvh4Node& n = t.nodes[index];
+            const BvhWideNode<N>& n = t.nodes[index];
             int children = 0;
-            for (int c = 0; c < 4; ++c) {
+            for (int c = 0; c < N; ++c) {
                 if (!n.has_child(c)) {
                     CHECK(n.count[c] == 0);
                     CHECK(child_box(n, c).lo.x > child_box(n, c).hi.x);
@@ -110,6 +107,17 @@ void check_bvh4_valid(const Accelerator& acc) {
     CHECK(std::all_of(node_uses.begin(), node_uses.end(), [](int u) { return u == 1; }));
 }
 
+/// check_wide_valid on the tree of the accelerator's layout.
+void check_bvh4_valid(const Accelerator& acc) {
+    if (acc.layout() == BvhLayout::wide8) {
+        CHECK(acc.bvh4().empty);
+        check_wide_valid(acc, acc.bvh8());
+    } else {
+        CHECK(acc.bvh8().empty);
+        check_wide_valid(acc, acc.bvh4());
+    }
+}
+
 bool same_t(float a, float b) { return std::fabs(a - b) <= 1e-6f * std::max(std::fabs(a), std::fabs(b)); }
 
 /// Rays on which `acc` (BVH4) disagrees with the brute-force loop, for intersect and occluded.
@@ -127,8 +135,8 @@ int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
     return bad;
 }
 
-/// Both wide layouts on every runnable SIMD path: valid trees, brute-force answers;
-/// `reinsert` adds the wide4 layout over the reinsertion builder's tree.
+/// The wide layouts on every runnable SIMD path: valid trees, brute-force answers;
+/// `reinsert` adds the wide8 layout over the reinsertion builder's tree.
 void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
     const Scene scene = scene_from_mesh(mesh);
     const double budget = 2.5e7 / double(std::max<size_t>(mesh.triangle_count(), 1));
@@ -136,8 +144,9 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
     const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
     SimdPathGuard guard;
     for (auto [layout, builder] : {std::pair{BvhLayout::wide4, BvhBuilder::binned},
+                                   std::pair{BvhLayout::wide8, BvhBuilder::binned},
                                    std::pair{BvhLayout::wide4_slots, BvhBuilder::binned},
-                                   std::pair{BvhLayout::wide4, BvhBuilder::reinsert}}) {
+                                   std::pair{BvhLayout::wide8, BvhBuilder::reinsert}}) {
         if (builder == BvhBuilder::reinsert && !reinsert) continue;
         AcceleratorOptions opt;
         opt.layout = layout;
@@ -226,7 +235,44 @@ TEST_CASE("BVH4 box test matches the single-node test, including zero directions
     CHECK(bad == 0);
 }
 
-TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight test") {
+TEST_CASE("BVH8 box test (SSE halves and AVX) matches the single-node test") {
+    std::mt19937 rng(32);
+    std::uniform_int_distribution<int> coord(-2, 2);
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0, hits = 0;
+    for (int i = 0; i < 50000 / kSanitizerDivisor; ++i) {
+        BvhNode child[8];
+        Bvh8Node n{};
+        for (int c = 0; c < 8; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};
+            child[c].set_box(b);
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+        }
+        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+        const BvhRay r(ray);
+        alignas(32) float t_sse[8], t_avx[8];
+        const int mask_sse = WideRay<8, false>(r).test(n, r.tmin, r.tmax, t_sse);
+        const int mask_avx = cpu_has_avx2() ? WideRay<8, true>(r).test(n, r.tmin, r.tmax, t_avx) : mask_sse;
+        if (!cpu_has_avx2()) std::copy(t_sse, t_sse + 8, t_avx);
+        for (int c = 0; c < 8; ++c) {
+            float t = 0.0f;
+            const bool hit = intersect_bvh_node(child[c], r, t);
+            hits += hit;
+            if (hit != bool(mask_sse & (1 << c)) || hit != bool(mask_avx & (1 << c))) ++bad;
+            if (hit && (t != t_sse[c] || t != t_avx[c])) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+}
+
+TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar watertight test") {
     // A fine grid: rays through shared edges and vertices give exactly-zero edge functions.
     const TriangleMesh m = make_tiny_grid(12, 1.0f, 1.0f);
     std::mt19937 rng(5);
@@ -251,6 +297,11 @@ TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight tes
             }
             float t[4], u[4], v[4];
             const int mask = intersect_triangle_block4(tr, b, ray.tmin, ray.tmax, t, u, v);
+            // The AVX pair test on (b, b) must give the same answer in both halves.
+            alignas(32) float t8[8], u8[8], v8[8];
+            const TriangleBlock4 pair[2] = {b, b};
+            const int mask8 =
+                cpu_has_avx2() ? intersect_triangle_blocks2_avx(tr, pair, ray.tmin, ray.tmax, t8, u8, v8) : 0;
             for (int l = 0; l < 4; ++l) {
                 TriangleHit h{};
                 const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
@@ -258,6 +309,13 @@ TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight tes
                 hits += hit;
                 if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l])))
                     ++bad;
+                if (!cpu_has_avx2()) continue;
+                for (int half = 0; half < 2; ++half) {
+                    const int k = 4 * half + l;
+                    if (hit != bool(mask8 & (1 << k)) ||
+                        (hit && (h.t != t8[k] || h.u != u8[k] || h.v != v8[k])))
+                        ++bad;
+                }
             }
         }
     }
@@ -270,15 +328,24 @@ TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
     Scene scene = scene_from_mesh(make_icosphere(2, 0.5f));
     scene.spheres.push_back(Sphere{Vec3(2.0f, 0.0f, 0.0f), 0.4f});
     scene.boxes.push_back(Box{Bounds3{{-2.5f, -0.5f, -0.5f}, {-1.5f, 0.5f, 0.5f}}});
-    const Accelerator acc(scene);
-    check_bvh4_valid(acc);
-    CHECK(disagreements(acc, make_random_rays(acc.bounds(), 20000 / kSanitizerDivisor, 91)) == 0);
-    TraversalCounters counters;
-    Ray r{Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1.0f)};
-    Hit h;
-    REQUIRE(acc.intersect_counted(r, h, counters));
-    CHECK(counters.nodes_visited > 1);
-    CHECK(counters.prims_tested > 0);
+    SimdPathGuard guard;
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        const Accelerator acc(scene, opt);
+        check_bvh4_valid(acc);
+        for (SimdPath path : runnable_paths()) {
+            force_simd_path(path);
+            INFO(bvh_layout_name(layout), " ", simd_path_name(path));
+            CHECK(disagreements(acc, make_random_rays(acc.bounds(), 20000 / kSanitizerDivisor, 91)) == 0);
+        }
+        TraversalCounters counters;
+        Ray r{Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1.0f)};
+        Hit h;
+        REQUIRE(acc.intersect_counted(r, h, counters));
+        CHECK(counters.nodes_visited > 1);
+        CHECK(counters.prims_tested > 0);
+    }
     BvhLayout layout{};
     CHECK(parse_bvh_layout("pairs", layout));
     CHECK(layout == BvhLayout::pairs);
@@ -286,5 +353,7 @@ TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
     CHECK(layout == BvhLayout::wide4);
     CHECK(parse_bvh_layout("wide4-slots", layout));
     CHECK(layout == BvhLayout::wide4_slots);
+    CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide8), layout));
+    CHECK(layout == BvhLayout::wide8);
     CHECK_FALSE(parse_bvh_layout("bvh8", layout));
 }

@@ -121,16 +121,12 @@ std::vector<Vec2> square_centres() {
 
 /// Restores automatic SIMD path selection when a test ends.
 struct SimdGuard {
-    ~SimdGuard() { force_simd_path(cpu_has_avx2() ? SimdPath::avx2 : SimdPath::sse2); }
+    ~SimdGuard() { force_simd_path(best_simd_path()); }
 };
 
-std::vector<SimdPath> simd_paths() {
-    std::vector<SimdPath> paths{SimdPath::sse2};
-    if (cpu_has_avx2()) paths.push_back(SimdPath::avx2);
-    return paths;
-}
+std::vector<SimdPath> simd_paths() { return runnable_simd_paths(); }
 
-constexpr BvhLayout kLayouts[] = {BvhLayout::wide4, BvhLayout::wide4_slots, BvhLayout::pairs};
+constexpr BvhLayout kLayouts[] = {BvhLayout::wide4, BvhLayout::wide8, BvhLayout::wide4_slots, BvhLayout::pairs};
 
 /// 4 standard deviations of a binomial fraction with probability p over n trials.
 double four_sigma(double p, int n) { return 4.0 * std::sqrt(p * (1.0 - p) / double(n)); }

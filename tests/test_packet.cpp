@@ -104,16 +104,23 @@ std::vector<RayPacket> camera_packets(Vec3 eye, int n, float fov_tan) {
     return out;
 }
 
+AcceleratorOptions with_layout(BvhLayout layout) {
+    AcceleratorOptions o;
+    o.layout = layout;
+    return o;
+}
+
 }  // namespace
 
 TEST_CASE("packets agree with single rays: coherent camera tiles, on every SIMD path") {
     PacketSimdGuard guard;
     const Scene scene = mixed_scene();
-    const Accelerator acc(scene);
     const int n = kSanitized ? 32 : 96;
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
     for (PacketSimd path : runnable_packet_paths()) {
+        const Accelerator acc(scene, with_layout(layout));
         force_packet_simd(path);
-        const std::string name = packet_simd_name(path);
+        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
         CAPTURE(name);
         Agreement a;
         for (const Vec3& eye : {Vec3(0.3f, 0.2f, 4.0f), Vec3(-3.0f, 2.0f, -3.0f), Vec3(0.0f, 0.0f, 5.0f)})
@@ -127,13 +134,14 @@ TEST_CASE("packets agree with single rays: coherent camera tiles, on every SIMD 
 TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactive lanes, axis rays") {
     PacketSimdGuard guard;
     const Scene scene = mixed_scene();
-    const Accelerator acc(scene);
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     const int packets = kSanitized ? 150 : 2000;
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
     for (PacketSimd path : runnable_packet_paths()) {
+        const Accelerator acc(scene, with_layout(layout));
         force_packet_simd(path);
-        const std::string name = packet_simd_name(path);
+        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
         CAPTURE(name);
         Agreement a;
         for (int k = 0; k < packets; ++k) {

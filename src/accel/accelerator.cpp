@@ -75,7 +75,17 @@ Bvh single_leaf_bvh(const PrimitiveList& prims) {
 }  // namespace
 
 const char* bvh_layout_name(BvhLayout layout) {
-    return layout == BvhLayout::pairs ? "pairs" : layout == BvhLayout::wide4_slots ? "wide4-slots" : "wide4";
+    switch (layout) {
+        case BvhLayout::pairs:
+            return "pairs";
+        case BvhLayout::wide4_slots:
+            return "wide4-slots";
+        case BvhLayout::wide8:
+            return "wide8";
+        case BvhLayout::wide4:
+            break;
+    }
+    return "wide4";
 }
 
 bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
@@ -85,6 +95,8 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
         out = BvhLayout::wide4_slots;
     else if (text == "pairs")
         out = BvhLayout::pairs;
+    else if (text == "wide8")
+        out = BvhLayout::wide8;
     else
         return false;
     return true;
@@ -97,11 +109,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     for (const Box& b : scene.boxes) boxes_.push_back(b.box);
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
-    BvhBuildParams params = options.params;
-    if (options.layout == BvhLayout::wide4) {
-        params.intersection_cost *= options.wide4_leaf_cost_scale;
-        params.leaf_block_size = 4;  // a leaf block tests four triangles at once
-    }
+    const BvhBuildParams params = options.build_params();
     bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
                       : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
@@ -120,10 +128,16 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     layout_ = options.layout;
     if (layout_ == BvhLayout::pairs)
         pairs_ = make_bvh_pairs(bvh_);
+    else if (layout_ == BvhLayout::wide8)
+        wide8_ = make_bvh_wide<8>(bvh_);
     else
         wide_ = make_bvh4(bvh_);
-    if (layout_ == BvhLayout::wide4) {
-        make_leaf_blocks(ids, tris);  // the blocks and ids_ are all the wide4 layout keeps
+    if (layout_has_blocks(layout_)) {
+        // The blocks and ids_ are all the block layouts keep.
+        if (layout_ == BvhLayout::wide8)
+            make_leaf_blocks(wide8_, ids, tris);
+        else
+            make_leaf_blocks(wide_, ids, tris);
         ids_ = std::move(ids);
     } else {
         slots_.resize(slots);
@@ -134,9 +148,11 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// Rewrites every BVH4 leaf (first slot, count) to (first block, count), its
+/// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
 /// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
-void Accelerator::make_leaf_blocks(const std::vector<uint32_t>& ids, const std::vector<TriangleVerts>& tris) {
+template <int N>
+void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
+                                   const std::vector<TriangleVerts>& tris) {
     auto add_leaf = [&](uint32_t first, uint32_t count) {
         const auto block = uint32_t(blocks_.size());
         for (uint32_t s = first; s < first + count; s += 4) {
@@ -156,19 +172,19 @@ void Accelerator::make_leaf_blocks(const std::vector<uint32_t>& ids, const std::
         }
         return block;
     };
-    if (wide_.empty) return;
-    if (wide_.root.is_leaf()) wide_.root.index = add_leaf(wide_.root.index, wide_.root.count);
-    for (Bvh4Node& n : wide_.nodes)
-        for (int c = 0; c < 4; ++c)
+    if (tree.empty) return;
+    if (tree.root.is_leaf()) tree.root.index = add_leaf(tree.root.index, tree.root.count);
+    for (BvhWideNode<N>& n : tree.nodes)
+        for (int c = 0; c < N; ++c)
             if (n.count[c]) n.child[c] = add_leaf(n.child[c], n.count[c]);
 }
 
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
-    // The wide4 layout keeps only the blocks (vertices) and one id per slot.
-    if (layout_ == BvhLayout::wide4)
-        return wide_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + ids_.size() * sizeof(uint32_t) +
+    // The block layouts keep only the tree, the blocks (vertices) and one id per slot.
+    if (layout_has_blocks(layout_))
+        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) + blocks_.size() * sizeof(TriangleBlock4) + ids_.size() * sizeof(uint32_t) +
                other;
     return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
            bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
@@ -233,19 +249,20 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
     return found;
 }
 
-/// The BVH4 traversal; trace_wide_avx2 is the same code compiled for AVX2
-/// (both inline this body, so each gets its own instruction selection).
-template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit,
-                                                                        Counters& counters) const {
+/// The wide-BVH traversal; trace_wide_avx2 is the same code compiled for AVX2
+/// (both inline this body, so each gets its own instruction selection; an
+/// 8-wide node is tested in one AVX step there, as two SSE halves otherwise).
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
+__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
+                                                                        Hit& hit, Counters& counters) const {
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
-    const bool found = traverse_bvh4<kAnyHit>(
-        wide_, br,
-        [&](uint32_t first, uint32_t count, float& tmax) {
+    const bool found = traverse_wide<kAnyHit, kAvx>(
+        tree, br,
+        [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
             if constexpr (kBlocks)
-                return test_blocks<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
+                return test_blocks<kAnyHit, kCutouts, kAvx>(ray, tr, first, count, tmax, best);
             else
                 return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
         },
@@ -257,22 +274,27 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
     return found;
 }
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-bool Accelerator::trace_wide(Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks>(ray, hit, counters);
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false>(tree, ray, hit, counters);
 }
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks>(ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true>(tree, ray, hit, counters);
+}
+
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
+    const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit>
-__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray,
-                                                                        const TriangleBlock4& block, int mask,
-                                                                        const float t[4], const float u[4],
-                                                                        const float v[4]) const {
+__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray, uint32_t first, int mask,
+                                                                        const float* t, const float* u,
+                                                                        const float* v) const {
     // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
     while (mask) {
         int best = __builtin_ctz(unsigned(mask));
@@ -281,29 +303,42 @@ __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ra
                 const int l = __builtin_ctz(unsigned(m));
                 if (t[l] < t[best]) best = l;
             }
-        if (keep_triangle_hit(ray, ids_[block.slot[best]], u[best], v[best])) return 1 << best;
+        if (keep_triangle_hit(ray, ids_[block_slot(first, best)], u[best], v[best])) return 1 << best;
         mask &= ~(1 << best);
     }
     return 0;
 }
 
+/// Sign bits of a block's slots: its lanes of other kinds and padding.
+inline int other_lanes(const TriangleBlock4& block) {
+    return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+}
+
 /// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
-/// time, other kinds through intersect_other; the closest hit lowers `tmax`.
-template <bool kAnyHit, bool kCutouts>
+/// time (kAvx: eight, two blocks per step), other kinds through intersect_other;
+/// the closest hit lowers `tmax`. Ties keep the earlier lane, as one block at a time would.
+template <bool kAnyHit, bool kCutouts, bool kAvx>
 __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
                                                                     uint32_t first, uint32_t count,
                                                                     float& tmax, Hit& hit) const {
     bool found = false;
-    for (uint32_t b = first; b < first + (count + 3) / 4; ++b) {
-        const TriangleBlock4& block = blocks_[b];
-        float t[4], u[4], v[4];
-        // Sign bits of the slots: lanes of other kinds and padding. A block with
-        // no triangle lane (e.g. a leaf of spheres) skips the triangle test.
-        const int other =
-            _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
-        int mask = other == 0xF ? 0 : intersect_triangle_block4(tr, block, ray.tmin, tmax, t, u, v);
+    const uint32_t end = first + (count + 3) / 4;
+    for (uint32_t b = first; b < end;) {
+        const bool pair = kAvx && b + 1 < end;
+        alignas(32) float t[8], u[8], v[8];
+        // Lanes of other kinds and padding; a step with no triangle lane (e.g. a
+        // leaf of spheres) skips the triangle test.
+        const int other = other_lanes(blocks_[b]) | (pair ? other_lanes(blocks_[b + 1]) << 4 : 0);
+        int mask = 0;
+        if (other != (pair ? 0xFF : 0xF)) {
+            if constexpr (kAvx)
+                mask = pair ? intersect_triangle_blocks2_avx(tr, &blocks_[b], ray.tmin, tmax, t, u, v)
+                            : intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
+            else
+                mask = intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
+        }
         if constexpr (kCutouts)
-            if (mask) mask = keep_block_lanes<kAnyHit>(ray, block, mask, t, u, v);
+            if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
             if constexpr (kAnyHit) return true;
             int best = __builtin_ctz(unsigned(mask));
@@ -312,11 +347,11 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
                 if (t[l] < t[best]) best = l;
             }
             tmax = t[best];
-            hit = Hit{t[best], ids_[block.slot[best]], u[best], v[best]};
+            hit = Hit{t[best], ids_[block_slot(b, best)], u[best], v[best]};
             found = true;
         }
         for (int m = other; m; m &= m - 1) {
-            const uint32_t slot = block.slot[__builtin_ctz(unsigned(m))];
+            const uint32_t slot = block_slot(b, __builtin_ctz(unsigned(m)));
             if (slot == TriangleBlock4::kEmptyLane) continue;
             const uint32_t id = ids_[slot & ~TriangleBlock4::kOtherKind];
             float t_other = 0.0f, u_other = 0.0f;
@@ -326,6 +361,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             hit = Hit{t_other, id, u_other, 0.0f};
             found = true;
         }
+        b += pair ? 2 : 1;
     }
     return found;
 }
@@ -338,13 +374,24 @@ bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
 
 template <bool kAnyHit, bool kCutouts, class Counters>
 bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
-    const bool avx2 = active_simd_path() == SimdPath::avx2;
-    if (layout_ == BvhLayout::wide4)
-        return avx2 ? trace_wide_avx2<kAnyHit, kCutouts, true>(ray, hit, counters)
-                    : trace_wide<kAnyHit, kCutouts, true>(ray, hit, counters);
-    if (layout_ == BvhLayout::wide4_slots)
-        return avx2 ? trace_wide_avx2<kAnyHit, kCutouts, false>(ray, hit, counters)
-                    : trace_wide<kAnyHit, kCutouts, false>(ray, hit, counters);
+    if (layout_ != BvhLayout::pairs) {
+        // The wide layouts: one traversal body compiled three times (SSE2, AVX2, AVX-512).
+        const SimdPath path = active_simd_path();
+        const bool blocks = layout_ != BvhLayout::wide4_slots;
+        if (layout_ == BvhLayout::wide8) {
+            if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+        }
+        if (blocks) {
+            if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+            if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+            return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+        }
+        if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+        if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+        return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+    }
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
@@ -383,7 +430,7 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
     return trace<true>(r, h, counters);
 }
 
-/// The wide4 brute force: every lane of every block, triangles by the scalar test.
+/// The block layouts' brute force: every lane of every block, triangles by the scalar test.
 bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const {
     bool found = false;
     for (const TriangleBlock4& b : blocks_)
@@ -409,7 +456,7 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
     return found;
 }
 
-/// Packet fallback for a non-triangle lane of a wide4 leaf block (packets run only on wide4, without
+/// Packet fallback for a non-triangle lane of a leaf block (packets run only on the block layouts, without
 /// cut-outs).
 bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
     const uint32_t id = ids_[slot];
@@ -423,7 +470,7 @@ bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
     const TriangleRay tr(ray);
     float tmax = ray.tmax;
     Hit best;
-    const bool found = layout_ == BvhLayout::wide4 ? brute_force_blocks(ray, tr, tmax, best)
+    const bool found = layout_has_blocks(layout_) ? brute_force_blocks(ray, tr, tmax, best)
                        : alpha_.empty()
                            ? test_slots<false, false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)
                            : test_slots<false, true>(ray, tr, 0, uint32_t(slots_.size()), tmax, best);

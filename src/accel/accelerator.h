@@ -13,7 +13,7 @@
 
 #include "accel/alpha_filter.h"
 #include "accel/bvh.h"
-#include "accel/bvh4.h"
+#include "accel/bvh_wide.h"
 #include "accel/bvh4_leaf.h"
 #include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"
@@ -40,19 +40,28 @@ inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
 /// Traversal structure built from the binary SAH tree.
 enum class BvhLayout : uint8_t {
-    wide4,  ///< 4-wide BVH (accel/bvh4.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h); the default
+    wide4,  ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
     wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
     pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
+    wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
 };
 
-/// "wide4", "wide4-slots" or "pairs".
+/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
+inline bool layout_has_blocks(BvhLayout layout) {
+    return layout == BvhLayout::wide4 || layout == BvhLayout::wide8;
+}
+
+/// "wide4", "wide4-slots", "pairs" or "wide8".
 const char* bvh_layout_name(BvhLayout layout);
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
-    BvhLayout layout = BvhLayout::wide4;
+    /// wide8 by default: against wide4 it cut CPU time per ray by 10-25% on every
+    /// ray set (`sahara bench --layout wide4|wide8 --threads 1 --size 512`, bunny,
+    /// 2026-11-22: primary 0.65 -> 0.72, diffuse 0.51 -> 0.62, shadow 0.61 -> 0.80 of Embree).
+    BvhLayout layout = BvhLayout::wide8;
     BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
     /// The wide4 layout builds with params.intersection_cost times this and counts
@@ -63,9 +72,26 @@ struct AcceleratorOptions {
     /// (bunny: 53.6 bytes/triangle of nodes + blocks vs 58.0 at 0.5; without the
     /// block rounding 0.5 gave 79.9, mostly padding lanes of 2- and 3-triangle leaves).
     float wide4_leaf_cost_scale = 0.25f;
+    /// The same for the wide8 layout, whose node visits cost less per binary level:
+    /// instructions per diffuse ray (callgrind, `sahara bench --rays diffuse --size 256`,
+    /// 2026-11-22) at 0.25 / 0.5 / 1.0: suzanne 1141 / 1072 / 1070, bunny 1194 / 1139 /
+    /// 1138, ogre 1310 / 1253 / 1252; 0.5 is the smaller tree of the two best. Blocks of
+    /// eight (two blocks per AVX step) measured worse: bunny 1214 at 0.5.
+    float wide8_leaf_cost_scale = 0.5f;
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
+
+    /// `params` as the chosen layout builds with: the block layouts scale the
+    /// intersection cost and count leaves in blocks of four.
+    BvhBuildParams build_params() const {
+        BvhBuildParams p = params;
+        if (layout_has_blocks(layout)) {
+            p.intersection_cost *= layout == BvhLayout::wide8 ? wide8_leaf_cost_scale : wide4_leaf_cost_scale;
+            p.leaf_block_size = 4;  // a leaf block tests four triangles at once
+        }
+        return p;
+    }
 };
 
 class Accelerator {
@@ -83,13 +109,13 @@ class Accelerator {
     /// Nearest hits of the active rays of a packet (accel/packet.h); on a hit,
     /// the lane's tmax becomes hit.t. Per ray the answer is intersect()'s up to
     /// ties between primitives at exactly the same distance. Layouts other than
-    /// wide4, scenes with cut-outs and incoherent packets (mixed direction signs
+    /// wide4 and wide8, scenes with cut-outs and incoherent packets (mixed direction signs
     /// or dominant axes) are traced ray by ray.
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
-    /// Tests the non-triangle primitive in wide4 leaf slot `slot` alone (packet
+    /// Tests the non-triangle primitive in leaf slot `slot` of a block layout alone (packet
     /// fallback); on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
     bool intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const;
-    /// Primitive id held by wide4 leaf slot `slot`.
+    /// Primitive id held by leaf slot `slot` (block layouts).
     uint32_t slot_prim(uint32_t slot) const { return ids_[slot]; }
     /// Reference answer: tests every primitive, no tree (for tests).
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
@@ -99,10 +125,12 @@ class Accelerator {
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
     BvhLayout layout() const { return layout_; }
-    /// The 4-wide tree (empty for the pairs layout; with the wide4 layout a leaf's
-    /// child index is its first TriangleBlock4, not its first slot).
+    /// The 4-wide tree (empty unless the layout is wide4 or wide4-slots; with the
+    /// wide4 layout a leaf's child index is its first TriangleBlock4, not its first slot).
     const Bvh4& bvh4() const { return wide_; }
-    /// Leaf triangle blocks of the wide4 layout (empty for the other layouts).
+    /// The 8-wide tree (empty unless the layout is wide8; a leaf's child index is its first block).
+    const Bvh8& bvh8() const { return wide8_; }
+    /// Leaf triangle blocks of the wide4 and wide8 layouts (empty for the other layouts).
     const std::vector<TriangleBlock4>& leaf_blocks() const { return blocks_; }
     /// Elapsed build time (BVH, pair layout, leaf-ordered primitive copies).
     double build_ms() const { return build_ms_; }
@@ -123,16 +151,22 @@ class Accelerator {
     bool trace(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-    bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-    bool trace_wide(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, class Counters>
-    __attribute__((target("avx2"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
+    bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+    bool trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+    __attribute__((target("avx2"))) bool trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
+                                                         Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+    __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
+        const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kAvx>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
-    void make_leaf_blocks(const std::vector<uint32_t>& ids, const std::vector<TriangleVerts>& tris);
+    template <int N>
+    void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
+                          const std::vector<TriangleVerts>& tris);
     bool intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const;
     bool brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const;
     template <bool kAnyHit, bool kCutouts>
@@ -143,16 +177,20 @@ class Accelerator {
         const uint32_t e = alpha_.entry_of(prim_index(id));
         return e == AlphaFilter::kOpaque || alpha_.passes(e, ray, id, u, v);
     }
-    /// Of the hit lanes `mask` of a triangle block, the one kept lane (the nearest
-    /// kept one; for kAnyHit the first) as a mask, or 0 when every hit is cut out.
+    /// Of the hit lanes `mask` of the triangle blocks from `first` (lane l: lane
+    /// l & 3 of block first + l / 4), the one kept lane (the nearest kept one; for
+    /// kAnyHit the first) as a mask, or 0 when every hit is cut out.
     template <bool kAnyHit>
-    int keep_block_lanes(const Ray& ray, const TriangleBlock4& block, int mask, const float t[4],
-                         const float u[4], const float v[4]) const;
+    int keep_block_lanes(const Ray& ray, uint32_t first, int mask, const float* t, const float* u,
+                         const float* v) const;
+    /// Leaf slot of lane l of the blocks from `first`.
+    uint32_t block_slot(uint32_t first, int l) const { return blocks_[first + uint32_t(l >> 2)].slot[l & 3]; }
 
     Bvh bvh_;                             ///< canonical tree (statistics, validation)
     BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
-    Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide layouts)
-    std::vector<TriangleBlock4> blocks_;  ///< wide4 layout: each leaf's slots in blocks of four
+    Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
+    Bvh8 wide8_;                          ///< the same tree collapsed to 8-wide nodes (wide8 layout)
+    std::vector<TriangleBlock4> blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
     BvhLayout layout_ = BvhLayout::wide4;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).
@@ -162,7 +200,7 @@ class Accelerator {
     };
     std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive
                                ///< bvh_.prim_indices[s]
-    /// wide4 layout: the primitive id of each slot (the vertices live only in blocks_).
+    /// wide4/wide8 layouts: the primitive id of each slot (the vertices live only in blocks_).
     std::vector<uint32_t> ids_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)

@@ -9,9 +9,13 @@
 ///
 /// Lanes that hold no triangle (another primitive kind, or padding) have NaN
 /// vertices, which every comparison rejects; the caller tests those kinds itself.
+///
+/// With AVX2, two consecutive blocks are tested in one 8-lane step
+/// (intersect_triangle_blocks2_avx): the same operations per lane, so the
+/// storage stays one format for every ISA.
 #include <cstdint>
 
-#include <emmintrin.h>
+#include <immintrin.h>
 
 #include "geometry/triangle.h"
 
@@ -28,6 +32,28 @@ struct alignas(16) TriangleBlock4 {
 };
 static_assert(sizeof(TriangleBlock4) == 160, "40 bytes per triangle, like a leaf slot");
 
+/// Scalar redo of the lanes of `b` in `lanes` (bit l: lane l) whose edge
+/// function was exactly 0 (double fallback included); returns the hit lanes as
+/// bits `shift + l`, their answers written to t/u/v_out[shift + l].
+__attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRay& tr, const TriangleBlock4& b,
+                                                                int lanes, int shift, float tmin, float tmax,
+                                                                float* t_out, float* u_out, float* v_out) {
+    int result = 0;
+    for (; lanes; lanes &= lanes - 1) {
+        const int l = __builtin_ctz(unsigned(lanes));
+        if (b.slot[l] & TriangleBlock4::kOtherKind) continue;
+        const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
+                                 {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
+                                 {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
+        TriangleHit h{};
+        if (intersect_triangle(tr, tri, tmin, tmax, h)) {
+            t_out[shift + l] = h.t, u_out[shift + l] = h.u, v_out[shift + l] = h.v;
+            result |= 1 << (shift + l);
+        }
+    }
+    return result;
+}
+
 /// Tests the four lanes of `b`; returns the mask of lanes hit in (tmin, tmax)
 /// and their distances and barycentrics.
 __attribute__((always_inline)) inline int intersect_triangle_block4(const TriangleRay& tr,
@@ -37,57 +63,116 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m128 ox = _mm_set1_ps(tr.org[kx]), oy = _mm_set1_ps(tr.org[ky]), oz = _mm_set1_ps(tr.org[kz]);
     const __m128 sx = _mm_set1_ps(tr.sx), sy = _mm_set1_ps(tr.sy), sz = _mm_set1_ps(tr.sz);
-    __m128 x[3], y[3], z[3];
+    __m128 x[3], y[3], rz[3];
     for (int v = 0; v < 3; ++v) {
-        const __m128 rz = _mm_sub_ps(_mm_load_ps(b.p[v][kz]), oz);
-        x[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][kx]), ox), _mm_mul_ps(sx, rz));
-        y[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][ky]), oy), _mm_mul_ps(sy, rz));
-        z[v] = _mm_mul_ps(sz, rz);
+        rz[v] = _mm_sub_ps(_mm_load_ps(b.p[v][kz]), oz);
+        x[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][kx]), ox), _mm_mul_ps(sx, rz[v]));
+        y[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][ky]), oy), _mm_mul_ps(sy, rz[v]));
     }
     // u = cx by - cy bx, v = ax cy - ay cx, w = bx ay - by ax (as in intersect_triangle).
     const __m128 u = _mm_sub_ps(_mm_mul_ps(x[2], y[1]), _mm_mul_ps(y[2], x[1]));
     const __m128 v = _mm_sub_ps(_mm_mul_ps(x[0], y[2]), _mm_mul_ps(y[0], x[2]));
     const __m128 w = _mm_sub_ps(_mm_mul_ps(x[1], y[0]), _mm_mul_ps(y[1], x[0]));
     const __m128 zero = _mm_setzero_ps();
-    const int exact_zero = _mm_movemask_ps(
-        _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
-    const __m128 any_neg =
-        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-    const __m128 any_pos =
-        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-    const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
-    const __m128 t_scaled =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, z[0]), _mm_mul_ps(v, z[1])), _mm_mul_ps(w, z[2]));
-    const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
-    const __m128 abs_det = _mm_xor_ps(det, sign);
-    const __m128 t_signed = _mm_xor_ps(t_scaled, sign);
-    __m128 ok = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_cmpneq_ps(det, zero));
-    ok = _mm_and_ps(ok, _mm_cmpgt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmin), abs_det)));
-    ok = _mm_and_ps(ok, _mm_cmplt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmax), abs_det)));
-    int mask = _mm_movemask_ps(ok) & ~exact_zero;
+    // A lane with an edge function of exactly 0 goes to the scalar test below. The
+    // product also flags products that underflow to 0, which the scalar test then
+    // answers just as exactly; NaN (padding) lanes compare unequal.
+    const int exact_zero = _mm_movemask_ps(_mm_cmpeq_ps(_mm_mul_ps(_mm_mul_ps(u, v), w), zero));
+    // With no zero among them, u, v, w of a hit share one sign: differing sign bits miss.
+    const int mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w)));
+    int mask = ~(mixed | exact_zero) & 0xF;
     int result = 0;
     if (mask) {
-        const __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.0f), det);
-        const __m128 t = _mm_mul_ps(t_scaled, inv_det);
-        // Rounding of the division can push t onto the interval's boundary.
-        const __m128 in = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax)));
-        result = mask & _mm_movemask_ps(in);
-        _mm_storeu_ps(t_out, t);
-        _mm_storeu_ps(u_out, _mm_mul_ps(v, inv_det));
-        _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
+        const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
+        const __m128 t_scaled = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, rz[0])), _mm_mul_ps(v, _mm_mul_ps(sz, rz[1]))),
+            _mm_mul_ps(w, _mm_mul_ps(sz, rz[2])));
+        const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
+        const __m128 abs_det = _mm_xor_ps(det, sign);
+        const __m128 t_signed = _mm_xor_ps(t_scaled, sign);
+        // NaN lanes fail the ordered comparisons.
+        __m128 ok = _mm_cmpneq_ps(det, zero);
+        ok = _mm_and_ps(ok, _mm_cmpgt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmin), abs_det)));
+        ok = _mm_and_ps(ok, _mm_cmplt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmax), abs_det)));
+        mask &= _mm_movemask_ps(ok);
+        if (mask) {
+            const __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.0f), det);
+            const __m128 t = _mm_mul_ps(t_scaled, inv_det);
+            // Rounding of the division can push t onto the interval's boundary.
+            const __m128 in =
+                _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax)));
+            result = mask & _mm_movemask_ps(in);
+            _mm_storeu_ps(t_out, t);
+            _mm_storeu_ps(u_out, _mm_mul_ps(v, inv_det));
+            _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
+        }
     }
     // Lanes with an exactly-zero edge function: the scalar test, double fallback included.
-    for (int lanes = exact_zero; lanes; lanes &= lanes - 1) {
-        const int l = __builtin_ctz(unsigned(lanes));
-        if (b.slot[l] & TriangleBlock4::kOtherKind) continue;
-        const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
-                                 {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
-                                 {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
-        TriangleHit h{};
-        if (intersect_triangle(tr, tri, tmin, tmax, h)) {
-            t_out[l] = h.t, u_out[l] = h.u, v_out[l] = h.v;
-            result |= 1 << l;
+    if (exact_zero) result |= redo_exact_zero_lanes(tr, b, exact_zero, 0, tmin, tmax, t_out, u_out, v_out);
+    return result;
+}
+
+/// Loads lane group [v][axis] of blocks b[0] (low half) and b[1] (high half).
+__attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b, int v,
+                                                                            int axis) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b[0].p[v][axis])), _mm_load_ps(b[1].p[v][axis]),
+                                1);
+}
+
+/// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step:
+/// bit l of the result is lane l & 3 of block l >> 2; t/u/v_out hold 8 lanes.
+/// Not always_inline, like WideRay<8, true>::test (bvh_wide.h): it is inlined
+/// once its generic caller sits inside the AVX2 traversal.
+__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
+                                                                         const TriangleBlock4* b, float tmin,
+                                                                         float tmax, float t_out[8],
+                                                                         float u_out[8], float v_out[8]) {
+    const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
+    const __m256 ox = _mm256_set1_ps(tr.org[kx]), oy = _mm256_set1_ps(tr.org[ky]),
+                 oz = _mm256_set1_ps(tr.org[kz]);
+    const __m256 sx = _mm256_set1_ps(tr.sx), sy = _mm256_set1_ps(tr.sy), sz = _mm256_set1_ps(tr.sz);
+    __m256 x[3], y[3], rz[3];
+    for (int v = 0; v < 3; ++v) {
+        rz[v] = _mm256_sub_ps(load_block_pair(b, v, kz), oz);
+        x[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b, v, kx), ox), _mm256_mul_ps(sx, rz[v]));
+        y[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b, v, ky), oy), _mm256_mul_ps(sy, rz[v]));
+    }
+    const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
+    const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
+    const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
+    const __m256 zero = _mm256_setzero_ps();
+    const int exact_zero =
+        _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(u, v), w), zero, _CMP_EQ_OQ));
+    const int mixed = _mm256_movemask_ps(_mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w)));
+    int mask = ~(mixed | exact_zero) & 0xFF;
+    int result = 0;
+    if (mask) {
+        const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+        const __m256 t_scaled =
+            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, rz[0])),
+                                        _mm256_mul_ps(v, _mm256_mul_ps(sz, rz[1]))),
+                          _mm256_mul_ps(w, _mm256_mul_ps(sz, rz[2])));
+        const __m256 sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
+        const __m256 abs_det = _mm256_xor_ps(det, sign);
+        const __m256 t_signed = _mm256_xor_ps(t_scaled, sign);
+        __m256 ok = _mm256_cmp_ps(det, zero, _CMP_NEQ_UQ);
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ));
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
+        mask &= _mm256_movemask_ps(ok);
+        if (mask) {
+            const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+            const __m256 t = _mm256_mul_ps(t_scaled, inv_det);
+            const __m256 in = _mm256_and_ps(_mm256_cmp_ps(t, _mm256_set1_ps(tmin), _CMP_GT_OQ),
+                                            _mm256_cmp_ps(t, _mm256_set1_ps(tmax), _CMP_LT_OQ));
+            result = mask & _mm256_movemask_ps(in);
+            _mm256_storeu_ps(t_out, t);
+            _mm256_storeu_ps(u_out, _mm256_mul_ps(v, inv_det));
+            _mm256_storeu_ps(v_out, _mm256_mul_ps(w, inv_det));
         }
+    }
+    if (exact_zero) {
+        result |= redo_exact_zero_lanes(tr, b[0], exact_zero & 0xF, 0, tmin, tmax, t_out, u_out, v_out);
+        result |= redo_exact_zero_lanes(tr, b[1], exact_zero >> 4, 4, tmin, tmax, t_out, u_out, v_out);
     }
     return result;
 }

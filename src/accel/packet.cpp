@@ -19,13 +19,12 @@ namespace {
 /// and plane choice shared by all active rays (see packet_eligible).
 struct PacketContext {
     const RayPacket* rays;
-    const Bvh4* bvh;
     const TriangleBlock4* blocks;
     const Accelerator* accel;
     int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
     int neg[3];       ///< direction sign per axis, common to all active rays
-    int near_off[3];  ///< float offset of each axis's near planes in a Bvh4Node
-    int far_off[3];   ///< float offset of each axis's far planes
+    int near_off[3];  ///< offset of each axis's near planes in a node, in units of N floats
+    int far_off[3];   ///< offset of each axis's far planes, in units of N floats
     int first;        ///< first active lane
 };
 
@@ -50,10 +49,10 @@ bool packet_eligible(const RayPacket& p, PacketContext& c) {
     c.ky = c.kx == 2 ? 0 : c.kx + 1;
     for (int a = 0; a < 3; ++a) c.neg[a] = (key >> (2 + a)) & 1;
     if (c.neg[c.kz]) std::swap(c.kx, c.ky);  // as in TriangleRay: keeps the winding
-    // Float offsets of lo_x, hi_x, lo_y, hi_y, lo_z, hi_z in a Bvh4Node: 0, 4, ..., 20.
+    // lo_x, hi_x, lo_y, hi_y, lo_z, hi_z of an N-wide node start at N floats times 0, 1, ..., 5.
     for (int a = 0; a < 3; ++a) {
-        c.near_off[a] = 8 * a + 4 * c.neg[a];
-        c.far_off[a] = 8 * a + 4 * (1 - c.neg[a]);
+        c.near_off[a] = 2 * a + c.neg[a];
+        c.far_off[a] = 2 * a + 1 - c.neg[a];
     }
     return true;
 }
@@ -162,12 +161,13 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     if (!packet.active) return;
     PacketContext c{};
     c.rays = &packet;
-    c.bvh = &wide_;
     c.blocks = blocks_.data();
     c.accel = this;
     // Other layouts, scenes with cut-outs (the alpha test is single-ray only),
     // mixed directions and near-empty packets: single rays.
-    if (layout_ != BvhLayout::wide4 || wide_.empty || has_cutouts() || std::popcount(packet.active) < 2 ||
+    const bool wide8 = layout_ == BvhLayout::wide8;
+    const bool tree_empty = wide8 ? wide8_.empty : wide_.empty;
+    if (!layout_has_blocks(layout_) || tree_empty || has_cutouts() || std::popcount(packet.active) < 2 ||
         !packet_eligible(packet, c)) {
         for (uint32_t m = packet.active; m; m &= m - 1) {
             const int i = std::countr_zero(m);
@@ -182,13 +182,13 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     }
     switch (active_packet_simd()) {
         case PacketSimd::avx512:
-            packet_avx512::trace_packet(c, hits);
+            wide8 ? packet_avx512::trace_packet(c, wide8_, hits) : packet_avx512::trace_packet(c, wide_, hits);
             break;
         case PacketSimd::avx2:
-            packet_avx2::trace_packet(c, hits);
+            wide8 ? packet_avx2::trace_packet(c, wide8_, hits) : packet_avx2::trace_packet(c, wide_, hits);
             break;
         case PacketSimd::sse2:
-            packet_sse2::trace_packet(c, hits);
+            wide8 ? packet_sse2::trace_packet(c, wide8_, hits) : packet_sse2::trace_packet(c, wide_, hits);
             break;
     }
     for (uint32_t m = packet.active; m; m &= m - 1) {

@@ -39,9 +39,10 @@ constexpr const char* kBenchUsage =
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
     "              the camera's up axis)\n"
-    "  --layout L  traversal structure: wide4 (default: 4-wide BVH, leaf triangles tested 4 at a\n"
-    "              time), wide4-slots (4-wide BVH, one leaf slot at a time) or pairs (binary BVH);\n"
-    "              the wide layouts use AVX2 when the CPU has it, SSE2 with SAHARA_SIMD=sse2\n"
+    "  --layout L  traversal structure: wide8 (default: 8-wide BVH, leaf triangles tested 4 at a\n"
+    "              time, 8 with AVX2), wide4 (4-wide BVH), wide4-slots (4-wide BVH, one leaf slot at\n"
+    "              a time) or pairs (binary BVH); the wide layouts use the widest of AVX-512, AVX2\n"
+    "              and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a narrower one)\n"
     "  --size N    primary image side (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
@@ -60,7 +61,7 @@ struct BenchOptions {
     int threads = 1;
     std::vector<std::string> sets;
     BvhBuilder builder = BvhBuilder::binned;
-    BvhLayout layout = BvhLayout::wide4;
+    BvhLayout layout = AcceleratorOptions{}.layout;
     int size = 1024;
     int repeat = 3;
     bool embree = true;
@@ -298,8 +299,8 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--repeat must be a positive integer";
     if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), opt.builder))
         return "--builder must be binned, sweep or reinsert";
-    if (!parse_bvh_layout(args.value_or("--layout", "wide4"), opt.layout))
-        return "--layout must be wide4, wide4-slots or pairs";
+    if (!parse_bvh_layout(args.value_or("--layout", bvh_layout_name(opt.layout)), opt.layout))
+        return "--layout must be wide8, wide4, wide4-slots or pairs";
     const std::string sets = args.value_or("--rays", "all");
     if (sets == "all")
         opt.sets = {"primary", "primary_packet", "diffuse", "shadow"};

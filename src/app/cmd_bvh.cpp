@@ -21,13 +21,16 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBvhUsage =
-    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--threads N] [--size N] [--json]\n"
+    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--layout L] [--threads N] [--size N]\n"
+    "                       [--json]\n"
     "  FILE        a mesh (.obj, .gltf, .glb; OBJ polygons are fan-split, degenerate triangles kept)\n"
     "              or a scene file (.json): the tree holds its triangles, spheres, boxes and quadrics;\n"
     "              planes are unbounded, stay outside the tree and are not traced here\n"
     "  --builder   binned (default: binned SAH, parallel), sweep (exact sweep SAH) or reinsert\n"
     "              (binned SAH, then insertion-based reinsertion of the most inefficient nodes);\n"
     "              a scene file's render.bvh_builder when not given\n"
+    "  --layout L  traversal structure the counts below are taken on: wide8 (default), wide4,\n"
+    "              wide4-slots or pairs (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
     "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays;\n"
     "              a mesh is framed from (0.4, 0.3, 1), a scene is seen through its own camera\n"
@@ -67,18 +70,18 @@ nlohmann::ordered_json primitive_kinds_json(const Scene& scene) {
             {"quadrics", scene.quadrics.size()}};
 }
 
-nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuilder> chosen, int size,
-                                  int threads) {
+nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuilder> chosen, BvhLayout layout,
+                                  int size, int threads) {
     const ToolInput input = read_tool_input(file);
     const Scene& scene = input.scene;
     const BvhBuilder builder = chosen.value_or(scene.render.bvh_builder);
     AcceleratorOptions opt;
     opt.builder = builder;
+    opt.layout = layout;
     omp_set_num_threads(threads);
     const Accelerator accel(scene, opt);
-    // The SAH cost of the tree as built (the wide4 layout scales the intersection cost).
-    BvhBuildParams built = opt.params;
-    if (opt.layout == BvhLayout::wide4) built.intersection_cost *= opt.wide4_leaf_cost_scale;
+    // The SAH cost of the tree as built (the block layouts scale the intersection cost).
+    const BvhBuildParams built = opt.build_params();
     const BvhStats s = compute_bvh_stats(accel.bvh(), built);
     const BenchRaySets rays = make_bench_rays(
         scene, accel, size, size, input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
@@ -100,7 +103,7 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
         {"traversal_cost", opt.params.traversal_cost},
         {"intersection_cost", built.intersection_cost},
         {"layout", bvh_layout_name(accel.layout())},
-        {"wide4_nodes", accel.bvh4().nodes.size()},
+        {"wide_nodes", layout == BvhLayout::wide8 ? accel.bvh8().nodes.size() : accel.bvh4().nodes.size()},
         {"build_ms", accel.build_ms()},
         {"build_cpu_ms", accel.build_cpu_ms()},
         {"build_threads", threads},
@@ -117,6 +120,9 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
 void print_text(const nlohmann::ordered_json& j) {
     std::printf("%-17s %s\n", j["input"].get<std::string>().c_str(), j["mesh"].get<std::string>().c_str());
     std::printf("builder           %s\n", j["builder"].get<std::string>().c_str());
+    std::printf("layout            %s", j["layout"].get<std::string>().c_str());
+    if (j["layout"] != "pairs") std::printf(" (%zu wide nodes)", j["wide_nodes"].get<size_t>());
+    std::printf("\n");
     std::printf("primitives        %zu (%s)\n", j["primitives"].get<size_t>(),
                 j["primitive_kinds"].get<std::string>().c_str());
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
@@ -150,7 +156,7 @@ void print_text(const nlohmann::ordered_json& j) {
 int run_bvh_command(int argc, char** argv) {
     ToolArgs args;
     const std::string err =
-        parse_tool_args(argc, argv, {"--builder", "--size", "--threads"}, {"--json"}, args);
+        parse_tool_args(argc, argv, {"--builder", "--layout", "--size", "--threads"}, {"--json"}, args);
     if (!err.empty()) return usage_error("bvh", err, kBvhUsage);
     if (args.help) {
         std::fputs(kBvhUsage, stdout);
@@ -164,6 +170,9 @@ int run_bvh_command(int argc, char** argv) {
             return usage_error("bvh", "--builder must be binned, sweep or reinsert", kBvhUsage);
         builder = b;
     }
+    BvhLayout layout = AcceleratorOptions{}.layout;
+    if (args.has("--layout") && !parse_bvh_layout(args.values["--layout"], layout))
+        return usage_error("bvh", "--layout must be wide8, wide4, wide4-slots or pairs", kBvhUsage);
     int size = 1024;
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
         return usage_error("bvh", "--size must be a positive integer", kBvhUsage);
@@ -171,7 +180,7 @@ int run_bvh_command(int argc, char** argv) {
     if (args.has("--threads") && !parse_positive_int(args.values["--threads"], threads))
         return usage_error("bvh", "--threads must be a positive integer", kBvhUsage);
     try {
-        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, size, threads);
+        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, layout, size, threads);
         if (args.switches.count("--json"))
             std::printf("%s\n", j.dump().c_str());
         else

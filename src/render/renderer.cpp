@@ -36,7 +36,7 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 }
 
 /// Whether camera rays are traced as packets: the path integrator (which can
-/// take a first hit) over the wide4 BVH without cut-outs, unless
+/// take a first hit) over a block layout (wide4, wide8) without cut-outs, unless
 /// SAHARA_PACKETS=0, and only with the AVX-512 kernel: the AVX2 and SSE2
 /// kernels trace primary rays slower than single rays (`sahara bench` on the
 /// bunny, 1 thread, 2026-11-22: AVX2 packets 6.5 MRays/s CPU against about 10
@@ -44,7 +44,7 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
     return packets_enabled() && active_packet_simd() == PacketSimd::avx512 &&
-           scene.render.integrator == IntegratorType::path && accel && accel->layout() == BvhLayout::wide4 &&
+           scene.render.integrator == IntegratorType::path && accel && layout_has_blocks(accel->layout()) &&
            accel->uses_tree() && !accel->has_cutouts();
 }
 

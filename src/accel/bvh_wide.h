@@ -1,0 +1,276 @@
+#pragma once
+/// Wide BVHs (BVH4, BVH8) collapsed from the binary SAH tree: each node holds
+/// the boxes of up to N children in structure-of-arrays form, so one ray tests
+/// all children in one SIMD step (SSE for 4, AVX for 8; the SSE2 fallback tests
+/// an 8-wide node as two halves). Collapsing follows the usual "open the
+/// largest inner child" rule (Wald, Benthin and Boulos, "Getting Rid of
+/// Packets", 2008; Dammertz et al., "Shallow Bounding Volume Hierarchies", 2008).
+///
+/// Traversal is ordered: the hit children are sorted by entry distance and
+/// visited nearest first. Robustness is that of bvh_traverse.h: NaN from
+/// 0 * inf (origin on a slab plane, zero direction component) is ignored, and
+/// the far distance is enlarged by 1 + 2 gamma(3) (Ize, "Robust BVH Ray
+/// Traversal", 2013). Unused child slots hold an empty box (lo = +inf,
+/// hi = -inf), which no ray with a finite origin can hit.
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <immintrin.h>
+
+#include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
+
+namespace sahara {
+
+/// One N-wide node; child c is empty (child[c] == kNoNode, count 0), inner
+/// (count 0, child = node index) or a leaf (count > 0, child = first slot).
+template <int N>
+struct alignas(64) BvhWideNode {
+    float lo_x[N], hi_x[N], lo_y[N], hi_y[N], lo_z[N], hi_z[N];  ///< 24 N bytes of child bounds
+    uint32_t child[N];
+    uint32_t count[N];
+
+    static constexpr int kWidth = N;
+    bool has_child(int c) const { return child[c] != kNoNode; }
+};
+using Bvh4Node = BvhWideNode<4>;
+using Bvh8Node = BvhWideNode<8>;
+static_assert(sizeof(Bvh4Node) == 128, "two cache lines per node");
+static_assert(sizeof(Bvh8Node) == 256, "four cache lines per node");
+
+/// An N-wide BVH. `root` keeps the root box; a leaf root has no nodes.
+template <int N>
+struct BvhWide {
+    BvhNode root{};
+    std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>> nodes;  ///< nodes[0]: the root's children
+    bool empty = true;
+
+    size_t bytes() const { return sizeof(BvhNode) + nodes.size() * sizeof(BvhWideNode<N>); }
+};
+using Bvh4 = BvhWide<4>;
+using Bvh8 = BvhWide<8>;
+
+/// Collapses a canonical binary Bvh (slots unchanged; nodes in depth-first order).
+template <int N>
+BvhWide<N> make_bvh_wide(const Bvh& bvh);
+inline Bvh4 make_bvh4(const Bvh& bvh) { return make_bvh_wide<4>(bvh); }
+
+/// Which instruction set the wide-BVH traversal is compiled for (one body, three instantiations).
+enum class SimdPath : uint8_t {
+    sse2,    ///< baseline of every x86-64 CPU
+    avx2,    ///< VEX encoding, 8-wide node tests in one AVX step
+    avx512,  ///< the AVX2 code with AVX-512VL available: 32 vector registers, fewer spills
+};
+
+/// The path in use: the widest the CPU has, unless SAHARA_SIMD=sse2|avx2|avx512
+/// asks for a narrower one or force_simd_path() was called.
+SimdPath active_simd_path();
+/// Forces a path (tests); a path the CPU lacks falls back to the widest it has.
+void force_simd_path(SimdPath path);
+/// Whether this CPU can run the AVX2 path.
+bool cpu_has_avx2();
+/// Whether this CPU can run the AVX-512 path (F, VL, BW, DQ).
+bool cpu_has_avx512();
+/// The widest path this CPU runs.
+SimdPath best_simd_path();
+/// Every path this CPU runs, narrowest first (tests force each).
+std::vector<SimdPath> runnable_simd_paths();
+/// "sse2", "avx2" or "avx512".
+const char* simd_path_name(SimdPath path);
+
+/// Per-ray constants of the SSE box test of an N-wide node: broadcast origin and
+/// inverse direction, and the byte offsets of each axis's near and far planes in a node.
+template <int N>
+struct WideRaySse {
+    __m128 org[3], inv[3];
+    uint32_t near_off[3], far_off[3];
+
+    explicit WideRaySse(const BvhRay& r) {
+        using Node = BvhWideNode<N>;
+        const uint32_t lo[3] = {offsetof(Node, lo_x), offsetof(Node, lo_y), offsetof(Node, lo_z)};
+        const uint32_t hi[3] = {offsetof(Node, hi_x), offsetof(Node, hi_y), offsetof(Node, hi_z)};
+        for (int a = 0; a < 3; ++a) {
+            org[a] = _mm_set1_ps(r.org[a]);
+            inv[a] = _mm_set1_ps(r.inv_dir[a]);
+            // Near plane of an axis is `hi` for a negative direction.
+            near_off[a] = r.neg[a] ? hi[a] : lo[a];
+            far_off[a] = r.neg[a] ? lo[a] : hi[a];
+        }
+    }
+};
+using Bvh4Ray = WideRaySse<4>;
+
+/// Tests children [4 g, 4 g + 4) of an N-wide node with SSE; bit c of the result
+/// is set when child 4 g + c is hit, and lane c of t_near is then its entry
+/// distance. Same answers as intersect_bvh_node per child.
+template <int N>
+__attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N>& n, const WideRaySse<N>& r,
+                                                             int g, float tmin, float tmax, __m128& t_near) {
+    // _mm_max_ps(x, acc) and _mm_min_ps(x, acc) return acc when x is NaN (the NaN-ignoring order).
+    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+    const char* base = reinterpret_cast<const char*>(&n) + 16 * g;
+    for (int a = 0; a < 3; ++a) {
+        const __m128 near = _mm_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
+        const __m128 far = _mm_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
+        t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.org[a]), r.inv[a]), t0);
+        t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, r.org[a]), r.inv[a]), t1);
+    }
+    t_near = t0;
+    return _mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(kRobustFarScale))));
+}
+
+/// The four children of a BVH4 node (see intersect_wide_sse).
+__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin,
+                                                         float tmax, __m128& t_near) {
+    return intersect_wide_sse<4>(n, r, 0, tmin, tmax, t_near);
+}
+
+/// Per-ray constants of the AVX box test of an 8-wide node: origin, inverse
+/// direction and the byte offsets of each axis's near and far planes. Kept as
+/// scalars (broadcast inside the AVX2 test) so that building them needs no AVX.
+struct Bvh8RayAvx {
+    float org[3], inv[3];
+    uint32_t near_off[3], far_off[3];
+
+    __attribute__((always_inline)) explicit Bvh8RayAvx(const BvhRay& r) {
+        // lo_x, hi_x, lo_y, ... are consecutive 32-byte arrays: an axis's planes start at
+        // 64 a; the near plane is `hi` (32 bytes further) for a negative direction.
+        static_assert(offsetof(Bvh8Node, hi_x) == 32 && offsetof(Bvh8Node, lo_y) == 64);
+        for (int a = 0; a < 3; ++a) {
+            org[a] = r.org[a];
+            inv[a] = r.inv_dir[a];
+            near_off[a] = uint32_t(64 * a + 32 * r.neg[a]);
+            far_off[a] = uint32_t(64 * a + 32 * (1 - r.neg[a]));
+        }
+    }
+};
+
+/// The eight children of a BVH8 node in one AVX step: the operations of
+/// intersect_wide_sse, eight lanes wide; entry distances go to t_near[0..8).
+__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
+                                                                             const Bvh8RayAvx& r, float tmin,
+                                                                             float tmax, float* t_near) {
+    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax);
+    const char* base = reinterpret_cast<const char*>(&n);
+    for (int a = 0; a < 3; ++a) {
+        const __m256 org = _mm256_set1_ps(r.org[a]), inv = _mm256_set1_ps(r.inv[a]);
+        const __m256 near = _mm256_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
+        const __m256 far = _mm256_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
+        t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, org), inv), t0);
+        t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, org), inv), t1);
+    }
+    _mm256_store_ps(t_near, t0);
+    return _mm256_movemask_ps(_mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
+}
+
+/// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
+/// kAvx (the caller is compiled for AVX2), SSE otherwise.
+template <int N, bool kAvx>
+struct WideRay;
+template <int N>
+struct WideRay<N, false> {
+    WideRaySse<N> sse;
+    explicit WideRay(const BvhRay& r) : sse(r) {}
+    /// Tests all N children: mask of hit children, entry distances in t[0..N).
+    __attribute__((always_inline)) int test(const BvhWideNode<N>& n, float tmin, float tmax, float* t) const {
+        int mask = 0;
+        for (int g = 0; g < N / 4; ++g) {
+            __m128 tv;
+            mask |= intersect_wide_sse<N>(n, sse, g, tmin, tmax, tv) << (4 * g);
+            _mm_store_ps(t + 4 * g, tv);
+        }
+        return mask;
+    }
+};
+template <>
+struct WideRay<8, true> {
+    Bvh8RayAvx avx;
+    __attribute__((always_inline)) explicit WideRay(const BvhRay& r) : avx(r) {}
+    /// Not always_inline: GCC inlines callees into traverse_wide before traverse_wide
+    /// itself is inlined into its AVX2 caller, and refuses AVX2 code in that generic
+    /// body; as a plain inline function it is inlined once it sits in the AVX2 caller.
+    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax,
+                                                            float* t) const {
+        return intersect_bvh8_avx(n, avx, tmin, tmax, t);
+    }
+};
+
+/// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
+/// (bvh_traverse.h): the nearest hit child is visited next, the others are
+/// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2).
+template <bool kAnyHit, bool kAvx = false, int N, class Counters, class LeafFn>
+__attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray, LeafFn&& leaf,
+                                                         Counters& counters) {
+    if (bvh.empty) return false;
+    // No test of the root box: nodes[0] tests the root's children, which lie inside it.
+    if (bvh.root.is_leaf()) {
+        counters.on_prims(bvh.root.count);
+        return leaf(bvh.root.index, bvh.root.count, ray.tmax);
+    }
+    struct Entry {
+        uint32_t index;  ///< node index, or first leaf item
+        uint32_t count;  ///< 0: inner node
+        float t_entry;
+    };
+    const WideRay<N, kAvx && N == 8> rw(ray);
+    // Each node pushes at most N - 1 entries per level, plus slack.
+    Entry stack[(N - 1) * kBvhMaxDepth + 4];
+    int top = 0;
+    bool found = false;
+    Entry cur{0, 0, ray.tmin};
+    for (;;) {
+        if (cur.count) {
+            counters.on_prims(cur.count);
+            if (leaf(cur.index, cur.count, ray.tmax)) {
+                if constexpr (kAnyHit) return true;
+                found = true;
+            }
+        } else {
+            const BvhWideNode<N>& n = bvh.nodes[cur.index];
+            if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
+                for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
+            alignas(32) float t[N];
+            int mask = rw.test(n, ray.tmin, ray.tmax, t);
+            if (mask) {
+                int c = __builtin_ctz(unsigned(mask));
+                mask &= mask - 1;
+                cur = Entry{n.child[c], n.count[c], t[c]};
+                if (!mask) continue;  // one child hit: no ordering, no stack
+                // Insert the others into the stack top sorted by distance (farthest
+                // deepest); the nearest of all becomes `cur`.
+                const int base = top;
+                do {
+                    c = __builtin_ctz(unsigned(mask));
+                    mask &= mask - 1;
+                    Entry in{n.child[c], n.count[c], t[c]};
+                    if (in.t_entry < cur.t_entry) std::swap(in, cur);
+                    int k = top++;
+                    while (k > base && stack[k - 1].t_entry < in.t_entry) {
+                        stack[k] = stack[k - 1];
+                        --k;
+                    }
+                    stack[k] = in;
+                } while (mask);
+                continue;
+            }
+        }
+        // Pop the nearest pending entry that can still hold a closer hit.
+        for (;;) {
+            if (top == 0) return found;
+            cur = stack[--top];
+            if (cur.t_entry <= ray.tmax * kRobustFarScale) break;
+        }
+    }
+}
+
+/// The BVH4 traversal (traverse_wide with N = 4).
+template <bool kAnyHit, class Counters, class LeafFn>
+__attribute__((always_inline)) inline bool traverse_bvh4(const Bvh4& bvh, BvhRay& ray, LeafFn&& leaf,
+                                                         Counters& counters) {
+    return traverse_wide<kAnyHit, false>(bvh, ray, static_cast<LeafFn&&>(leaf), counters);
+}
+
+}  // namespace sahara
