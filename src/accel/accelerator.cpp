@@ -326,8 +326,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
     for (uint32_t b = first; b < end;) {
         const bool pair = kAvx && b + 1 < end;
         alignas(32) float t[8], u[8], v[8];
-        // Lanes of other kinds and padding; a step with no triangle lane (e.g. a
-        // leaf of spheres) skips the triangle test.
+        // Lanes of other kinds (not padding); a step with nothing but those (e.g. a
+        // full block of spheres) skips the triangle test.
         const int other = other_lanes(blocks_[b]) | (pair ? other_lanes(blocks_[b + 1]) << 4 : 0);
         int mask = 0;
         if (other != (pair ? 0xFF : 0xF)) {

@@ -28,7 +28,9 @@ struct alignas(16) TriangleBlock4 {
     uint32_t slot[4];
 
     static constexpr uint32_t kOtherKind = 0x80000000u;
-    static constexpr uint32_t kEmptyLane = 0xFFFFFFFFu;
+    /// Sign bit clear, so the sign-bit mask of `slot` holds exactly the other-kind lanes
+    /// (padding lanes have NaN vertices and never hit).
+    static constexpr uint32_t kEmptyLane = 0x7FFFFFFFu;
 };
 static_assert(sizeof(TriangleBlock4) == 160, "40 bytes per triangle, like a leaf slot");
 
@@ -41,7 +43,7 @@ __attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRa
     int result = 0;
     for (; lanes; lanes &= lanes - 1) {
         const int l = __builtin_ctz(unsigned(lanes));
-        if (b.slot[l] & TriangleBlock4::kOtherKind) continue;
+        if ((b.slot[l] & TriangleBlock4::kOtherKind) || b.slot[l] == TriangleBlock4::kEmptyLane) continue;
         const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
                                  {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                  {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};

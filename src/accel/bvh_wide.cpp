@@ -63,7 +63,6 @@ BvhWideNode<N> empty_node() {
     return p;
 }
 
-std::atomic<int> g_forced_path{-1};
 
 }  // namespace
 
@@ -140,19 +139,25 @@ std::vector<SimdPath> runnable_simd_paths() {
     return paths;
 }
 
-SimdPath active_simd_path() {
-    const int forced = g_forced_path.load(std::memory_order_relaxed);
-    if (forced >= 0) return SimdPath(forced);
+namespace detail {
+std::atomic<int> g_simd_path{-1};
+}  // namespace detail
+
+SimdPath init_simd_path() {
     static const SimdPath from_env = [] {
         const char* env = std::getenv("SAHARA_SIMD");
         if (env && std::strcmp(env, "sse2") == 0) return SimdPath::sse2;
         if (env && std::strcmp(env, "avx2") == 0) return supported(SimdPath::avx2);
         return best_simd_path();
     }();
-    return from_env;
+    int expected = -1;
+    detail::g_simd_path.compare_exchange_strong(expected, int(from_env), std::memory_order_relaxed);
+    return SimdPath(detail::g_simd_path.load(std::memory_order_relaxed));
 }
 
-void force_simd_path(SimdPath path) { g_forced_path.store(int(supported(path)), std::memory_order_relaxed); }
+void force_simd_path(SimdPath path) {
+    detail::g_simd_path.store(int(supported(path)), std::memory_order_relaxed);
+}
 
 const char* simd_path_name(SimdPath path) {
     return path == SimdPath::avx512 ? "avx512" : path == SimdPath::avx2 ? "avx2" : "sse2";

@@ -12,6 +12,7 @@
 /// the far distance is enlarged by 1 + 2 gamma(3) (Ize, "Robust BVH Ray
 /// Traversal", 2013). Unused child slots hold an empty box (lo = +inf,
 /// hi = -inf), which no ray with a finite origin can hit.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -65,9 +66,17 @@ enum class SimdPath : uint8_t {
     avx512,  ///< the AVX2 code with AVX-512VL available: 32 vector registers, fewer spills
 };
 
+namespace detail {
+extern std::atomic<int> g_simd_path;  ///< -1 until the first call of active_simd_path()
+}  // namespace detail
+/// Reads SAHARA_SIMD and the CPU once (behind active_simd_path()).
+SimdPath init_simd_path();
 /// The path in use: the widest the CPU has, unless SAHARA_SIMD=sse2|avx2|avx512
-/// asks for a narrower one or force_simd_path() was called.
-SimdPath active_simd_path();
+/// asks for a narrower one or force_simd_path() was called. One relaxed load per ray.
+inline SimdPath active_simd_path() {
+    const int p = detail::g_simd_path.load(std::memory_order_relaxed);
+    return p >= 0 ? SimdPath(p) : init_simd_path();
+}
 /// Forces a path (tests); a path the CPU lacks falls back to the widest it has.
 void force_simd_path(SimdPath path);
 /// Whether this CPU can run the AVX2 path.
