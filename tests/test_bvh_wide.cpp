@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -49,11 +50,12 @@ bool inside(const Bounds3& inner, const Bounds3& outer) {
     return true;
 }
 
-/// Marks the slots of one leaf (first slot or, with leaf blocks, first block; count slots).
-void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vector<int>& slot_uses) {
+/// Marks the primitives of one leaf (first slot or, with leaf blocks, first block; count
+/// slots): by slot index, or with leaf blocks by primitive id.
+void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::map<uint32_t, int>& uses) {
     if (!layout_has_blocks(acc.layout())) {
-        REQUIRE(first + count <= slot_uses.size());
-        for (uint32_t s = 0; s < count; ++s) ++slot_uses[first + s];
+        REQUIRE(first + count <= acc.primitive_count());
+        for (uint32_t s = 0; s < count; ++s) ++uses[first + s];
         return;
     }
     const auto& blocks = acc.leaf_blocks();
@@ -63,9 +65,7 @@ void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vecto
         for (uint32_t slot : blocks[b].slot) {
             if (slot == TriangleBlock4::kEmptyLane) continue;
             ++lanes;
-            slot &= ~TriangleBlock4::kOtherKind;
-            REQUIRE(slot < slot_uses.size());
-            ++slot_uses[slot];
+            ++uses[acc.lane_prim(slot)];
         }
     CHECK(lanes == count);
 }
@@ -74,7 +74,8 @@ void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::vecto
 template <int N>
 void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
     REQUIRE_FALSE(t.empty);
-    std::vector<int> slot_uses(acc.primitive_count(), 0), node_uses(t.nodes.size(), 0);
+    std::map<uint32_t, int> slot_uses;
+    std::vector<int> node_uses(t.nodes.size(), 0);
     if (t.root.is_leaf()) {
         use_leaf(acc, t.root.index, t.root.count, slot_uses);
     } else {
@@ -103,7 +104,8 @@ void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
             CHECK(children >= 2);
         }
     }
-    CHECK(std::all_of(slot_uses.begin(), slot_uses.end(), [](int u) { return u == 1; }));
+    CHECK(slot_uses.size() == acc.primitive_count());
+    CHECK(std::all_of(slot_uses.begin(), slot_uses.end(), [](const auto& u) { return u.second == 1; }));
     CHECK(std::all_of(node_uses.begin(), node_uses.end(), [](int u) { return u == 1; }));
 }
 

@@ -133,17 +133,18 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     else
         wide_ = make_bvh4(bvh_);
     if (layout_has_blocks(layout_)) {
-        // The blocks and ids_ are all the block layouts keep.
+        // The tree and the blocks are all the block layouts keep (plus others_).
         if (layout_ == BvhLayout::wide8)
             make_leaf_blocks(wide8_, ids, tris);
         else
             make_leaf_blocks(wide_, ids, tris);
-        ids_ = std::move(ids);
     } else {
         slots_.resize(slots);
         for (size_t s = 0; s < slots; ++s) slots_[s] = Slot{tris[s], ids[s]};
     }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
+    primitive_count_ = bvh_.prim_indices.size();
+    if (layout_has_blocks(layout_) && !options.keep_binary_tree) bvh_ = Bvh{};
     build_cpu_ms_ = process_cpu_ms() - cpu_start;
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -161,9 +162,14 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
                 const uint32_t slot = s + uint32_t(l);
                 const bool in_leaf = slot < first + count;
                 const bool tri = in_leaf && prim_kind(ids[slot]) == PrimKind::triangle;
-                b.slot[l] = !in_leaf ? TriangleBlock4::kEmptyLane
-                            : tri    ? slot
-                                     : slot | TriangleBlock4::kOtherKind;
+                if (!in_leaf) {
+                    b.slot[l] = TriangleBlock4::kEmptyLane;
+                } else if (tri) {
+                    b.slot[l] = ids[slot];
+                } else {
+                    b.slot[l] = uint32_t(others_.size()) | TriangleBlock4::kOtherKind;
+                    others_.push_back(ids[slot]);
+                }
                 for (int v = 0; v < 3; ++v)
                     for (int a = 0; a < 3; ++a)
                         b.p[v][a][l] = tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
@@ -184,7 +190,7 @@ size_t Accelerator::bytes() const {
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
     // The block layouts keep only the tree, the blocks (vertices) and one id per slot.
     if (layout_has_blocks(layout_))
-        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) + blocks_.size() * sizeof(TriangleBlock4) + ids_.size() * sizeof(uint32_t) +
+        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) + blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) +
                other;
     return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
            bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
@@ -303,13 +309,13 @@ __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ra
                 const int l = __builtin_ctz(unsigned(m));
                 if (t[l] < t[best]) best = l;
             }
-        if (keep_triangle_hit(ray, ids_[block_slot(first, best)], u[best], v[best])) return 1 << best;
+        if (keep_triangle_hit(ray, block_slot(first, best), u[best], v[best])) return 1 << best;
         mask &= ~(1 << best);
     }
     return 0;
 }
 
-/// Sign bits of a block's slots: its lanes of other kinds and padding.
+/// Sign bits of a block's slots: its lanes of other kinds (padding has the sign bit clear).
 inline int other_lanes(const TriangleBlock4& block) {
     return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
 }
@@ -347,13 +353,11 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
                 if (t[l] < t[best]) best = l;
             }
             tmax = t[best];
-            hit = Hit{t[best], ids_[block_slot(b, best)], u[best], v[best]};
+            hit = Hit{t[best], block_slot(b, best), u[best], v[best]};
             found = true;
         }
         for (int m = other; m; m &= m - 1) {
-            const uint32_t slot = block_slot(b, __builtin_ctz(unsigned(m)));
-            if (slot == TriangleBlock4::kEmptyLane) continue;
-            const uint32_t id = ids_[slot & ~TriangleBlock4::kOtherKind];
+            const uint32_t id = others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
             float t_other = 0.0f, u_other = 0.0f;
             if (!intersect_other(ray, id, tmax, t_other, u_other)) continue;
             if constexpr (kAnyHit) return true;
@@ -436,7 +440,7 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
     for (const TriangleBlock4& b : blocks_)
         for (int l = 0; l < 4; ++l) {
             if (b.slot[l] == TriangleBlock4::kEmptyLane) continue;
-            const uint32_t id = ids_[b.slot[l] & ~TriangleBlock4::kOtherKind];
+            const uint32_t id = lane_prim(b.slot[l]);
             float t = 0.0f, u = 0.0f, v = 0.0f;
             if (prim_kind(id) == PrimKind::triangle) {
                 const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
@@ -458,8 +462,8 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
 
 /// Packet fallback for a non-triangle lane of a leaf block (packets run only on the block layouts, without
 /// cut-outs).
-bool Accelerator::intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const {
-    const uint32_t id = ids_[slot];
+bool Accelerator::intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const {
+    const uint32_t id = others_[other];
     float t = 0.0f, u = 0.0f;
     if (!intersect_other(ray, id, ray.tmax, t, u)) return false;
     hit = Hit{t, id, u, 0.0f};

@@ -81,6 +81,9 @@ struct AcceleratorOptions {
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
+    /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
+    /// `sahara bvh` statistics); otherwise its memory is released.
+    bool keep_binary_tree = false;
 
     /// `params` as the chosen layout builds with: the block layouts scale the
     /// intersection cost and count leaves in blocks of four.
@@ -112,15 +115,18 @@ class Accelerator {
     /// wide4 and wide8, scenes with cut-outs and incoherent packets (mixed direction signs
     /// or dominant axes) are traced ray by ray.
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
-    /// Tests the non-triangle primitive in leaf slot `slot` of a block layout alone (packet
+    /// Tests the non-triangle primitive others_[other] of a block layout alone (packet
     /// fallback); on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
-    bool intersect_slot(const Ray& ray, uint32_t slot, Hit& hit) const;
-    /// Primitive id held by leaf slot `slot` (block layouts).
-    uint32_t slot_prim(uint32_t slot) const { return ids_[slot]; }
+    bool intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const;
+    /// The primitive id of a block lane (not padding).
+    uint32_t lane_prim(uint32_t lane) const {
+        return lane & TriangleBlock4::kOtherKind ? others_[lane & ~TriangleBlock4::kOtherKind] : lane;
+    }
     /// Reference answer: tests every primitive, no tree (for tests).
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
 
     Bounds3 bounds() const { return bounds_; }
+    /// The binary tree; empty for the block layouts unless AcceleratorOptions::keep_binary_tree.
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
@@ -136,7 +142,7 @@ class Accelerator {
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
-    size_t primitive_count() const { return bvh_.prim_indices.size(); }
+    size_t primitive_count() const { return primitive_count_; }
     /// Whether traversal runs the cut-out (alpha-tested) variant: the scene has
     /// triangles with a cut-out material (accel/alpha_filter.h).
     bool has_cutouts() const { return !alpha_.empty(); }
@@ -186,7 +192,7 @@ class Accelerator {
     /// Leaf slot of lane l of the blocks from `first`.
     uint32_t block_slot(uint32_t first, int l) const { return blocks_[first + uint32_t(l >> 2)].slot[l & 3]; }
 
-    Bvh bvh_;                             ///< canonical tree (statistics, validation)
+    Bvh bvh_;                             ///< the binary tree (see bvh())
     BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
     Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
     Bvh8 wide8_;                          ///< the same tree collapsed to 8-wide nodes (wide8 layout)
@@ -200,14 +206,15 @@ class Accelerator {
     };
     std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive
                                ///< bvh_.prim_indices[s]
-    /// wide4/wide8 layouts: the primitive id of each slot (the vertices live only in blocks_).
-    std::vector<uint32_t> ids_;
+    /// wide4/wide8 layouts: ids of the non-triangle lanes (a triangle lane holds its id itself).
+    std::vector<uint32_t> others_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
     AlphaFilter alpha_;              ///< cut-out triangles (empty: traversal without the alpha test)
     Bounds3 bounds_;
     bool uses_tree_ = false;
+    size_t primitive_count_ = 0;
     double build_ms_ = 0;
     double build_cpu_ms_ = 0;
 };

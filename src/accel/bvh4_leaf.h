@@ -24,7 +24,8 @@ namespace sahara {
 /// Four triangles: p[v][axis][lane] is coordinate `axis` of vertex v.
 struct alignas(16) TriangleBlock4 {
     float p[3][3][4];  ///< 144 bytes
-    /// Leaf slot of each lane; kOtherKind set for a non-triangle slot, kEmptyLane for padding.
+    /// Each lane's primitive: a triangle's prim id (kind bits zero), kOtherKind | index into the
+    /// accelerator's table of other kinds, or kEmptyLane for padding.
     uint32_t slot[4];
 
     static constexpr uint32_t kOtherKind = 0x80000000u;

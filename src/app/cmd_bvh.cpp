@@ -78,6 +78,7 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
     AcceleratorOptions opt;
     opt.builder = builder;
     opt.layout = layout;
+    opt.keep_binary_tree = true;  // for the statistics below
     omp_set_num_threads(threads);
     const Accelerator accel(scene, opt);
     // The SAH cost of the tree as built (the block layouts scale the intersection cost).
