@@ -167,6 +167,8 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
     __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
         const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
+    /// Packets over the wide8 tree with the single-ray box and leaf tests (packet_wide8.cpp).
+    __attribute__((target("avx2"))) void trace_packet8_avx2(const RayPacket& p, HitPacket& out) const;
     template <bool kAnyHit, bool kCutouts, bool kAvx>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;

@@ -144,6 +144,7 @@ struct Bvh8RayAvx {
     float org[3], inv[3];
     uint32_t near_off[3], far_off[3];
 
+    Bvh8RayAvx() = default;
     __attribute__((always_inline)) explicit Bvh8RayAvx(const BvhRay& r) {
         // lo_x, hi_x, lo_y, ... are consecutive 32-byte arrays: an axis's planes start at
         // 64 a; the near plane is `hi` (32 bytes further) for a negative direction.

@@ -3,6 +3,8 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -24,6 +26,7 @@ void set_flush_denormals(bool on) {
 struct EmbreeReference::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
+    std::atomic<int64_t> allocated{0};  ///< Embree's net allocations (its memory monitor)
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
         if (device) rtcReleaseDevice(device);
@@ -38,6 +41,13 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
     const auto start = std::chrono::steady_clock::now();
     impl_->device = rtcNewDevice(nullptr);
     if (!impl_->device) throw std::runtime_error("embree: rtcNewDevice failed");
+    rtcSetDeviceMemoryMonitorFunction(
+        impl_->device,
+        [](void* user, ssize_t bytes, bool) {
+            static_cast<Impl*>(user)->allocated.fetch_add(int64_t(bytes), std::memory_order_relaxed);
+            return true;
+        },
+        impl_.get());
     impl_->scene = rtcNewScene(impl_->device);
     if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -54,7 +64,11 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
     rtcCommitGeometry(geom);
     rtcAttachGeometry(impl_->scene, geom);
     rtcReleaseGeometry(geom);
+    const int64_t before_commit = impl_->allocated.load();
     rtcCommitScene(impl_->scene);
+    // What the build added and keeps: the BVH and its leaf triangles (the vertex and
+    // index buffers were allocated before).
+    bvh_bytes_ = size_t(std::max<int64_t>(impl_->allocated.load() - before_commit, 0));
     if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE)
         throw std::runtime_error("embree: scene build failed");
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -33,11 +33,15 @@ class EmbreeReference {
     /// Whether anything blocks the ray.
     bool occluded(const Ray& ray) const;
     double build_ms() const { return build_ms_; }
+    /// Bytes Embree's scene build allocated and kept (BVH nodes and leaf triangles,
+    /// without the vertex and index buffers), from its device memory monitor.
+    size_t bvh_bytes() const { return bvh_bytes_; }
 
    private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     double build_ms_ = 0;
+    size_t bvh_bytes_ = 0;
 };
 
 /// Sets flush-to-zero and denormals-are-zero for the calling thread (Embree's

@@ -185,7 +185,8 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
             wide8 ? packet_avx512::trace_packet(c, wide8_, hits) : packet_avx512::trace_packet(c, wide_, hits);
             break;
         case PacketSimd::avx2:
-            wide8 ? packet_avx2::trace_packet(c, wide8_, hits) : packet_avx2::trace_packet(c, wide_, hits);
+            // 8-wide nodes: one AVX box test per ray and child set beats 16 rays per box in two halves.
+            wide8 ? trace_packet8_avx2(packet, hits) : packet_avx2::trace_packet(c, wide_, hits);
             break;
         case PacketSimd::sse2:
             wide8 ? packet_sse2::trace_packet(c, wide8_, hits) : packet_sse2::trace_packet(c, wide_, hits);

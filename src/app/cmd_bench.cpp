@@ -186,7 +186,11 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"build_threads", opt.threads},
         {"mprims_s", double(accel.primitive_count()) / std::max(accel.build_ms() * 1e3, 1e-9)},
         {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
-    if (embree) j["embree_build_ms"] = embree->build_ms();
+    if (embree) {
+        j["embree_build_ms"] = embree->build_ms();
+        j["embree_bvh_bytes_per_primitive"] =
+            double(embree->bvh_bytes()) / double(std::max<size_t>(accel.primitive_count(), 1));
+    }
     for (const std::string& set : opt.sets) {
         if (set == "primary_packet") {
             j["rays"][set] = bench_packet_set(mesh, accel, embree.get(), rays.primary, opt);
@@ -212,8 +216,10 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms")) std::printf(", Embree %.1f ms", j["embree_build_ms"].get<double>());
-    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)\n",
-                j["tree_bytes_per_primitive"].get<double>());
+    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)", j["tree_bytes_per_primitive"].get<double>());
+    if (j.contains("embree_bvh_bytes_per_primitive"))
+        std::printf(", Embree %.1f (what its build allocated)", j["embree_bvh_bytes_per_primitive"].get<double>());
+    std::printf("\n");
     const bool embree = j.contains("embree_build_ms");
     if (!embree) std::printf("Embree      %s\n", j["embree"].get<std::string>().c_str());
     std::printf("%-14s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");

@@ -23,6 +23,7 @@ struct TriangleRay {
     int kx = 0, ky = 1, kz = 2;    ///< axis permutation: kz = dominant direction axis
     float sx = 0, sy = 0, sz = 1;  ///< shear constants
 
+    TriangleRay() = default;
     __attribute__((always_inline)) explicit TriangleRay(const Ray& ray) {
         org[0] = ray.origin.x;
         org[1] = ray.origin.y;

@@ -37,15 +37,20 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 
 /// Whether camera rays are traced as packets: the path integrator (which can
 /// take a first hit) over a block layout (wide4, wide8) without cut-outs, unless
-/// SAHARA_PACKETS=0, and only with the AVX-512 kernel: the AVX2 and SSE2
-/// kernels trace primary rays slower than single rays (`sahara bench` on the
-/// bunny, 1 thread, 2026-11-22: AVX2 packets 6.5 MRays/s CPU against about 10
-/// for single rays; AVX-512 packets 17-23), so they stay for tests and bench.
+/// SAHARA_PACKETS=0, with the AVX-512 kernel or the AVX2 wide8 kernel
+/// (packet_wide8.cpp). The AVX2 kernel on wide4 and the SSE2 kernel trace
+/// primary rays slower than single rays (`sahara bench` on the bunny, 1 thread,
+/// 2026-11-22: AVX2 wide4 packets 6.5 MRays/s CPU against about 10 for single
+/// rays), so they stay for tests and bench. On wide8 with AVX2 (2026-11-25,
+/// AMD EPYC, `sahara bench stanford-bunny.obj --threads 1 --size 512`): packets
+/// 9.8 MRays/s against 9.3 for single rays.
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
-    return packets_enabled() && active_packet_simd() == PacketSimd::avx512 &&
-           scene.render.integrator == IntegratorType::path && accel && layout_has_blocks(accel->layout()) &&
-           accel->uses_tree() && !accel->has_cutouts();
+    if (!packets_enabled() || scene.render.integrator != IntegratorType::path || !accel ||
+        !layout_has_blocks(accel->layout()) || !accel->uses_tree() || accel->has_cutouts())
+        return false;
+    const PacketSimd simd = active_packet_simd();
+    return simd == PacketSimd::avx512 || (simd == PacketSimd::avx2 && accel->layout() == BvhLayout::wide8);
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4

@@ -1,0 +1,85 @@
+#pragma once
+// The leaf-block tests of Accelerator (definitions of its always-inline member
+// templates), shared by the single-ray traversal (accelerator.cpp) and the
+// wide8 packet traversal (packet_wide8.cpp). Include only from those.
+#include <immintrin.h>
+
+#include "accel/accelerator.h"
+#include "accel/bvh4_leaf.h"
+
+namespace sahara {
+
+template <bool kAnyHit>
+__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray, uint32_t first, int mask,
+                                                                        const float* t, const float* u,
+                                                                        const float* v) const {
+    // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
+    while (mask) {
+        int best = __builtin_ctz(unsigned(mask));
+        if constexpr (!kAnyHit)
+            for (int m = mask & (mask - 1); m; m &= m - 1) {
+                const int l = __builtin_ctz(unsigned(m));
+                if (t[l] < t[best]) best = l;
+            }
+        if (keep_triangle_hit(ray, block_slot(first, best), u[best], v[best])) return 1 << best;
+        mask &= ~(1 << best);
+    }
+    return 0;
+}
+
+/// Sign bits of a block's slots: its lanes of other kinds (padding has the sign bit clear).
+inline int other_lanes(const TriangleBlock4& block) {
+    return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+}
+
+/// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
+/// time (kAvx: eight, two blocks per step), other kinds through intersect_other;
+/// the closest hit lowers `tmax`. Ties keep the earlier lane, as one block at a time would.
+template <bool kAnyHit, bool kCutouts, bool kAvx>
+__attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& ray, const TriangleRay& tr,
+                                                                    uint32_t first, uint32_t count,
+                                                                    float& tmax, Hit& hit) const {
+    bool found = false;
+    const uint32_t end = first + (count + 3) / 4;
+    for (uint32_t b = first; b < end;) {
+        const bool pair = kAvx && b + 1 < end;
+        alignas(32) float t[8], u[8], v[8];
+        // Lanes of other kinds (not padding); a step with nothing but those (e.g. a
+        // full block of spheres) skips the triangle test.
+        const int other = other_lanes(blocks_[b]) | (pair ? other_lanes(blocks_[b + 1]) << 4 : 0);
+        int mask = 0;
+        if (other != (pair ? 0xFF : 0xF)) {
+            if constexpr (kAvx)
+                mask = pair ? intersect_triangle_blocks2_avx(tr, &blocks_[b], ray.tmin, tmax, t, u, v)
+                            : intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
+            else
+                mask = intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
+        }
+        if constexpr (kCutouts)
+            if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
+        if (mask) {
+            if constexpr (kAnyHit) return true;
+            int best = __builtin_ctz(unsigned(mask));
+            for (int m = mask & (mask - 1); m; m &= m - 1) {
+                const int l = __builtin_ctz(unsigned(m));
+                if (t[l] < t[best]) best = l;
+            }
+            tmax = t[best];
+            hit = Hit{t[best], block_slot(b, best), u[best], v[best]};
+            found = true;
+        }
+        for (int m = other; m; m &= m - 1) {
+            const uint32_t id = others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
+            float t_other = 0.0f, u_other = 0.0f;
+            if (!intersect_other(ray, id, tmax, t_other, u_other)) continue;
+            if constexpr (kAnyHit) return true;
+            tmax = t_other;
+            hit = Hit{t_other, id, u_other, 0.0f};
+            found = true;
+        }
+        b += pair ? 2 : 1;
+    }
+    return found;
+}
+
+}  // namespace sahara
