@@ -137,7 +137,7 @@ class Accelerator {
     /// The 8-wide tree (empty unless the layout is wide8; a leaf's child index is its first block).
     const Bvh8& bvh8() const { return wide8_; }
     /// Leaf triangle blocks of the wide4 and wide8 layouts (empty for the other layouts).
-    const std::vector<TriangleBlock4>& leaf_blocks() const { return blocks_; }
+    const auto& leaf_blocks() const { return blocks_; }
     /// Elapsed build time (BVH, pair layout, leaf-ordered primitive copies).
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
@@ -198,7 +198,7 @@ class Accelerator {
     BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
     Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
     Bvh8 wide8_;                          ///< the same tree collapsed to 8-wide nodes (wide8 layout)
-    std::vector<TriangleBlock4> blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
+    std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>> blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
     BvhLayout layout_ = BvhLayout::wide4;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).

@@ -40,7 +40,14 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");
 
-/// Minimal allocator returning `Align`-byte aligned storage.
+/// Allocations of at least this size are 2 MiB aligned and marked for
+/// transparent huge pages: traversal jumps across node and leaf arrays of
+/// several MiB, and with 4 KiB pages nearly every node visit also misses the TLB.
+inline constexpr size_t kHugePageBytes = size_t(2) << 20;
+/// Marks [p, p + bytes) for transparent huge pages (a hint; no effect where unsupported).
+void advise_huge_pages(void* p, size_t bytes);
+
+/// Minimal allocator returning `Align`-byte aligned storage (huge pages for big arrays).
 template <class T, size_t Align>
 struct AlignedAllocator {
     using value_type = T;
@@ -51,8 +58,16 @@ struct AlignedAllocator {
     AlignedAllocator() = default;
     template <class U>
     AlignedAllocator(const AlignedAllocator<U, Align>&) {}
-    T* allocate(size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align))); }
-    void deallocate(T* p, size_t) { ::operator delete(p, std::align_val_t(Align)); }
+    static constexpr size_t alignment(size_t bytes) {
+        return bytes >= kHugePageBytes && Align < kHugePageBytes ? kHugePageBytes : Align;
+    }
+    T* allocate(size_t n) {
+        const size_t bytes = n * sizeof(T);
+        void* p = ::operator new(bytes, std::align_val_t(alignment(bytes)));
+        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, bytes);
+        return static_cast<T*>(p);
+    }
+    void deallocate(T* p, size_t n) { ::operator delete(p, std::align_val_t(alignment(n * sizeof(T)))); }
     friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
 };
 
