@@ -67,3 +67,42 @@ TEST_CASE("sphere: the 20-minutes ground (radius 1e6) is hit within 1e-4 of its 
     }
     CHECK(hits == 20000);
 }
+
+TEST_CASE("sphere: the float pre-test never rejects a ray whose line meets the sphere") {
+    // Lines at distance r (1 + delta) from the centre, delta from -1e-3 to +1e-3
+    // down to 1e-9, for radii 1e-3 .. 1e6, centres up to 1e4 from the origin and
+    // ray origins up to 1e3 radii away: a line inside the sphere (in long double)
+    // must never be rejected; lines well outside must be (the test pays off).
+    Pcg32 rng(11);
+    int inside = 0, outside_rejected = 0, outside = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const float r = std::pow(10.0f, -3.0f + 9.0f * rng.next_float());
+        const Vec3 c(1e4f * (rng.next_float() - 0.5f), 1e4f * (rng.next_float() - 0.5f),
+                     1e4f * (rng.next_float() - 0.5f));
+        const Vec3 axis = normalize(Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+        const Vec3 side = normalize(cross(axis, std::fabs(axis.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
+        const float mag = std::pow(10.0f, -9.0f + 6.0f * rng.next_float());
+        const float delta = (rng.next_float() < 0.5f ? -mag : mag) * (i % 10 == 0 ? 1e3f : 1.0f);
+        const float back = r * std::pow(10.0f, 3.0f * rng.next_float());
+        const Vec3 origin = c + side * (r * (1.0f + delta)) - axis * back;
+        const Vec3 dir = axis * std::pow(10.0f, -2.0f + 4.0f * rng.next_float());
+        // The line's distance from the centre with the float inputs as given, in long double.
+        using LD = long double;
+        const LD fx = LD(origin.x) - c.x, fy = LD(origin.y) - c.y, fz = LD(origin.z) - c.z;
+        const LD dd = LD(dir.x) * dir.x + LD(dir.y) * dir.y + LD(dir.z) * dir.z;
+        const LD b = (fx * dir.x + fy * dir.y + fz * dir.z) / dd;
+        const LD px = fx - b * dir.x, py = fy - b * dir.y, pz = fz - b * dir.z;
+        const LD dist = std::sqrt(px * px + py * py + pz * pz);
+        const bool rejected = sphere_clearly_missed(make_ray(origin, dir), c, r);
+        if (dist <= LD(r)) {
+            ++inside;
+            if (rejected) FAIL_CHECK("rejected a line inside the sphere: r " << r << " dist/r " << double(dist / r));
+        } else if (dist > 1.5L * r && std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z) < 1e3f * r) {
+            ++outside;
+            outside_rejected += rejected;
+        }
+    }
+    CHECK(inside > 50000);
+    CHECK(outside > 100);
+    CHECK(outside_rejected == outside);
+}
