@@ -6,7 +6,7 @@
 /// moved in place, read sequentially.
 ///
 /// Parallelism: ranges above kParallelScanThreshold are binned and partitioned
-/// as kScanChunks OpenMP tasks (stable partition through a second buffer), the
+/// as kScanChunks OpenMP tasks (stable partition into the other of two buffers), the
 /// subtrees above params.parallel_threshold are tasks. The chunks do not depend
 /// on the thread count, and every node owns a fixed region of the node array
 /// (compacted at the end), so the tree is the same for any thread count.
@@ -16,7 +16,6 @@
 #include <xmmintrin.h>
 
 #include <algorithm>
-#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -118,10 +117,12 @@ struct Split {
     Bounds3 left, right;
 };
 
-/// A node's work item: its primitives, box and centroid bounds.
+/// A node's work item: its primitives, box and centroid bounds, and the buffer that
+/// holds the primitives (a parallel partition moves them to the other buffer).
 struct Range {
     uint32_t begin = 0, end = 0;
     Bounds3 box, centroids;
+    PrimRef* refs = nullptr;
 };
 
 /// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
@@ -162,7 +163,6 @@ class BinnedBuild {
             build(0, Bvh::kFirstPair, root, 0);
         }
         compact();
-        for (uint32_t i = 0; i < n_; ++i) out_.prim_indices[i] = refs_[i].id;
     }
 
    private:
@@ -185,7 +185,7 @@ class BinnedBuild {
         });
         Box4 box, cent;
         for (uint32_t c = 0; c < kScanChunks; ++c) box.extend(boxes[c]), cent.extend(cents[c]);
-        return Range{0, n_, box.bounds(), cent.bounds()};
+        return Range{0, n_, box.bounds(), cent.bounds(), refs_.get()};
     }
 
     /// Builds the subtree of `r` at node `slot`; its descendants go to the 2 * n - 2 slots from `region`.
@@ -197,6 +197,7 @@ class BinnedBuild {
         if (n == 1 || !split(r, depth, left, right)) {
             node.index = r.begin;
             node.count = n;
+            for (uint32_t i = r.begin; i < r.end; ++i) out_.prim_indices[i] = r.refs[i].id;
             return;
         }
         used_pairs_[region / 2] = 1;
@@ -225,7 +226,7 @@ class BinnedBuild {
         if (n <= kParallelScanThreshold) {
             thread_local Bins all;  // not used across a task scheduling point
             all.clear(bins);
-            fill_bins(r.begin, r.end, map, all);
+            fill_bins(r.refs, r.begin, r.end, map, all);
             best = find_split(all, map);
             if (best.axis < 0) return !may_be_leaf && median_split(r, left, right);
             if (may_be_leaf && is_leaf_cheaper(r, n, best)) return false;
@@ -234,7 +235,7 @@ class BinnedBuild {
             std::vector<Bins> parts(kScanChunks);
             for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
                 parts[c].clear(bins);
-                fill_bins(b, e, map, parts[c]);
+                fill_bins(r.refs, b, e, map, parts[c]);
             });
             auto all = std::make_unique<Bins>();
             all->clear(bins);
@@ -254,9 +255,9 @@ class BinnedBuild {
         return params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + s.cost;
     }
 
-    void fill_bins(uint32_t begin, uint32_t end, const BinMap& map, Bins& out) const {
+    static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
         for (uint32_t i = begin; i < end; ++i) {
-            const PrimRef& p = refs_[i];
+            const PrimRef& p = refs[i];
             alignas(16) int32_t k[4];
             _mm_store_si128(reinterpret_cast<__m128i*>(k),
                             _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(p.c), map.lo), map.scale)));
@@ -326,8 +327,8 @@ class BinnedBuild {
 
     /// In-place partition of a short range; accumulates the children's centroid bounds.
     void partition_serial(const Range& r, const BinMap& map, const Split& s, Range& left, Range& right) {
-        PrimRef* lo = &refs_[r.begin];
-        PrimRef* hi = &refs_[r.end];
+        PrimRef* lo = &r.refs[r.begin];
+        PrimRef* hi = &r.refs[r.end];
         Box4 lc, rc;
         const int axis = s.axis;
         for (;;) {
@@ -340,12 +341,13 @@ class BinnedBuild {
             --hi;
             rc.extend(_mm_load_ps(hi->c));
         }
-        const auto mid = uint32_t(lo - refs_.get());
+        const auto mid = uint32_t(lo - r.refs);
         left.begin = r.begin;
         left.end = right.begin = mid;
         right.end = r.end;
         left.centroids = lc.bounds();
         right.centroids = rc.bounds();
+        left.refs = right.refs = r.refs;
     }
 
     /// Stable partition of a long range through scratch_, chunk by chunk: each chunk's
@@ -366,22 +368,19 @@ class BinnedBuild {
             rsum += (ce - cb) - lcount;
         }
         Box4 lc[kScanChunks], rc[kScanChunks];
-        PrimRef* scratch = scratch_.get();
+        PrimRef* const to = r.refs == refs_.get() ? scratch_.get() : refs_.get();
         for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
             uint32_t l = left_at[c], h = right_at[c];
             for (uint32_t i = b; i < e; ++i) {
-                const PrimRef& p = refs_[i];
+                const PrimRef& p = r.refs[i];
                 if (map.bin(p, s.axis) < s.pos) {
-                    scratch[l++] = p;
+                    to[l++] = p;
                     lc[c].extend(_mm_load_ps(p.c));
                 } else {
-                    scratch[h++] = p;
+                    to[h++] = p;
                     rc[c].extend(_mm_load_ps(p.c));
                 }
             }
-        });
-        for_chunks(r.begin, r.end, [&](uint32_t, uint32_t b, uint32_t e) {
-            std::memcpy(&refs_[b], &scratch[b], size_t(e - b) * sizeof(PrimRef));
         });
         Box4 lall, rall;
         for (uint32_t c = 0; c < kScanChunks; ++c) lall.extend(lc[c]), rall.extend(rc[c]);
@@ -390,6 +389,7 @@ class BinnedBuild {
         right.end = r.end;
         left.centroids = lall.bounds();
         right.centroids = rall.bounds();
+        left.refs = right.refs = to;
     }
 
     /// Object median on the widest centroid axis (below kBvhMedianSplitDepth, or when no
@@ -397,22 +397,22 @@ class BinnedBuild {
     bool median_split(const Range& r, Range& left, Range& right) {
         const int axis = max_dimension(r.centroids.extent());
         const uint32_t mid = r.begin + (r.end - r.begin) / 2;
-        std::nth_element(&refs_[r.begin], &refs_[mid], &refs_[r.end],
+        std::nth_element(&r.refs[r.begin], &r.refs[mid], &r.refs[r.end],
                          [axis](const PrimRef& a, const PrimRef& b) {
                              return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.id < b.id);
                          });
-        scan(r.begin, mid, left);
-        scan(mid, r.end, right);
+        scan(r.refs, r.begin, mid, left);
+        scan(r.refs, mid, r.end, right);
         return true;
     }
 
-    void scan(uint32_t begin, uint32_t end, Range& out) const {
+    static void scan(PrimRef* refs, uint32_t begin, uint32_t end, Range& out) {
         Box4 box, cent;
         for (uint32_t i = begin; i < end; ++i) {
-            box.extend(load_lo(refs_[i]), _mm_load_ps(refs_[i].hi));
-            cent.extend(_mm_load_ps(refs_[i].c));
+            box.extend(load_lo(refs[i]), _mm_load_ps(refs[i].hi));
+            cent.extend(_mm_load_ps(refs[i].c));
         }
-        out = Range{begin, end, box.bounds(), cent.bounds()};
+        out = Range{begin, end, box.bounds(), cent.bounds(), refs};
     }
 
     /// Primitive count rounded up to whole leaf blocks (what a leaf of n actually tests).
