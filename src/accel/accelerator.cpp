@@ -2,6 +2,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 
@@ -13,19 +14,22 @@ namespace sahara {
 
 namespace {
 
+/// Loops over fewer items than this stay serial (a parallel region costs more).
+constexpr int64_t kParallelLoopMin = 8192;
+
 /// The builder's view of the scene: one box, one centre and one id per primitive.
 struct PrimitiveList {
     std::vector<Bounds3> boxes;
     std::vector<Vec3> centers;
     std::vector<uint32_t> ids;
 
-    void add(const Bounds3& b, uint32_t id) {
+    void set(size_t k, const Bounds3& b, uint32_t id) {
         // A primitive with non-finite coordinates can never be hit; give it an
         // empty box (ignored by node bounds) and a harmless centre.
         const bool finite = is_finite(b.lo) && is_finite(b.hi);
-        boxes.push_back(finite ? b : Bounds3{});
-        centers.push_back(finite ? b.center() : Vec3(0.0f));
-        ids.push_back(id);
+        boxes[k] = finite ? b : Bounds3{};
+        centers[k] = finite ? b.center() : Vec3(0.0f);
+        ids[k] = id;
     }
 };
 
@@ -33,21 +37,24 @@ PrimitiveList collect_primitives(const Scene& scene) {
     PrimitiveList list;
     const TriangleSoup& soup = scene.triangles;
     const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
-    list.boxes.reserve(n);
-    list.centers.reserve(n);
-    list.ids.reserve(n);
-    for (uint32_t i = 0; i < soup.size(); ++i) {
+    list.boxes.resize(n);
+    list.centers.resize(n);
+    list.ids.resize(n);
+    const auto triangles = int64_t(soup.size());
+#pragma omp parallel for schedule(static) if (triangles > kParallelLoopMin)
+    for (int64_t i = 0; i < triangles; ++i) {
         Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(soup.positions[soup.indices[3 * i + k]]);
-        list.add(b, make_prim_id(PrimKind::triangle, i));
+        for (int k = 0; k < 3; ++k) b.extend(soup.positions[soup.indices[3 * size_t(i) + size_t(k)]]);
+        list.set(size_t(i), b, make_prim_id(PrimKind::triangle, uint32_t(i)));
     }
+    size_t k = soup.size();
     for (uint32_t i = 0; i < scene.spheres.size(); ++i)
-        list.add(scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
+        list.set(k++, scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
                  make_prim_id(PrimKind::sphere, i));
     for (uint32_t i = 0; i < scene.boxes.size(); ++i)
-        list.add(scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+        list.set(k++, scene.boxes[i].box, make_prim_id(PrimKind::box, i));
     for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
-        list.add(scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
+        list.set(k++, scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
 }
 
@@ -118,6 +125,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     std::vector<uint32_t> ids(slots);
     std::vector<TriangleVerts> tris(slots);
     const TriangleSoup& soup = scene.triangles;
+#pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
     for (size_t s = 0; s < slots; ++s) {
         ids[s] = prims.ids[bvh_.prim_indices[s]];
         tris[s] = TriangleVerts{};
@@ -152,13 +160,25 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 
 /// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
 /// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
+/// The blocks are in node order, leaves numbered by a serial prefix sum, filled in parallel.
 template <int N>
 void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                                    const std::vector<TriangleVerts>& tris) {
-    auto add_leaf = [&](uint32_t first, uint32_t count) {
-        const auto block = uint32_t(blocks_.size());
-        for (uint32_t s = first; s < first + count; s += 4) {
-            TriangleBlock4 b{};
+    // Non-triangle slots get consecutive entries of others_ in slot order (fixed
+    // before the parallel fill, so the result does not depend on the threads).
+    std::vector<uint32_t> other_rank;
+    const size_t other_count = size_t(std::count_if(
+        ids.begin(), ids.end(), [](uint32_t id) { return prim_kind(id) != PrimKind::triangle; }));
+    if (other_count) {
+        other_rank.resize(ids.size());
+        uint32_t k = 0;
+        for (size_t s = 0; s < ids.size(); ++s)
+            if (prim_kind(ids[s]) != PrimKind::triangle) other_rank[s] = k++;
+    }
+    others_.assign(other_count, 0);
+    auto fill_leaf = [&](uint32_t first, uint32_t count, uint32_t block) {
+        for (uint32_t s = first; s < first + count; s += 4, ++block) {
+            TriangleBlock4& b = blocks_[block];
             for (int l = 0; l < 4; ++l) {
                 const uint32_t slot = s + uint32_t(l);
                 const bool in_leaf = slot < first + count;
@@ -168,31 +188,53 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
                 } else if (tri) {
                     b.slot[l] = ids[slot];
                 } else {
-                    b.slot[l] = uint32_t(others_.size()) | TriangleBlock4::kOtherKind;
-                    others_.push_back(ids[slot]);
+                    b.slot[l] = other_rank[slot] | TriangleBlock4::kOtherKind;
+                    others_[other_rank[slot]] = ids[slot];
                 }
                 for (int v = 0; v < 3; ++v)
                     for (int a = 0; a < 3; ++a)
                         b.p[v][a][l] = tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
             }
-            blocks_.push_back(b);
         }
-        return block;
     };
+    auto blocks_of = [](uint32_t count) { return (count + 3) / 4; };
     if (tree.empty) return;
-    if (tree.root.is_leaf()) tree.root.index = add_leaf(tree.root.index, tree.root.count);
-    for (BvhWideNode<N>& n : tree.nodes)
+    if (tree.root.is_leaf()) {
+        const auto block = uint32_t(blocks_.size());
+        blocks_.resize(block + blocks_of(tree.root.count));
+        fill_leaf(tree.root.index, tree.root.count, block);
+        tree.root.index = block;
+        return;
+    }
+    const auto nodes = int64_t(tree.nodes.size());
+    std::vector<uint32_t> first_block(tree.nodes.size());
+    auto total = uint32_t(blocks_.size());
+    for (int64_t i = 0; i < nodes; ++i) {
+        first_block[size_t(i)] = total;
+        for (int c = 0; c < N; ++c) total += blocks_of(tree.nodes[size_t(i)].count[c]);
+    }
+    blocks_.resize(total);
+#pragma omp parallel for schedule(static) if (nodes > kParallelLoopMin / N)
+    for (int64_t i = 0; i < nodes; ++i) {
+        BvhWideNode<N>& n = tree.nodes[size_t(i)];
+        uint32_t block = first_block[size_t(i)];
         for (int c = 0; c < N; ++c)
-            if (n.count[c]) n.child[c] = add_leaf(n.child[c], n.count[c]);
+            if (n.count[c]) {
+                fill_leaf(n.child[c], n.count[c], block);
+                n.child[c] = block;
+                block += blocks_of(n.count[c]);
+            }
+    }
 }
 
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
-    // The block layouts keep only the tree, the blocks (vertices) and one id per slot.
+    // The block layouts keep only the tree, the blocks (vertices and triangle ids) and the
+    // ids of other kinds.
     if (layout_has_blocks(layout_))
-        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) + blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) +
-               other;
+        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) +
+               blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) + other;
     return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
            bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
 }
@@ -311,17 +353,23 @@ bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
         const SimdPath path = active_simd_path();
         const bool blocks = layout_ != BvhLayout::wide4_slots;
         if (layout_ == BvhLayout::wide8) {
-            if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
-            if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            if (path == SimdPath::avx512)
+                return trace_wide_avx512<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            if (path == SimdPath::avx2)
+                return trace_wide_avx2<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
             return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
         }
         if (blocks) {
-            if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
-            if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+            if (path == SimdPath::avx512)
+                return trace_wide_avx512<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+            if (path == SimdPath::avx2)
+                return trace_wide_avx2<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
             return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
         }
-        if (path == SimdPath::avx512) return trace_wide_avx512<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
-        if (path == SimdPath::avx2) return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+        if (path == SimdPath::avx512)
+            return trace_wide_avx512<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+        if (path == SimdPath::avx2)
+            return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
         return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
     }
     const TriangleRay tr(ray);

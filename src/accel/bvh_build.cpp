@@ -1,10 +1,8 @@
 /// Top-down SAH builders (MacDonald and Booth, "Heuristics for ray tracing
-/// using space subdivision", 1990). The binned builder follows Wald, "On fast
-/// Construction of SAH-based Bounding Volume Hierarchies" (2007): centroids are
-/// binned per axis and only the bin boundaries are evaluated. The sweep
-/// builder evaluates every split of the centroid-sorted primitives on every
-/// axis (exact object-split SAH), O(n log^2 n); it exists to measure how much
-/// quality binning gives away.
+/// using space subdivision", 1990). The binned builder is in bvh_binned.cpp.
+/// The sweep builder (here) evaluates every split of the centroid-sorted
+/// primitives on every axis (exact object-split SAH), O(n log^2 n); it exists
+/// to measure how much quality binning gives away.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -12,6 +10,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_binned.h"
 
 namespace sahara {
 
@@ -20,20 +19,14 @@ namespace {
 /// The chosen partition of a node's range.
 struct Split {
     int axis = -1;           ///< -1: no valid split found
-    uint32_t pos = 0;        ///< binned: first bin of the right side; sweep: primitives on the left
+    uint32_t pos = 0;        ///< primitives on the left
     float cost = kInfinity;  ///< unnormalised: traversal * A + intersection * sum(A_child * n_child)
-};
-
-/// A centroid bin: bounds and primitive count.
-struct Bin {
-    Bounds3 box;
-    uint32_t count = 0;
 };
 
 class BvhBuildJob {
    public:
-    BvhBuildJob(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params, Bvh& out)
-        : in_(input), builder_(builder), params_(params), out_(out) {}
+    BvhBuildJob(const BvhBuildInput& input, const BvhBuildParams& params, Bvh& out)
+        : in_(input), params_(params), out_(out) {}
 
     void run() {
         const auto n = uint32_t(in_.boxes.size());
@@ -122,100 +115,13 @@ class BvhBuildJob {
         const uint32_t n = end - begin;
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return may_be_leaf ? begin : median_split(begin, end, centroids);
-        const Split split = builder_ == BvhBuilder::binned ? find_binned_split(begin, end, centroids)
-                                                           : find_sweep_split(begin, end, centroids);
+        const Split split = find_sweep_split(begin, end, centroids);
         if (split.axis < 0) return may_be_leaf ? begin : median_split(begin, end, centroids);
         const float area = box.surface_area();
         const float leaf_cost = params_.intersection_cost * blocked(n) * area;
         const float split_cost = params_.traversal_cost * area + split.cost;
         if (may_be_leaf && leaf_cost <= split_cost) return begin;
-        return builder_ == BvhBuilder::binned ? partition_binned(begin, end, centroids, split)
-                                              : partition_sweep(begin, end, split);
-    }
-
-    // ---- binned SAH ------------------------------------------------------
-
-    uint32_t bin_of(float c, float lo, float scale) const {
-        const auto b = int((c - lo) * scale);
-        return uint32_t(std::clamp(b, 0, int(params_.bin_count) - 1));
-    }
-
-    /// One pass over [begin, end) fills the bins of all three axes (3 x bin_count, cleared by the caller).
-    void fill_bins(uint32_t begin, uint32_t end, const float lo[3], const float scale[3], Bin* bins) const {
-        for (uint32_t i = begin; i < end; ++i) {
-            const uint32_t p = out_.prim_indices[i];
-            for (int axis = 0; axis < 3; ++axis) {
-                Bin& target = bins[size_t(axis) * params_.bin_count +
-                                   bin_of(in_.centers[p][axis], lo[axis], scale[axis])];
-                target.box.extend(in_.boxes[p]);
-                ++target.count;
-            }
-        }
-    }
-
-    Split find_binned_split(uint32_t begin, uint32_t end, const Bounds3& centroids) const {
-        const uint32_t bins = params_.bin_count;
-        Split best;
-        float right_area[64];
-        uint32_t right_count[64];
-        float lo[3], scale[3];
-        for (int axis = 0; axis < 3; ++axis) {
-            const float extent = centroids.hi[axis] - centroids.lo[axis];
-            lo[axis] = centroids.lo[axis];
-            scale[axis] = extent > 0.0f ? float(bins) / extent : 0.0f;
-        }
-        // Only 3 * bins entries are cleared (a fixed 3 x 64 array would be cleared whole at every
-        // node). Not used across for_chunks' taskwait, where this thread may run another node.
-        thread_local std::vector<Bin> all_bins;
-        const size_t per_chunk = 3 * size_t(bins);
-        if (end - begin <= kParallelScanThreshold) {
-            all_bins.assign(per_chunk, Bin{});
-            fill_bins(begin, end, lo, scale, all_bins.data());
-        } else {
-            std::vector<Bin> parts(kScanChunks * per_chunk);
-            for_chunks(begin, end, [&](uint32_t c, uint32_t b, uint32_t e) {
-                fill_bins(b, e, lo, scale, &parts[c * per_chunk]);
-            });
-            all_bins.assign(per_chunk, Bin{});
-            for (uint32_t c = 0; c < kScanChunks; ++c)
-                for (size_t k = 0; k < per_chunk; ++k) {
-                    all_bins[k].box.extend(parts[c * per_chunk + k].box);
-                    all_bins[k].count += parts[c * per_chunk + k].count;
-                }
-        }
-        for (int axis = 0; axis < 3; ++axis) {
-            if (!(scale[axis] > 0.0f)) continue;
-            const Bin* bin = &all_bins[size_t(axis) * bins];
-            // find_best_split: suffix sweep from the right, then prefix sweep from the left.
-            Bounds3 acc;
-            uint32_t cnt = 0;
-            for (uint32_t b = bins - 1; b > 0; --b) {
-                acc.extend(bin[b].box);
-                cnt += bin[b].count;
-                right_area[b] = acc.surface_area();
-                right_count[b] = cnt;
-            }
-            acc = Bounds3{};
-            cnt = 0;
-            for (uint32_t b = 1; b < bins; ++b) {
-                acc.extend(bin[b - 1].box);
-                cnt += bin[b - 1].count;
-                if (cnt == 0 || right_count[b] == 0) continue;
-                const float cost = sah_cost(acc.surface_area(), cnt, right_area[b], right_count[b]);
-                if (cost < best.cost) best = Split{axis, b, cost};
-            }
-        }
-        return best;
-    }
-
-    uint32_t partition_binned(uint32_t begin, uint32_t end, const Bounds3& centroids, const Split& split) {
-        const float lo = centroids.lo[split.axis];
-        const float scale = float(params_.bin_count) / (centroids.hi[split.axis] - lo);
-        auto* first = out_.prim_indices.data() + begin;
-        auto* mid = std::partition(first, out_.prim_indices.data() + end, [&](uint32_t p) {
-            return bin_of(in_.centers[p][split.axis], lo, scale) < split.pos;
-        });
-        return uint32_t(mid - out_.prim_indices.data());
+        return partition_sweep(begin, end, split);
     }
 
     // ---- exact sweep SAH -------------------------------------------------
@@ -282,7 +188,6 @@ class BvhBuildJob {
     }
 
     const BvhBuildInput& in_;
-    BvhBuilder builder_;
     BvhBuildParams params_;
     Bvh& out_;
     std::atomic<uint32_t> node_count_{0};
@@ -296,14 +201,18 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     p.max_leaf_size = std::max(p.max_leaf_size, 1u);
     p.leaf_block_size = std::max(p.leaf_block_size, 1u);
     Bvh bvh;
-    if (builder != BvhBuilder::reinsert) {
-        BvhBuildJob(input, builder, p, bvh).run();
+    if (builder == BvhBuilder::binned) {
+        build_binned_bvh(input, p, bvh);
+        return bvh;
+    }
+    if (builder == BvhBuilder::sweep) {
+        BvhBuildJob(input, p, bvh).run();
         return bvh;
     }
     // Reinsertion starts from one primitive per leaf, so that it may regroup every primitive.
     BvhBuildParams single = p;
     single.max_leaf_size = 1;
-    BvhBuildJob(input, BvhBuilder::binned, single, bvh).run();
+    build_binned_bvh(input, single, bvh);
     return reinsert_optimize_bvh(bvh, input.boxes, p);
 }
 

@@ -36,10 +36,12 @@ struct EmbreeReference::Impl {
 bool EmbreeReference::available() { return true; }
 
 EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                                 bool robust)
+                                 bool robust, int build_threads)
     : impl_(std::make_unique<Impl>()) {
-    const auto start = std::chrono::steady_clock::now();
-    impl_->device = rtcNewDevice(nullptr);
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const std::string config = build_threads > 0 ? "threads=" + std::to_string(build_threads) : "";
+    impl_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!impl_->device) throw std::runtime_error("embree: rtcNewDevice failed");
     rtcSetDeviceMemoryMonitorFunction(
         impl_->device,
@@ -65,13 +67,16 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
     rtcAttachGeometry(impl_->scene, geom);
     rtcReleaseGeometry(geom);
     const int64_t before_commit = impl_->allocated.load();
+    const auto commit = Clock::now();
     rtcCommitScene(impl_->scene);
+    const auto end = Clock::now();
     // What the build added and keeps: the BVH and its leaf triangles (the vertex and
     // index buffers were allocated before).
     bvh_bytes_ = size_t(std::max<int64_t>(impl_->allocated.load() - before_commit, 0));
     if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE)
         throw std::runtime_error("embree: scene build failed");
-    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    build_ms_ = std::chrono::duration<double, std::milli>(end - commit).count();
+    setup_ms_ = std::chrono::duration<double, std::milli>(end - start).count();
 }
 
 EmbreeReference::~EmbreeReference() = default;
@@ -152,7 +157,7 @@ bool EmbreeReference::occluded(const Ray& ray) const {
 
 struct EmbreeReference::Impl {};
 bool EmbreeReference::available() { return false; }
-EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool) {
+EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool, int) {
     throw std::runtime_error("this sahara was built without Embree");
 }
 EmbreeReference::~EmbreeReference() = default;

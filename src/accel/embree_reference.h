@@ -20,7 +20,9 @@ class EmbreeReference {
     /// Builds an Embree scene over the indexed triangles. `robust` sets
     /// RTC_SCENE_FLAG_ROBUST (Embree's slower, watertight-leaning mode); the
     /// default mode is the fast one and can let rays slip through shared edges.
-    EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false);
+    /// `build_threads` > 0 limits Embree's build threads (0: Embree's default, all cores).
+    EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false,
+                    int build_threads = 0);
     ~EmbreeReference();
     EmbreeReference(const EmbreeReference&) = delete;
     EmbreeReference& operator=(const EmbreeReference&) = delete;
@@ -32,7 +34,10 @@ class EmbreeReference {
     void intersect16(const RayPacket& packet, float t[kPacketSize], uint32_t prim[kPacketSize]) const;
     /// Whether anything blocks the ray.
     bool occluded(const Ray& ray) const;
+    /// Wall time of rtcCommitScene (Embree's BVH build), and of the whole construction
+    /// (device, buffer copies, build).
     double build_ms() const { return build_ms_; }
+    double setup_ms() const { return setup_ms_; }
     /// Bytes Embree's scene build allocated and kept (BVH nodes and leaf triangles,
     /// without the vertex and index buffers), from its device memory monitor.
     size_t bvh_bytes() const { return bvh_bytes_; }
@@ -42,6 +47,7 @@ class EmbreeReference {
     std::unique_ptr<Impl> impl_;
     double build_ms_ = 0;
     size_t bvh_bytes_ = 0;
+    double setup_ms_ = 0;
 };
 
 /// Sets flush-to-zero and denormals-are-zero for the calling thread (Embree's

@@ -1,0 +1,467 @@
+/// Binned SAH builder (Wald, "On fast Construction of SAH-based Bounding Volume
+/// Hierarchies", 2007). Every node bins the centroids of its range on all three
+/// axes in one pass and partitions in a second one; its children's boxes come
+/// from the bins and their centroid bounds from the partition, so there is no
+/// separate bounds pass. Primitives are 48-byte records (box, id, centroid)
+/// moved in place, read sequentially.
+///
+/// Parallelism: ranges above kParallelScanThreshold are binned and partitioned
+/// as kScanChunks OpenMP tasks (stable partition into the other of two buffers), the
+/// subtrees above params.parallel_threshold are tasks. The chunks do not depend
+/// on the thread count, and every node owns a fixed region of the node array
+/// (compacted at the end), so the tree is the same for any thread count.
+#include "accel/bvh_binned.h"
+
+#include <emmintrin.h>
+#include <xmmintrin.h>
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+namespace sahara {
+
+namespace {
+
+constexpr uint32_t kMaxBins = 64;
+constexpr uint32_t kParallelScanThreshold = 1u << 15;
+constexpr uint32_t kScanChunks = 8;
+
+struct alignas(16) PrimRef {
+    float lo[3];
+    uint32_t id;
+    float hi[3];
+    float pad0;
+    float c[3];
+    float pad1;
+};
+static_assert(sizeof(PrimRef) == 48);
+
+/// lo with lane 3 (the id's bits, often a denormal float: slow in arithmetic) cleared.
+inline __m128 load_lo(const PrimRef& p) {
+    return _mm_and_ps(_mm_load_ps(p.lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
+
+/// A box in two SSE registers (lane 3 unused). The min/max argument order
+/// matches std::min/std::max in Bounds3::extend, bit for bit.
+struct Box4 {
+    __m128 lo = _mm_set1_ps(kInfinity);
+    __m128 hi = _mm_set1_ps(-kInfinity);
+
+    void extend(__m128 l, __m128 h) {
+        lo = _mm_min_ps(l, lo);
+        hi = _mm_max_ps(h, hi);
+    }
+    void extend(__m128 p) { extend(p, p); }
+    void extend(const Box4& b) { extend(b.lo, b.hi); }
+    /// Bounds3::surface_area, the same operations in the same order.
+    float area() const {
+        if (_mm_movemask_ps(_mm_cmpgt_ps(lo, hi)) & 7) return 0.0f;
+        const __m128 e = _mm_sub_ps(hi, lo);
+        const __m128 yzx = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));
+        const __m128 p = _mm_mul_ps(e, yzx);  // x*y, y*z, z*x
+        const float sum = (_mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1))) +
+                          _mm_cvtss_f32(_mm_shuffle_ps(p, p, 2));
+        return 2.0f * sum;
+    }
+    Bounds3 bounds() const {
+        alignas(16) float l[4], h[4];
+        _mm_store_ps(l, lo);
+        _mm_store_ps(h, hi);
+        return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+    }
+};
+
+/// The bins of the three axes of one range (or of one chunk of it).
+struct Bins {
+    Box4 box[3][kMaxBins];
+    uint32_t count[3][kMaxBins];
+
+    void clear(uint32_t bins) {
+        for (int a = 0; a < 3; ++a)
+            for (uint32_t k = 0; k < bins; ++k) box[a][k] = Box4{}, count[a][k] = 0;
+    }
+    void add(const Bins& o, uint32_t bins) {
+        for (int a = 0; a < 3; ++a)
+            for (uint32_t k = 0; k < bins; ++k) box[a][k].extend(o.box[a][k]), count[a][k] += o.count[a][k];
+    }
+};
+
+/// Maps centroids to bins: bin = clamp(int((c - lo) * scale), 0, bins - 1) per axis.
+struct BinMap {
+    __m128 lo, scale;
+    float lo_s[3], scale_s[3];
+    int last;
+
+    BinMap(const Bounds3& centroids, uint32_t bins) : last(int(bins) - 1) {
+        for (int a = 0; a < 3; ++a) {
+            const float extent = centroids.hi[a] - centroids.lo[a];
+            lo_s[a] = centroids.lo[a];
+            scale_s[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
+        }
+        lo = _mm_setr_ps(lo_s[0], lo_s[1], lo_s[2], 0.0f);
+        scale = _mm_setr_ps(scale_s[0], scale_s[1], scale_s[2], 0.0f);
+    }
+    uint32_t clamp(int b) const { return uint32_t(std::clamp(b, 0, last)); }
+    /// Bin on one axis (the same arithmetic as the three-axis version).
+    uint32_t bin(const PrimRef& p, int axis) const {
+        return clamp(_mm_cvtt_ss2si(_mm_set_ss((p.c[axis] - lo_s[axis]) * scale_s[axis])));
+    }
+};
+
+struct Split {
+    int axis = -1;
+    uint32_t pos = 0;  ///< first bin of the right side
+    float cost = kInfinity;
+    uint32_t left_count = 0;
+    Bounds3 left, right;
+};
+
+/// A node's work item: its primitives, box and centroid bounds, and the buffer that
+/// holds the primitives (a parallel partition moves them to the other buffer).
+struct Range {
+    uint32_t begin = 0, end = 0;
+    Bounds3 box, centroids;
+    PrimRef* refs = nullptr;
+};
+
+/// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
+/// else as kScanChunks tasks (the caller is inside the build's parallel region).
+template <class Fn>
+void for_chunks(uint32_t begin, uint32_t end, const Fn& fn) {
+    const uint32_t n = end - begin;
+    if (n <= kParallelScanThreshold) {
+        fn(0u, begin, end);
+        return;
+    }
+    for (uint32_t c = 0; c < kScanChunks; ++c) {
+        const auto b = begin + uint32_t(uint64_t(n) * c / kScanChunks);
+        const auto e = begin + uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
+#pragma omp task default(shared) firstprivate(c, b, e)
+        fn(c, b, e);
+    }
+#pragma omp taskwait
+}
+
+class BinnedBuild {
+   public:
+    BinnedBuild(const BvhBuildInput& input, const BvhBuildParams& params, Bvh& out)
+        : in_(input), params_(params), out_(out), n_(uint32_t(input.boxes.size())) {}
+
+    void run() {
+        out_.nodes.clear();
+        out_.prim_indices.assign(n_, 0);
+        if (n_ == 0) return;
+        refs_.reset(new PrimRef[n_]);
+        nodes_.reset(new BvhNode[2 * size_t(n_)]);
+        used_pairs_.assign(n_, 0);
+        if (n_ > kParallelScanThreshold) scratch_.reset(new PrimRef[n_]);
+#pragma omp parallel
+#pragma omp single
+        {
+            const Range root = init_refs();
+            build(0, Bvh::kFirstPair, root, 0);
+        }
+        compact();
+    }
+
+   private:
+    Range init_refs() {
+        Box4 boxes[kScanChunks], cents[kScanChunks];
+        for_chunks(0, n_, [&](uint32_t c, uint32_t b, uint32_t e) {
+            for (uint32_t i = b; i < e; ++i) {
+                const Bounds3& box = in_.boxes[i];
+                const Vec3& ct = in_.centers[i];
+                PrimRef& r = refs_[i];
+                r = PrimRef{{box.lo.x, box.lo.y, box.lo.z},
+                            i,
+                            {box.hi.x, box.hi.y, box.hi.z},
+                            0.0f,
+                            {ct.x, ct.y, ct.z},
+                            0.0f};
+                boxes[c].extend(load_lo(r), _mm_load_ps(r.hi));
+                cents[c].extend(_mm_load_ps(r.c));
+            }
+        });
+        Box4 box, cent;
+        for (uint32_t c = 0; c < kScanChunks; ++c) box.extend(boxes[c]), cent.extend(cents[c]);
+        return Range{0, n_, box.bounds(), cent.bounds(), refs_.get()};
+    }
+
+    /// Builds the subtree of `r` at node `slot`; its descendants go to the 2 * n - 2 slots from `region`.
+    void build(uint32_t slot, uint32_t region, const Range& r, int depth) {
+        BvhNode& node = nodes_[slot];
+        node.set_box(r.box);
+        const uint32_t n = r.end - r.begin;
+        Range left, right;
+        if (n == 1 || !split(r, depth, left, right)) {
+            node.index = r.begin;
+            node.count = n;
+            for (uint32_t i = r.begin; i < r.end; ++i) out_.prim_indices[i] = r.refs[i].id;
+            return;
+        }
+        used_pairs_[region / 2] = 1;
+        node.index = region;
+        node.count = 0;
+        const uint32_t right_region = region + 2 * (left.end - left.begin);
+        if (n > params_.parallel_threshold) {
+#pragma omp task default(shared) firstprivate(region, left, depth)
+            build(region, region + 2, left, depth + 1);
+            build(region + 1, right_region, right, depth + 1);
+#pragma omp taskwait
+        } else {
+            build(region, region + 2, left, depth + 1);
+            build(region + 1, right_region, right, depth + 1);
+        }
+    }
+
+    /// SAH split of `r` into `left` and `right` (partitioned in place), or false for a leaf.
+    bool split(const Range& r, int depth, Range& left, Range& right) {
+        const uint32_t n = r.end - r.begin;
+        const bool may_be_leaf = n <= params_.max_leaf_size;
+        if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
+        const uint32_t bins = params_.bin_count;
+        const BinMap map(r.centroids, bins);
+        Split best;
+        if (n <= kParallelScanThreshold) {
+            thread_local Bins all;  // not used across a task scheduling point
+            all.clear(bins);
+            fill_bins(r.refs, r.begin, r.end, map, all);
+            best = find_split(all, map);
+            if (best.axis < 0) return !may_be_leaf && median_split(r, left, right);
+            if (may_be_leaf && is_leaf_cheaper(r, n, best)) return false;
+            partition_serial(r, map, best, left, right);
+        } else {
+            std::vector<Bins> parts(kScanChunks);
+            for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
+                parts[c].clear(bins);
+                fill_bins(r.refs, b, e, map, parts[c]);
+            });
+            auto all = std::make_unique<Bins>();
+            all->clear(bins);
+            for (const Bins& p : parts) all->add(p, bins);
+            best = find_split(*all, map);
+            if (best.axis < 0) return !may_be_leaf && median_split(r, left, right);
+            if (may_be_leaf && is_leaf_cheaper(r, n, best)) return false;
+            partition_parallel(r, map, best, parts, left, right);
+        }
+        left.box = best.left;
+        right.box = best.right;
+        return true;
+    }
+
+    bool is_leaf_cheaper(const Range& r, uint32_t n, const Split& s) const {
+        const float area = r.box.surface_area();
+        return params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + s.cost;
+    }
+
+    static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
+        for (uint32_t i = begin; i < end; ++i) {
+            const PrimRef& p = refs[i];
+            alignas(16) int32_t k[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k),
+                            _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(p.c), map.lo), map.scale)));
+            const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
+            for (int a = 0; a < 3; ++a) {
+                const uint32_t b = map.clamp(k[a]);
+                out.box[a][b].extend(lo, hi);
+                ++out.count[a][b];
+            }
+        }
+    }
+
+    /// The cheapest bin boundary over the axes with a non-zero centroid extent. Only the
+    /// non-empty bins are visited: the boundaries between two of them all cost the same, and
+    /// the first of them (the one a sweep over every boundary keeps) follows the left one.
+    Split find_split(const Bins& bins, const BinMap& map) const {
+        const uint32_t nb = params_.bin_count;
+        Split best;
+        int best_axis = -1;
+        uint32_t best_pos = 0;
+        uint32_t used[kMaxBins];
+        float right_area[kMaxBins];
+        uint32_t right_count[kMaxBins];
+        __m128 right_lo[kMaxBins], right_hi[kMaxBins];  // not cleared: written before read
+        Box4 best_left, best_right;
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(map.scale_s[axis] > 0.0f)) continue;
+            const Box4* box = bins.box[axis];
+            const uint32_t* count = bins.count[axis];
+            uint32_t m = 0;
+            for (uint32_t b = 0; b < nb; ++b) used[m] = b, m += count[b] != 0;
+            if (m < 2) continue;
+            // right_*[j]: bins used[j..m) together.
+            Box4 acc;
+            uint32_t cnt = 0;
+            for (uint32_t j = m - 1; j > 0; --j) {
+                acc.extend(box[used[j]]);
+                cnt += count[used[j]];
+                right_lo[j] = acc.lo;
+                right_hi[j] = acc.hi;
+                right_area[j] = acc.area();
+                right_count[j] = cnt;
+            }
+            acc = Box4{};
+            cnt = 0;
+            for (uint32_t j = 1; j < m; ++j) {
+                acc.extend(box[used[j - 1]]);
+                cnt += count[used[j - 1]];
+                const float cost = params_.intersection_cost *
+                                   (acc.area() * blocked(cnt) + right_area[j] * blocked(right_count[j]));
+                if (cost < best.cost) {
+                    best.cost = cost;
+                    best.left_count = cnt;
+                    best_axis = axis;
+                    best_pos = used[j - 1] + 1;
+                    best_left = acc;
+                    best_right.lo = right_lo[j];
+                    best_right.hi = right_hi[j];
+                }
+            }
+        }
+        best.axis = best_axis;
+        best.pos = best_pos;
+        if (best_axis >= 0) best.left = best_left.bounds(), best.right = best_right.bounds();
+        return best;
+    }
+
+    /// In-place partition of a short range; accumulates the children's centroid bounds.
+    void partition_serial(const Range& r, const BinMap& map, const Split& s, Range& left, Range& right) {
+        PrimRef* lo = &r.refs[r.begin];
+        PrimRef* hi = &r.refs[r.end];
+        Box4 lc, rc;
+        const int axis = s.axis;
+        for (;;) {
+            while (lo < hi && map.bin(*lo, axis) < s.pos) lc.extend(_mm_load_ps(lo->c)), ++lo;
+            while (lo < hi && map.bin(hi[-1], axis) >= s.pos) --hi, rc.extend(_mm_load_ps(hi->c));
+            if (lo >= hi) break;
+            std::swap(*lo, hi[-1]);
+            lc.extend(_mm_load_ps(lo->c));
+            ++lo;
+            --hi;
+            rc.extend(_mm_load_ps(hi->c));
+        }
+        const auto mid = uint32_t(lo - r.refs);
+        left.begin = r.begin;
+        left.end = right.begin = mid;
+        right.end = r.end;
+        left.centroids = lc.bounds();
+        right.centroids = rc.bounds();
+        left.refs = right.refs = r.refs;
+    }
+
+    /// Stable partition of a long range through scratch_, chunk by chunk: each chunk's
+    /// left and right counts come from its bins, so every chunk knows where to write.
+    void partition_parallel(const Range& r, const BinMap& map, const Split& s, const std::vector<Bins>& parts,
+                            Range& left, Range& right) {
+        uint32_t left_at[kScanChunks], right_at[kScanChunks];
+        uint32_t lsum = r.begin, rsum = r.begin + s.left_count;
+        const uint32_t n = r.end - r.begin;
+        for (uint32_t c = 0; c < kScanChunks; ++c) {
+            uint32_t lcount = 0;
+            for (uint32_t b = 0; b < s.pos; ++b) lcount += parts[c].count[s.axis][b];
+            const auto cb = uint32_t(uint64_t(n) * c / kScanChunks);
+            const auto ce = uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
+            left_at[c] = lsum;
+            right_at[c] = rsum;
+            lsum += lcount;
+            rsum += (ce - cb) - lcount;
+        }
+        Box4 lc[kScanChunks], rc[kScanChunks];
+        PrimRef* const to = r.refs == refs_.get() ? scratch_.get() : refs_.get();
+        for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
+            uint32_t l = left_at[c], h = right_at[c];
+            for (uint32_t i = b; i < e; ++i) {
+                const PrimRef& p = r.refs[i];
+                if (map.bin(p, s.axis) < s.pos) {
+                    to[l++] = p;
+                    lc[c].extend(_mm_load_ps(p.c));
+                } else {
+                    to[h++] = p;
+                    rc[c].extend(_mm_load_ps(p.c));
+                }
+            }
+        });
+        Box4 lall, rall;
+        for (uint32_t c = 0; c < kScanChunks; ++c) lall.extend(lc[c]), rall.extend(rc[c]);
+        left.begin = r.begin;
+        left.end = right.begin = r.begin + s.left_count;
+        right.end = r.end;
+        left.centroids = lall.bounds();
+        right.centroids = rall.bounds();
+        left.refs = right.refs = to;
+    }
+
+    /// Object median on the widest centroid axis (below kBvhMedianSplitDepth, or when no
+    /// bin boundary separates the centroids); the children's bounds are scanned.
+    bool median_split(const Range& r, Range& left, Range& right) {
+        const int axis = max_dimension(r.centroids.extent());
+        const uint32_t mid = r.begin + (r.end - r.begin) / 2;
+        std::nth_element(&r.refs[r.begin], &r.refs[mid], &r.refs[r.end],
+                         [axis](const PrimRef& a, const PrimRef& b) {
+                             return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.id < b.id);
+                         });
+        scan(r.refs, r.begin, mid, left);
+        scan(r.refs, mid, r.end, right);
+        return true;
+    }
+
+    static void scan(PrimRef* refs, uint32_t begin, uint32_t end, Range& out) {
+        Box4 box, cent;
+        for (uint32_t i = begin; i < end; ++i) {
+            box.extend(load_lo(refs[i]), _mm_load_ps(refs[i].hi));
+            cent.extend(_mm_load_ps(refs[i].c));
+        }
+        out = Range{begin, end, box.bounds(), cent.bounds(), refs};
+    }
+
+    /// Primitive count rounded up to whole leaf blocks (what a leaf of n actually tests).
+    /// (No division for the usual power-of-two block sizes: it is evaluated at every bin boundary.)
+    float blocked(uint32_t n) const {
+        const uint32_t b = params_.leaf_block_size;
+        if ((b & (b - 1)) == 0) return float((n + b - 1) & ~(b - 1));
+        return float((n + b - 1) / b * b);
+    }
+
+    /// Removes the unused pairs of the node regions, keeping the order (depth-first, left
+    /// before right: the order of a serial build that allocates pairs as it goes).
+    void compact() {
+        if (nodes_[0].is_leaf()) {
+            out_.nodes.assign(1, nodes_[0]);
+            return;
+        }
+        used_pairs_[0] = 1;
+        std::vector<uint32_t> new_pair(n_);
+        uint32_t pairs = 0;
+        for (uint32_t k = 0; k < n_; ++k) {
+            new_pair[k] = pairs;
+            pairs += used_pairs_[k];
+        }
+        out_.nodes.resize(2 * size_t(pairs));
+        for (uint32_t k = 0; k < n_; ++k) {
+            if (!used_pairs_[k]) continue;
+            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
+                BvhNode node = nodes_[2 * k + j];
+                if (!node.is_leaf()) node.index = 2 * new_pair[node.index / 2];
+                out_.nodes[2 * new_pair[k] + j] = node;
+            }
+        }
+        out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
+    }
+
+    const BvhBuildInput& in_;
+    const BvhBuildParams params_;
+    Bvh& out_;
+    const uint32_t n_;
+    std::unique_ptr<PrimRef[]> refs_, scratch_;
+    std::unique_ptr<BvhNode[]> nodes_;
+    std::vector<uint8_t> used_pairs_;
+};
+
+}  // namespace
+
+void build_binned_bvh(const BvhBuildInput& input, const BvhBuildParams& params, Bvh& out) {
+    BinnedBuild(input, params, out).run();
+}
+
+}  // namespace sahara
