@@ -145,10 +145,10 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
     const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
     const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
     SimdPathGuard guard;
-    for (auto [layout, builder] : {std::pair{BvhLayout::wide4, BvhBuilder::binned},
-                                   std::pair{BvhLayout::wide8, BvhBuilder::binned},
-                                   std::pair{BvhLayout::wide4_slots, BvhBuilder::binned},
-                                   std::pair{BvhLayout::wide8, BvhBuilder::reinsert}}) {
+    for (auto [layout, builder] :
+         {std::pair{BvhLayout::wide4, BvhBuilder::binned}, std::pair{BvhLayout::wide8, BvhBuilder::binned},
+          std::pair{BvhLayout::wide4_slots, BvhBuilder::binned},
+          std::pair{BvhLayout::wide8, BvhBuilder::reinsert}}) {
         if (builder == BvhBuilder::reinsert && !reinsert) continue;
         AcceleratorOptions opt;
         opt.layout = layout;

@@ -79,7 +79,8 @@ TEST_CASE("sphere: the float pre-test never rejects a ray whose line meets the s
         const float r = std::pow(10.0f, -3.0f + 9.0f * rng.next_float());
         const Vec3 c(1e4f * (rng.next_float() - 0.5f), 1e4f * (rng.next_float() - 0.5f),
                      1e4f * (rng.next_float() - 0.5f));
-        const Vec3 axis = normalize(Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+        const Vec3 axis =
+            normalize(Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
         const Vec3 side = normalize(cross(axis, std::fabs(axis.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 1, 0)));
         const float mag = std::pow(10.0f, -9.0f + 6.0f * rng.next_float());
         const float delta = (rng.next_float() < 0.5f ? -mag : mag) * (i % 10 == 0 ? 1e3f : 1.0f);
@@ -96,7 +97,8 @@ TEST_CASE("sphere: the float pre-test never rejects a ray whose line meets the s
         const bool rejected = sphere_clearly_missed(make_ray(origin, dir), c, r);
         if (dist <= LD(r)) {
             ++inside;
-            if (rejected) FAIL_CHECK("rejected a line inside the sphere: r " << r << " dist/r " << double(dist / r));
+            if (rejected)
+                FAIL_CHECK("rejected a line inside the sphere: r " << r << " dist/r " << double(dist / r));
         } else if (dist > 1.5L * r && std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z) < 1e3f * r) {
             ++outside;
             outside_rejected += rejected;

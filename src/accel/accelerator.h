@@ -40,7 +40,7 @@ inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
 /// Traversal structure built from the binary SAH tree.
 enum class BvhLayout : uint8_t {
-    wide4,  ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
+    wide4,        ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
     wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
     pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
     wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
@@ -194,11 +194,12 @@ class Accelerator {
     /// Leaf slot of lane l of the blocks from `first`.
     uint32_t block_slot(uint32_t first, int l) const { return blocks_[first + uint32_t(l >> 2)].slot[l & 3]; }
 
-    Bvh bvh_;                             ///< the binary tree (see bvh())
-    BvhPairs pairs_;                      ///< the same tree in pair layout (layout_ == pairs)
-    Bvh4 wide_;                           ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
-    Bvh8 wide8_;                          ///< the same tree collapsed to 8-wide nodes (wide8 layout)
-    std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>> blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
+    Bvh bvh_;         ///< the binary tree (see bvh())
+    BvhPairs pairs_;  ///< the same tree in pair layout (layout_ == pairs)
+    Bvh4 wide_;       ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
+    Bvh8 wide8_;      ///< the same tree collapsed to 8-wide nodes (wide8 layout)
+    std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>>
+        blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
     BvhLayout layout_ = BvhLayout::wide4;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).

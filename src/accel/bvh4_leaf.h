@@ -38,9 +38,10 @@ static_assert(sizeof(TriangleBlock4) == 160, "40 bytes per triangle, like a leaf
 /// Scalar redo of the lanes of `b` in `lanes` (bit l: lane l) whose edge
 /// function was exactly 0 (double fallback included); returns the hit lanes as
 /// bits `shift + l`, their answers written to t/u/v_out[shift + l].
-__attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRay& tr, const TriangleBlock4& b,
-                                                                int lanes, int shift, float tmin, float tmax,
-                                                                float* t_out, float* u_out, float* v_out) {
+__attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRay& tr,
+                                                                const TriangleBlock4& b, int lanes, int shift,
+                                                                float tmin, float tmax, float* t_out,
+                                                                float* u_out, float* v_out) {
     int result = 0;
     for (; lanes; lanes &= lanes - 1) {
         const int l = __builtin_ctz(unsigned(lanes));
@@ -87,9 +88,9 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
     int result = 0;
     if (mask) {
         const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
-        const __m128 t_scaled = _mm_add_ps(
-            _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, rz[0])), _mm_mul_ps(v, _mm_mul_ps(sz, rz[1]))),
-            _mm_mul_ps(w, _mm_mul_ps(sz, rz[2])));
+        const __m128 t_scaled =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, rz[0])), _mm_mul_ps(v, _mm_mul_ps(sz, rz[1]))),
+                       _mm_mul_ps(w, _mm_mul_ps(sz, rz[2])));
         const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
         const __m128 abs_det = _mm_xor_ps(det, sign);
         const __m128 t_signed = _mm_xor_ps(t_scaled, sign);
@@ -117,9 +118,9 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
 
 /// Loads lane group [v][axis] of blocks b[0] (low half) and b[1] (high half).
 __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b, int v,
-                                                                            int axis) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b[0].p[v][axis])), _mm_load_ps(b[1].p[v][axis]),
-                                1);
+                                                                             int axis) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b[0].p[v][axis])),
+                                _mm_load_ps(b[1].p[v][axis]), 1);
 }
 
 /// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step:
@@ -127,9 +128,9 @@ __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(con
 /// Not always_inline, like WideRay<8, true>::test (bvh_wide.h): it is inlined
 /// once its generic caller sits inside the AVX2 traversal.
 __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
-                                                                         const TriangleBlock4* b, float tmin,
-                                                                         float tmax, float t_out[8],
-                                                                         float u_out[8], float v_out[8]) {
+                                                                          const TriangleBlock4* b, float tmin,
+                                                                          float tmax, float t_out[8],
+                                                                          float u_out[8], float v_out[8]) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m256 ox = _mm256_set1_ps(tr.org[kx]), oy = _mm256_set1_ps(tr.org[ky]),
                  oz = _mm256_set1_ps(tr.org[kz]);
@@ -151,16 +152,17 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const 
     int result = 0;
     if (mask) {
         const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-        const __m256 t_scaled =
-            _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, rz[0])),
-                                        _mm256_mul_ps(v, _mm256_mul_ps(sz, rz[1]))),
-                          _mm256_mul_ps(w, _mm256_mul_ps(sz, rz[2])));
+        const __m256 t_scaled = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, rz[0])),
+                                                            _mm256_mul_ps(v, _mm256_mul_ps(sz, rz[1]))),
+                                              _mm256_mul_ps(w, _mm256_mul_ps(sz, rz[2])));
         const __m256 sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
         const __m256 abs_det = _mm256_xor_ps(det, sign);
         const __m256 t_signed = _mm256_xor_ps(t_scaled, sign);
         __m256 ok = _mm256_cmp_ps(det, zero, _CMP_NEQ_UQ);
-        ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ));
-        ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
+        ok = _mm256_and_ps(ok,
+                           _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ));
+        ok = _mm256_and_ps(ok,
+                           _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
         mask &= _mm256_movemask_ps(ok);
         if (mask) {
             const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);

@@ -63,7 +63,6 @@ BvhWideNode<N> empty_node() {
     return p;
 }
 
-
 }  // namespace
 
 template <int N>

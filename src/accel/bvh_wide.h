@@ -46,7 +46,8 @@ static_assert(sizeof(Bvh8Node) == 256, "four cache lines per node");
 template <int N>
 struct BvhWide {
     BvhNode root{};
-    std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>> nodes;  ///< nodes[0]: the root's children
+    std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>>
+        nodes;  ///< nodes[0]: the root's children
     bool empty = true;
 
     size_t bytes() const { return sizeof(BvhNode) + nodes.size() * sizeof(BvhWideNode<N>); }
@@ -173,7 +174,8 @@ __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(con
         t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, org), inv), t1);
     }
     _mm256_store_ps(t_near, t0);
-    return _mm256_movemask_ps(_mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
+    return _mm256_movemask_ps(
+        _mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
@@ -202,8 +204,7 @@ struct WideRay<8, true> {
     /// Not always_inline: GCC inlines callees into traverse_wide before traverse_wide
     /// itself is inlined into its AVX2 caller, and refuses AVX2 code in that generic
     /// body; as a plain inline function it is inlined once it sits in the AVX2 caller.
-    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax,
-                                                            float* t) const {
+    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax, float* t) const {
         return intersect_bvh8_avx(n, avx, tmin, tmax, t);
     }
 };

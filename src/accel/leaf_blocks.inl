@@ -10,8 +10,9 @@
 namespace sahara {
 
 template <bool kAnyHit>
-__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray, uint32_t first, int mask,
-                                                                        const float* t, const float* u,
+__attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray, uint32_t first,
+                                                                        int mask, const float* t,
+                                                                        const float* u,
                                                                         const float* v) const {
     // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
     while (mask) {
@@ -69,7 +70,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             found = true;
         }
         for (int m = other; m; m &= m - 1) {
-            const uint32_t id = others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
+            const uint32_t id =
+                others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
             float t_other = 0.0f, u_other = 0.0f;
             if (!intersect_other(ray, id, tmax, t_other, u_other)) continue;
             if constexpr (kAnyHit) return true;

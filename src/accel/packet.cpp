@@ -182,7 +182,8 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     }
     switch (active_packet_simd()) {
         case PacketSimd::avx512:
-            wide8 ? packet_avx512::trace_packet(c, wide8_, hits) : packet_avx512::trace_packet(c, wide_, hits);
+            wide8 ? packet_avx512::trace_packet(c, wide8_, hits)
+                  : packet_avx512::trace_packet(c, wide_, hits);
             break;
         case PacketSimd::avx2:
             // 8-wide nodes: one AVX box test per ray and child set beats 16 rays per box in two halves.

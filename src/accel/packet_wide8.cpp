@@ -20,7 +20,8 @@
 
 namespace sahara {
 
-__attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPacket& p, HitPacket& out) const {
+__attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPacket& p,
+                                                                     HitPacket& out) const {
     // Per-lane single-ray constants; inactive lanes are never read.
     Ray rays[kPacketSize];
     TriangleRay tr[kPacketSize];
@@ -103,7 +104,8 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
                 const __m256 t = _mm256_set1_ps(cur.t_entry);
                 const uint32_t reach =
                     uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(t, _mm256_load_ps(tmax_scaled), _CMP_LE_OQ))) |
-                    uint32_t(_mm256_movemask_ps(_mm256_cmp_ps(t, _mm256_load_ps(tmax_scaled + 8), _CMP_LE_OQ)))
+                    uint32_t(
+                        _mm256_movemask_ps(_mm256_cmp_ps(t, _mm256_load_ps(tmax_scaled + 8), _CMP_LE_OQ)))
                         << 8;
                 cur.mask &= reach;
                 if (cur.mask) break;

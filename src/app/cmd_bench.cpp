@@ -228,9 +228,11 @@ void print_text(const nlohmann::ordered_json& j) {
         std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads)",
                     j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
                     j["threads"].get<int>());
-    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)", j["tree_bytes_per_primitive"].get<double>());
+    std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)",
+                j["tree_bytes_per_primitive"].get<double>());
     if (j.contains("embree_bvh_bytes_per_primitive"))
-        std::printf(", Embree %.1f (what its build allocated)", j["embree_bvh_bytes_per_primitive"].get<double>());
+        std::printf(", Embree %.1f (what its build allocated)",
+                    j["embree_bvh_bytes_per_primitive"].get<double>());
     std::printf("\n");
     const bool embree = j.contains("embree_build_ms");
     if (!embree) std::printf("Embree      %s\n", j["embree"].get<std::string>().c_str());
