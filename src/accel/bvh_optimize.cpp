@@ -289,16 +289,23 @@ class Collapser {
         const double ci = double(params_.intersection_cost), ct = double(params_.traversal_cost);
         if (tree_.is_leaf(n)) {
             count_[n] = 1;
-            cost_[n] = ci * a;
+            cost_[n] = ci * blocked(1) * a;
             make_leaf_[n] = 1;
             return;
         }
         const uint32_t c0 = tree_.child(n, 0), c1 = tree_.child(n, 1);
         count_[n] = count_[c0] + count_[c1];
         const double split = ct * a + cost_[c0] + cost_[c1];
-        const double leaf = ci * double(count_[n]) * a;
+        const double leaf = ci * blocked(count_[n]) * a;
         make_leaf_[n] = count_[n] <= params_.max_leaf_size && leaf <= split;
         cost_[n] = make_leaf_[n] ? leaf : split;
+    }
+
+    /// Primitives a leaf of n tests: whole blocks of params_.leaf_block_size (as the
+    /// binned builder counts them), so leaves fill the block layouts' blocks.
+    double blocked(uint32_t n) const {
+        const uint32_t b = std::max(params_.leaf_block_size, 1u);
+        return double((n + b - 1) / b * b);
     }
 
     void gather(uint32_t n, std::vector<uint32_t>& out) const {
