@@ -315,9 +315,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
             else
                 return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
         },
-        counters,
-        kBlocks ? reinterpret_cast<const char*>(blocks_.data()) : reinterpret_cast<const char*>(slots_.data()),
-        kBlocks ? sizeof(TriangleBlock4) : sizeof(slots_[0]));
+        counters);
     if (found && !kAnyHit) {
         hit = best;
         ray.tmax = best.t;

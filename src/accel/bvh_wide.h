@@ -214,12 +214,9 @@ struct WideRay<8, true> {
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
 /// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2).
-/// leaf_data, leaf_stride: where leaf item i starts (leaf_data + i * leaf_stride), for
-/// prefetching; null: no leaf prefetch.
 template <bool kAnyHit, bool kAvx = false, int N, class Counters, class LeafFn>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray, LeafFn&& leaf,
-                                                         Counters& counters, const char* leaf_data = nullptr,
-                                                         size_t leaf_stride = 0) {
+                                                         Counters& counters) {
     if (bvh.empty) return false;
     // No test of the root box: nodes[0] tests the root's children, which lie inside it.
     if (bvh.root.is_leaf()) {
@@ -232,21 +229,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         float t_entry;
     };
     const WideRay<N, kAvx && N == 8> rw(ray);
-    // Every hit child is fetched as soon as it is known (as Embree does): an inner
-    // node's lines, or a leaf's first primitive lines (through the leaf functor).
-    const auto prefetch_entry = [&](const Entry& e) __attribute__((always_inline)) {
-        if (e.count) {
-            if (leaf_data) {
-                const char* p = leaf_data + size_t(e.index) * leaf_stride;
-                _mm_prefetch(p, _MM_HINT_T0);
-                _mm_prefetch(p + 64, _MM_HINT_T0);
-                _mm_prefetch(p + 128, _MM_HINT_T0);
-            }
-        } else {
-            const char* p = reinterpret_cast<const char*>(&bvh.nodes[e.index]);
-            for (size_t line = 0; line < sizeof(BvhWideNode<N>); line += 64) _mm_prefetch(p + line, _MM_HINT_T0);
-        }
-    };
     // Each node pushes at most N - 1 entries per level, plus slack.
     Entry stack[(N - 1) * kBvhMaxDepth + 4];
     int top = 0;
@@ -269,7 +251,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 int c = __builtin_ctz(unsigned(mask));
                 mask &= mask - 1;
                 cur = Entry{n.child[c], n.count[c], t[c]};
-                prefetch_entry(cur);
                 if (!mask) continue;  // one child hit: no ordering, no stack
                 if constexpr (kAnyHit) {
                     // Any hit ends the search, so order buys little: push in child order
@@ -279,8 +260,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         c = __builtin_ctz(unsigned(mask));
                         mask &= mask - 1;
                         cur = Entry{n.child[c], n.count[c], t[c]};
-                        prefetch_entry(cur);
-                    } while (mask);
+                            } while (mask);
                     continue;
                 }
                 // Insert the others into the stack top sorted by distance (farthest
@@ -290,7 +270,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     c = __builtin_ctz(unsigned(mask));
                     mask &= mask - 1;
                     Entry in{n.child[c], n.count[c], t[c]};
-                    prefetch_entry(in);
                     if (in.t_entry < cur.t_entry) std::swap(in, cur);
                     int k = top++;
                     while (k > base && stack[k - 1].t_entry < in.t_entry) {
