@@ -13,11 +13,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path temp_dir() {
-    fs::path d = fs::temp_directory_path() / ("sahara-test-io-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+/// A fresh directory for one test case, removed with everything in it at the end.
+struct TempDir {
+    fs::path path = fs::temp_directory_path() / ("sahara-test-io-" + std::to_string(::getpid()));
+    TempDir() {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+};
 
 std::vector<float> gradient_pixels(int w, int h) {
     std::vector<float> rgb(size_t(w) * size_t(h) * 3);
@@ -34,7 +43,8 @@ std::vector<float> gradient_pixels(int w, int h) {
 }  // namespace
 
 TEST_CASE("image round trip: EXR is linear and exact in float") {
-    const fs::path file = temp_dir() / "round.exr";
+    const TempDir dir;
+    const fs::path file = dir.path / "round.exr";
     std::vector<float> rgb = gradient_pixels(7, 5);
     rgb[0] = 12.5f;  // HDR values are not clipped
     write_image(file, 7, 5, rgb, {{"spp", "3"}});
@@ -43,11 +53,11 @@ TEST_CASE("image round trip: EXR is linear and exact in float") {
     REQUIRE(img->height == 5);
     for (size_t i = 0; i < 35; ++i)
         for (size_t c = 0; c < 3; ++c) CHECK(img->rgba[i * 4 + c] == rgb[i * 3 + c]);
-    fs::remove(file);
 }
 
 TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
-    const fs::path file = temp_dir() / "round.png";
+    const TempDir dir;
+    const fs::path file = dir.path / "round.png";
     const std::vector<float> rgb = gradient_pixels(9, 4);
     write_image(file, 9, 4, rgb);
     auto img = read_image(file, true);
@@ -57,11 +67,11 @@ TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
     // Mid grey 0.5 encodes to sRGB 188/255 (IEC 61966-2-1).
     CHECK(std::lround(srgb_encode(0.5f) * 255) == 188);
     CHECK(srgb_decode(srgb_encode(0.2f)) == doctest::Approx(0.2f));
-    fs::remove(file);
 }
 
 TEST_CASE("image writing is atomic and checks its path first") {
-    const fs::path dir = temp_dir();
+    const TempDir tmp;
+    const fs::path& dir = tmp.path;
     CHECK_THROWS_AS(check_output_path(dir / "missing" / "x.png"), InputError);
     CHECK_THROWS_AS(check_output_path(dir / "x.bmpx"), InputError);
     CHECK_NOTHROW(check_output_path(dir / "x.png"));
@@ -74,7 +84,8 @@ TEST_CASE("image writing is atomic and checks its path first") {
 }
 
 TEST_CASE("reading a missing or broken image names the file") {
-    const fs::path dir = temp_dir();
+    const TempDir tmp;
+    const fs::path& dir = tmp.path;
     CHECK_THROWS_WITH_AS(read_image(dir / "nope.png", true), doctest::Contains("nope.png"), InputError);
     { std::ofstream(dir / "broken.png") << "not a png"; }
     CHECK_THROWS_WITH_AS(read_image(dir / "broken.png", true), doctest::Contains("broken.png"), InputError);

@@ -29,14 +29,14 @@ struct PacketContext {
 };
 
 /// Fills the common permutation and signs; false when the active rays do not
-/// share them (or a direction is zero or not finite): such packets are traced ray by ray.
+/// share them (or a direction is zero or not finite, or an origin not finite): such packets are traced ray by ray.
 bool packet_eligible(const RayPacket& p, PacketContext& c) {
     c.first = std::countr_zero(p.active);
     int key = -1;
     for (uint32_t m = p.active; m; m &= m - 1) {
         const int i = std::countr_zero(m);
         const Vec3 d(p.dir[0][i], p.dir[1][i], p.dir[2][i]);
-        if (!is_finite(d)) return false;
+        if (!is_finite(d) || !is_finite(Vec3(p.org[0][i], p.org[1][i], p.org[2][i]))) return false;
         const int kz = max_dimension(abs(d));
         if (!(std::fabs(d[kz]) > 0.0f)) return false;
         const int k =

@@ -16,6 +16,8 @@
 #include <immintrin.h>
 
 #include <bit>
+#include <cmath>
+#include <cstring>
 
 #include "accel/accelerator.h"
 #include "accel/leaf_blocks.inl"
@@ -47,12 +49,20 @@ __attribute__((target("avx2"), always_inline)) inline __m256 frustum_plane(const
     return _mm256_or_ps(kNear ? _mm256_min_ps(p0, p1) : _mm256_max_ps(p0, p1), nan);
 }
 
-/// The largest of 16 floats.
+/// The largest of 16 floats (none NaN).
 __attribute__((target("avx2"), always_inline)) inline float max16(const float* v) {
     __m256 m = _mm256_max_ps(_mm256_load_ps(v), _mm256_load_ps(v + 8));
     m = _mm256_max_ps(m, _mm256_permute2f128_ps(m, m, 1));
     m = _mm256_max_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
     return _mm_cvtss_f32(_mm256_castps256_ps128(_mm256_max_ps(m, _mm256_shuffle_ps(m, m, 1))));
+}
+
+/// The smallest of 16 floats (none NaN).
+__attribute__((target("avx2"), always_inline)) inline float min16(const float* v) {
+    __m256 m = _mm256_min_ps(_mm256_load_ps(v), _mm256_load_ps(v + 8));
+    m = _mm256_min_ps(m, _mm256_permute2f128_ps(m, m, 1));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+    return _mm_cvtss_f32(_mm256_castps256_ps128(_mm256_min_ps(m, _mm256_shuffle_ps(m, m, 1))));
 }
 
 /// A packet's rays in structure-of-arrays form for the per-ray leaf-box test.
@@ -96,34 +106,51 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
     Ray rays[kPacketSize];
     TriangleRay tr[kPacketSize];
     Hit hits[kPacketSize];
-    // Structure-of-arrays copies for the per-ray leaf-box test; inactive lanes repeat the first ray.
+    // Structure-of-arrays copies for the per-ray leaf-box test; inactive lanes repeat the
+    // first active ray, so they widen no bound below. The divisions are the single ray's
+    // (BvhRay, TriangleRay), eight lanes at a time.
     PacketBoxRays sr;
+    alignas(32) float dir[3][kPacketSize];
     const int first = std::countr_zero(p.active);
-    for (int i = 0; i < kPacketSize; ++i) {
-        const bool active = (p.active >> i) & 1;
-        rays[i] = p.ray(active ? i : first);
-        const BvhRay br(rays[i]);
-        for (int a = 0; a < 3; ++a) sr.org[a][i] = br.org[a], sr.inv[a][i] = br.inv_dir[a];
-        sr.tmin[i] = br.tmin;
-        sr.tmax_scaled[i] = active ? rays[i].tmax * kRobustFarScale : -kInfinity;
-        if (active) tr[i] = TriangleRay(rays[i]);
+    std::memcpy(sr.org, p.org, sizeof(sr.org));
+    std::memcpy(dir, p.dir, sizeof(dir));
+    std::memcpy(sr.tmin, p.tmin, sizeof(sr.tmin));
+    for (uint32_t m = ~p.active & 0xFFFFu; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        for (int a = 0; a < 3; ++a) sr.org[a][i] = p.org[a][first], dir[a][i] = p.dir[a][first];
+        sr.tmin[i] = p.tmin[first];
     }
-    // The frustum: per axis the extreme origins and inverse directions of the active rays
+    const TriangleRay first_tr(p.ray(first));  // packet_eligible: every ray has its permutation
+    const int kx = first_tr.kx, ky = first_tr.ky, kz = first_tr.kz;
+    alignas(32) float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];
+    const __m256 one = _mm256_set1_ps(1.0f);
+    for (int h = 0; h < kPacketSize; h += 8) {
+        for (int a = 0; a < 3; ++a) _mm256_store_ps(sr.inv[a] + h, _mm256_div_ps(one, _mm256_load_ps(dir[a] + h)));
+        const __m256 dz = _mm256_load_ps(dir[kz] + h);
+        _mm256_store_ps(sx + h, _mm256_div_ps(_mm256_load_ps(dir[kx] + h), dz));
+        _mm256_store_ps(sy + h, _mm256_div_ps(_mm256_load_ps(dir[ky] + h), dz));
+        _mm256_store_ps(sz + h, _mm256_div_ps(one, dz));
+        _mm256_store_ps(sr.tmax_scaled + h,
+                        _mm256_mul_ps(_mm256_load_ps(p.tmax + h), _mm256_set1_ps(kRobustFarScale)));
+    }
+    for (uint32_t m = p.active; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        rays[i] = p.ray(i);
+        tr[i] = first_tr;
+        for (int a = 0; a < 3; ++a) tr[i].org[a] = p.org[a][i];
+        tr[i].sx = sx[i], tr[i].sy = sy[i], tr[i].sz = sz[i];
+    }
+    for (uint32_t m = ~p.active & 0xFFFFu; m; m &= m - 1) sr.tmax_scaled[std::countr_zero(m)] = -kInfinity;
+    // The frustum: per axis the extreme origins and inverse directions of the packet's rays
     // (packet_eligible: all share their direction signs).
-    const BvhRay first_ray(rays[first]);
     FrustumAxis fa[3];
-    float tmin_lo = kInfinity;
+    const float tmin_lo = min16(sr.tmin);
     for (int a = 0; a < 3; ++a) {
-        float o_lo = kInfinity, o_hi = -kInfinity, i_lo = kInfinity, i_hi = -kInfinity;
-        for (uint32_t m = p.active; m; m &= m - 1) {
-            const int i = std::countr_zero(m);
-            o_lo = std::min(o_lo, sr.org[a][i]), o_hi = std::max(o_hi, sr.org[a][i]);
-            i_lo = std::min(i_lo, sr.inv[a][i]), i_hi = std::max(i_hi, sr.inv[a][i]);
-            tmin_lo = std::min(tmin_lo, sr.tmin[i]);
-        }
+        const float o_lo = min16(sr.org[a]), o_hi = max16(sr.org[a]);
+        const float i_lo = min16(sr.inv[a]), i_hi = max16(sr.inv[a]);
         // Positive direction: distance grows with plane - o, so the nearest near plane is
         // seen from the largest origin; negative: from the smallest.
-        const int neg = first_ray.neg[a];
+        const int neg = std::signbit(p.dir[a][first]) ? 1 : 0;  // as BvhRay::neg
         sr.neg[a] = neg;
         fa[a].o_near = _mm256_set1_ps(neg ? o_lo : o_hi);
         fa[a].o_far = _mm256_set1_ps(neg ? o_hi : o_lo);
