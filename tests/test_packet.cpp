@@ -177,6 +177,49 @@ TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactiv
     }
 }
 
+TEST_CASE("packets agree with single rays that run inside box planes (zero direction components)") {
+    // A 16 x 16 grid of quads in z = 0 over [-1, 1]^2: many leaf boxes have a face on a
+    // grid line. Each packet starts on a grid line x = k / 8 and mixes rays with a
+    // signed-zero x direction (inverse +-inf, 0 * inf = NaN in that slab) with rays
+    // slightly tilted the same way, so the packet's frustum meets 0 * inf at its corners.
+    PacketSimdGuard guard;
+    Scene scene;
+    const int n = 16;
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x)
+            scene.triangles.positions.push_back(Vec3(-1.0f + 2.0f * float(x) / n, -1.0f + 2.0f * float(y) / n, 0.0f));
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const uint32_t a = uint32_t(y * (n + 1) + x), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+            scene.triangles.indices.insert(scene.triangles.indices.end(), {a, b, d, a, d, c});
+        }
+    scene.triangles.material.assign(scene.triangles.indices.size() / 3, 0);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
+    for (PacketSimd path : runnable_packet_paths()) {
+        const Accelerator acc(scene, with_layout(layout));
+        force_packet_simd(path);
+        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+        CAPTURE(name);
+        Agreement a;
+        for (int k = -8; k <= 8; ++k)
+            for (const float sign : {-1.0f, 1.0f})
+                for (int rep = 0; rep < 8; ++rep) {
+                    RayPacket p;
+                    const float y0 = -0.9f + 1.8f * u(rng);
+                    for (int i = 0; i < kPacketSize; ++i) {
+                        const float dx = i % 2 ? sign * 0.0f : sign * 1e-3f * float(i);
+                        p.set(i, Ray{Vec3(float(k) / 8.0f, y0 + 0.01f * float(i), 1.0f),
+                                     Vec3(dx, 0.05f * u(rng), -1.0f)});
+                    }
+                    compare_packet(acc, p, a);
+                }
+        CHECK(a.mismatches == 0);
+        CHECK(a.hits > a.rays / 2);
+    }
+}
+
 TEST_CASE("packets on the bunny and on the pairs layout (ray-by-ray fallback) agree with single rays") {
     PacketSimdGuard guard;
     const TriangleMesh mesh = read_mesh_triangles(SAHARA_ASSETS_DIR "/obj/stanford-bunny/stanford-bunny.obj");
