@@ -117,18 +117,18 @@ TEST_CASE("packets agree with single rays: coherent camera tiles, on every SIMD 
     const Scene scene = mixed_scene();
     const int n = kSanitized ? 32 : 96;
     for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
-    for (PacketSimd path : runnable_packet_paths()) {
-        const Accelerator acc(scene, with_layout(layout));
-        force_packet_simd(path);
-        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
-        CAPTURE(name);
-        Agreement a;
-        for (const Vec3& eye : {Vec3(0.3f, 0.2f, 4.0f), Vec3(-3.0f, 2.0f, -3.0f), Vec3(0.0f, 0.0f, 5.0f)})
-            for (const RayPacket& p : camera_packets(eye, n, 0.6f)) compare_packet(acc, p, a);
-        CHECK(a.mismatches == 0);
-        CHECK(a.ties <= a.rays / 1000);
-        CHECK(a.hits > a.rays / 4);
-    }
+        for (PacketSimd path : runnable_packet_paths()) {
+            const Accelerator acc(scene, with_layout(layout));
+            force_packet_simd(path);
+            const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+            CAPTURE(name);
+            Agreement a;
+            for (const Vec3& eye : {Vec3(0.3f, 0.2f, 4.0f), Vec3(-3.0f, 2.0f, -3.0f), Vec3(0.0f, 0.0f, 5.0f)})
+                for (const RayPacket& p : camera_packets(eye, n, 0.6f)) compare_packet(acc, p, a);
+            CHECK(a.mismatches == 0);
+            CHECK(a.ties <= a.rays / 1000);
+            CHECK(a.hits > a.rays / 4);
+        }
 }
 
 TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactive lanes, axis rays") {
@@ -138,43 +138,44 @@ TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactiv
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     const int packets = kSanitized ? 150 : 2000;
     for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
-    for (PacketSimd path : runnable_packet_paths()) {
-        const Accelerator acc(scene, with_layout(layout));
-        force_packet_simd(path);
-        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
-        CAPTURE(name);
-        Agreement a;
-        for (int k = 0; k < packets; ++k) {
-            RayPacket p;
-            const int kind = k % 4;
-            // Same-octant bundles (kernel path) with jittered origins, or fully random rays (fallback).
-            const Vec3 base_o(3.0f * u(rng), 3.0f * u(rng), 4.0f);
-            // kind 0: non-negative x and y, so the +0 components of the axis rays share the octant.
-            const float ux = kind == 0 ? std::fabs(u(rng)) : u(rng),
-                        uy = kind == 0 ? std::fabs(u(rng)) : u(rng);
-            const Vec3 base_d = normalize(Vec3(0.3f * ux, 0.3f * uy, -1.0f));
-            const uint32_t active = kind == 3 ? uint32_t(rng()) & 0xFFFFu : 0xFFFFu;
-            for (int i = 0; i < kPacketSize; ++i) {
-                Ray r;
-                if (kind == 1) {
-                    r = Ray{Vec3(3.0f * u(rng), 3.0f * u(rng), 3.0f * u(rng)), Vec3(u(rng), u(rng), u(rng))};
-                } else {
-                    r = Ray{base_o + Vec3(0.05f * u(rng), 0.05f * u(rng), 0.0f),
-                            base_d + Vec3(0.02f * std::fabs(u(rng)), 0.02f * std::fabs(u(rng)), 0.0f)};
+        for (PacketSimd path : runnable_packet_paths()) {
+            const Accelerator acc(scene, with_layout(layout));
+            force_packet_simd(path);
+            const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+            CAPTURE(name);
+            Agreement a;
+            for (int k = 0; k < packets; ++k) {
+                RayPacket p;
+                const int kind = k % 4;
+                // Same-octant bundles (kernel path) with jittered origins, or fully random rays (fallback).
+                const Vec3 base_o(3.0f * u(rng), 3.0f * u(rng), 4.0f);
+                // kind 0: non-negative x and y, so the +0 components of the axis rays share the octant.
+                const float ux = kind == 0 ? std::fabs(u(rng)) : u(rng),
+                            uy = kind == 0 ? std::fabs(u(rng)) : u(rng);
+                const Vec3 base_d = normalize(Vec3(0.3f * ux, 0.3f * uy, -1.0f));
+                const uint32_t active = kind == 3 ? uint32_t(rng()) & 0xFFFFu : 0xFFFFu;
+                for (int i = 0; i < kPacketSize; ++i) {
+                    Ray r;
+                    if (kind == 1) {
+                        r = Ray{Vec3(3.0f * u(rng), 3.0f * u(rng), 3.0f * u(rng)),
+                                Vec3(u(rng), u(rng), u(rng))};
+                    } else {
+                        r = Ray{base_o + Vec3(0.05f * u(rng), 0.05f * u(rng), 0.0f),
+                                base_d + Vec3(0.02f * std::fabs(u(rng)), 0.02f * std::fabs(u(rng)), 0.0f)};
+                    }
+                    if (kind == 2) r.tmax = 3.0f + 2.0f * u(rng);  // some end before the geometry
+                    if (kind == 0 && i % 5 == 0) r.dir = Vec3(0.0f, 0.0f, -1.0f);  // zero components
+                    if (kind == 0 && i % 7 == 0) r.tmin = 3.0f;
+                    if (active >> i & 1) p.set(i, r);
                 }
-                if (kind == 2) r.tmax = 3.0f + 2.0f * u(rng);                  // some end before the geometry
-                if (kind == 0 && i % 5 == 0) r.dir = Vec3(0.0f, 0.0f, -1.0f);  // zero components
-                if (kind == 0 && i % 7 == 0) r.tmin = 3.0f;
-                if (active >> i & 1) p.set(i, r);
+                p.active = active;
+                compare_packet(acc, p, a);
             }
-            p.active = active;
-            compare_packet(acc, p, a);
+            CHECK(a.mismatches == 0);
+            CHECK(a.inactive_touched == 0);
+            CHECK(a.ties <= a.rays / 1000);
+            CHECK(a.hits > a.rays / 10);
         }
-        CHECK(a.mismatches == 0);
-        CHECK(a.inactive_touched == 0);
-        CHECK(a.ties <= a.rays / 1000);
-        CHECK(a.hits > a.rays / 10);
-    }
 }
 
 TEST_CASE("packets agree with single rays that run inside box planes (zero direction components)") {
@@ -187,7 +188,8 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
     const int n = 16;
     for (int y = 0; y <= n; ++y)
         for (int x = 0; x <= n; ++x)
-            scene.triangles.positions.push_back(Vec3(-1.0f + 2.0f * float(x) / n, -1.0f + 2.0f * float(y) / n, 0.0f));
+            scene.triangles.positions.push_back(
+                Vec3(-1.0f + 2.0f * float(x) / n, -1.0f + 2.0f * float(y) / n, 0.0f));
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
             const uint32_t a = uint32_t(y * (n + 1) + x), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
@@ -197,27 +199,27 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
-    for (PacketSimd path : runnable_packet_paths()) {
-        const Accelerator acc(scene, with_layout(layout));
-        force_packet_simd(path);
-        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
-        CAPTURE(name);
-        Agreement a;
-        for (int k = -8; k <= 8; ++k)
-            for (const float sign : {-1.0f, 1.0f})
-                for (int rep = 0; rep < 8; ++rep) {
-                    RayPacket p;
-                    const float y0 = -0.9f + 1.8f * u(rng);
-                    for (int i = 0; i < kPacketSize; ++i) {
-                        const float dx = i % 2 ? sign * 0.0f : sign * 1e-3f * float(i);
-                        p.set(i, Ray{Vec3(float(k) / 8.0f, y0 + 0.01f * float(i), 1.0f),
-                                     Vec3(dx, 0.05f * u(rng), -1.0f)});
+        for (PacketSimd path : runnable_packet_paths()) {
+            const Accelerator acc(scene, with_layout(layout));
+            force_packet_simd(path);
+            const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+            CAPTURE(name);
+            Agreement a;
+            for (int k = -8; k <= 8; ++k)
+                for (const float sign : {-1.0f, 1.0f})
+                    for (int rep = 0; rep < 8; ++rep) {
+                        RayPacket p;
+                        const float y0 = -0.9f + 1.8f * u(rng);
+                        for (int i = 0; i < kPacketSize; ++i) {
+                            const float dx = i % 2 ? sign * 0.0f : sign * 1e-3f * float(i);
+                            p.set(i, Ray{Vec3(float(k) / 8.0f, y0 + 0.01f * float(i), 1.0f),
+                                         Vec3(dx, 0.05f * u(rng), -1.0f)});
+                        }
+                        compare_packet(acc, p, a);
                     }
-                    compare_packet(acc, p, a);
-                }
-        CHECK(a.mismatches == 0);
-        CHECK(a.hits > a.rays / 2);
-    }
+            CHECK(a.mismatches == 0);
+            CHECK(a.hits > a.rays / 2);
+        }
 }
 
 TEST_CASE("packets on the bunny and on the pairs layout (ray-by-ray fallback) agree with single rays") {

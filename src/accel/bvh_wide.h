@@ -177,7 +177,8 @@ __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(con
         t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv[a]), t1);
     }
     _mm256_store_ps(t_near, t0);
-    return _mm256_movemask_ps(_mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
+    return _mm256_movemask_ps(
+        _mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
@@ -260,7 +261,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         c = __builtin_ctz(unsigned(mask));
                         mask &= mask - 1;
                         cur = Entry{n.child[c], n.count[c], t[c]};
-                            } while (mask);
+                    } while (mask);
                     continue;
                 }
                 // Insert the others into the stack top sorted by distance (farthest

@@ -29,7 +29,8 @@ struct PacketContext {
 };
 
 /// Fills the common permutation and signs; false when the active rays do not
-/// share them (or a direction is zero or not finite, or an origin not finite): such packets are traced ray by ray.
+/// share them (or a direction is zero or not finite, or an origin not finite): such packets are traced ray by
+/// ray.
 bool packet_eligible(const RayPacket& p, PacketContext& c) {
     c.first = std::countr_zero(p.active);
     int key = -1;

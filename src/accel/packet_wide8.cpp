@@ -41,8 +41,10 @@ struct FrustumAxis {
 /// slab plane with a zero direction component) makes the lane NaN, which the
 /// caller's min/max ignore, as the single-ray test ignores that slab.
 template <bool kNear>
-__attribute__((target("avx2"), always_inline)) inline __m256 frustum_plane(const char* node, const FrustumAxis& a) {
-    const __m256 plane = _mm256_load_ps(reinterpret_cast<const float*>(node + (kNear ? a.near_off : a.far_off)));
+__attribute__((target("avx2"), always_inline)) inline __m256 frustum_plane(const char* node,
+                                                                           const FrustumAxis& a) {
+    const __m256 plane =
+        _mm256_load_ps(reinterpret_cast<const float*>(node + (kNear ? a.near_off : a.far_off)));
     const __m256 x = _mm256_sub_ps(plane, kNear ? a.o_near : a.o_far);
     const __m256 p0 = _mm256_mul_ps(x, a.inv_lo), p1 = _mm256_mul_ps(x, a.inv_hi);
     const __m256 nan = _mm256_cmp_ps(p0, p1, _CMP_UNORD_Q);
@@ -125,7 +127,8 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
     alignas(32) float sx[kPacketSize], sy[kPacketSize], sz[kPacketSize];
     const __m256 one = _mm256_set1_ps(1.0f);
     for (int h = 0; h < kPacketSize; h += 8) {
-        for (int a = 0; a < 3; ++a) _mm256_store_ps(sr.inv[a] + h, _mm256_div_ps(one, _mm256_load_ps(dir[a] + h)));
+        for (int a = 0; a < 3; ++a)
+            _mm256_store_ps(sr.inv[a] + h, _mm256_div_ps(one, _mm256_load_ps(dir[a] + h)));
         const __m256 dz = _mm256_load_ps(dir[kz] + h);
         _mm256_store_ps(sx + h, _mm256_div_ps(_mm256_load_ps(dir[kx] + h), dz));
         _mm256_store_ps(sy + h, _mm256_div_ps(_mm256_load_ps(dir[ky] + h), dz));
@@ -201,8 +204,8 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
                     t1 = _mm256_min_ps(frustum_plane<false>(base, fa[a]), t1);
                 }
                 // Conservative: t0 is at most, t1 * scale at least, every ray's own value.
-                const __m256 far_t = _mm256_min_ps(_mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)),
-                                                   _mm256_set1_ps(reach));
+                const __m256 far_t =
+                    _mm256_min_ps(_mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _mm256_set1_ps(reach));
                 int any = _mm256_movemask_ps(_mm256_cmp_ps(t0, far_t, _CMP_LE_OQ));
                 if (any) {
                     alignas(32) float order[8];
