@@ -99,10 +99,10 @@ class BvhBuildJob {
         node.index = first_child;
         node.count = 0;
         if (n > params_.parallel_threshold) {
+            // No taskwait (see BinnedBuild::build): the parallel region's end waits for all tasks.
 #pragma omp task default(shared) firstprivate(first_child, begin, mid, depth)
             build_node(first_child, begin, mid, depth + 1);
             build_node(first_child + 1, mid, end, depth + 1);
-#pragma omp taskwait
         } else {
             build_node(first_child, begin, mid, depth + 1);
             build_node(first_child + 1, mid, end, depth + 1);
