@@ -304,12 +304,19 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
                                                                         Hit& hit, Counters& counters) const {
-    const TriangleRay tr(ray);
+    // The triangle constants (three divisions) are made at the first leaf: many
+    // rays (most diffuse bounces leaving a convex part) never reach one.
+    TriangleRay tr;
+    bool tr_ready = false;
     BvhRay br(ray);
     Hit best;
     const bool found = traverse_wide<kAnyHit, kAvx>(
         tree, br,
         [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
+            if (!tr_ready) {
+                tr = TriangleRay(ray);
+                tr_ready = true;
+            }
             if constexpr (kBlocks)
                 return test_blocks<kAnyHit, kCutouts, kAvx>(ray, tr, first, count, tmax, best);
             else
