@@ -5,6 +5,7 @@
 #include <cstring>
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <string>
 
 #include "accel/accelerator.h"
@@ -313,6 +314,42 @@ TEST_CASE("axis-parallel rays with the origin on a node's slab plane are not los
             if (!acc.intersect(r, h) || !acc.occluded(Ray{{px, py, 1}, {0, 0, -1}})) ++missed;
         }
     CHECK(missed == 0);
+}
+
+TEST_CASE("box test is conservative: a box around a point of the ray, one float step wide, is hit") {
+    // The ray's point at t* is found in double precision and the box is the float
+    // box just around it, so the exact ray passes through the box. Entry and exit
+    // are then within a few float steps of each other: the float slab test keeps
+    // the box only thanks to the 1 + 2 gamma(3) enlargement of the far distance.
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), ts(0.01, 100.0);
+    std::uniform_real_distribution<double> scale_exp(-8.0, 8.0);
+    int missed = 0, late_entry = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const double s = std::exp2(scale_exp(rng));
+        const Vec3 o(float(u(rng) * s), float(u(rng) * s), float(u(rng) * s));
+        Vec3 d(float(u(rng)), float(u(rng)), float(u(rng)));
+        if (i % 7 == 0) d.x = 0.0f;  // axis-parallel cases too
+        if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) continue;
+        const double t = ts(rng) * s;
+        Bounds3 b;
+        for (int a = 0; a < 3; ++a) {
+            const double p = double(o[a]) + t * double(d[a]);
+            const float f = float(p);
+            b.lo[a] = double(f) <= p ? f : std::nextafter(f, -INFINITY);
+            b.hi[a] = double(f) >= p ? f : std::nextafter(f, INFINITY);
+        }
+        BvhNode node;
+        node.set_box(b);
+        const BvhRay r(Ray{o, d});
+        float t_entry = 0.0f;
+        if (!intersect_bvh_node(node, r, t_entry))
+            ++missed;
+        else if (double(t_entry) > t * (1.0 + 1e-6))
+            ++late_entry;
+    }
+    CHECK(missed == 0);
+    CHECK(late_entry == 0);
 }
 
 TEST_CASE("pair-node box test matches the single-node test, including zero directions on slab planes") {

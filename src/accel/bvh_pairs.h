@@ -46,21 +46,25 @@ BvhPairs make_bvh_pairs(const Bvh& bvh);
 /// and t_near[c] is then its entry distance. Same answers as intersect_bvh_node.
 inline int intersect_bvh_pair(const BvhPairNode& n, const BvhRay& r, float t_near[2]) {
 #if defined(__SSE2__)
-    // Lanes of one axis after the sign fix-up: near(c0), near(c1), far(c0), far(c1).
-    auto axis = [](const float* b, float org, float inv, int neg) {
-        __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(b), _mm_set1_ps(org)), _mm_set1_ps(inv));
-        if (neg) t = _mm_shuffle_ps(t, t, _MM_SHUFFLE(1, 0, 3, 2));
-        return t;
+    // Lanes of one axis after the sign fix-up: near(c0), near(c1), far(c0), far(c1);
+    // far lanes use the enlarged inverse direction (BvhRay::inv_far).
+    auto axis = [](const float* b, float org, float inv, float inv_far, int neg) {
+        const __m128 scale = _mm_set_ps(inv_far, inv_far, inv, inv);
+        const __m128 p = _mm_load_ps(b);
+        // With a negative direction the near planes are the `hi` lanes: swap before scaling.
+        const __m128 planes = neg ? _mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 0, 3, 2)) : p;
+        return _mm_mul_ps(_mm_sub_ps(planes, _mm_set1_ps(org)), scale);
     };
-    // Negating the far lanes turns min(far) into max(-far): one max per axis.
-    // _mm_max_ps(x, acc) returns acc when x is NaN, the NaN-ignoring order.
+    // Negating the far lanes turns min(far) into max(-far): one max per step, in the
+    // order of intersect_bvh_node (_mm_max_ps(x, acc) returns acc when x is NaN).
     const __m128 negate_far = _mm_set_ps(-0.0f, -0.0f, 0.0f, 0.0f);
-    __m128 acc = _mm_set_ps(-r.tmax, -r.tmax, r.tmin, r.tmin);
-    acc = _mm_max_ps(_mm_xor_ps(axis(n.x, r.org[0], r.inv_dir[0], r.neg[0]), negate_far), acc);
-    acc = _mm_max_ps(_mm_xor_ps(axis(n.y, r.org[1], r.inv_dir[1], r.neg[1]), negate_far), acc);
-    acc = _mm_max_ps(_mm_xor_ps(axis(n.z, r.org[2], r.inv_dir[2], r.neg[2]), negate_far), acc);
-    const __m128 far =
-        _mm_mul_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-kRobustFarScale));
+    const float tmax = r.tmax * kRobustFarScale;
+    const __m128 init = _mm_set_ps(-tmax, -tmax, r.tmin, r.tmin);
+    const __m128 x = _mm_xor_ps(axis(n.x, r.org[0], r.inv_dir[0], r.inv_far[0], r.neg[0]), negate_far);
+    const __m128 y = _mm_xor_ps(axis(n.y, r.org[1], r.inv_dir[1], r.inv_far[1], r.neg[1]), negate_far);
+    const __m128 z = _mm_xor_ps(axis(n.z, r.org[2], r.inv_dir[2], r.inv_far[2], r.neg[2]), negate_far);
+    const __m128 acc = _mm_max_ps(_mm_max_ps(y, z), _mm_max_ps(x, init));
+    const __m128 far = _mm_xor_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-0.0f));
     alignas(16) float out[4];
     _mm_store_ps(out, acc);
     t_near[0] = out[0];
@@ -70,13 +74,16 @@ inline int intersect_bvh_pair(const BvhPairNode& n, const BvhRay& r, float t_nea
     int mask = 0;
     for (int c = 0; c < 2; ++c) {
         const float* b[3] = {n.x, n.y, n.z};
-        float t0 = r.tmin, t1 = r.tmax;
+        float tn[3], tf[3];
         for (int a = 0; a < 3; ++a) {
-            t0 = max_ignore_nan(t0, (b[a][c + 2 * r.neg[a]] - r.org[a]) * r.inv_dir[a]);
-            t1 = min_ignore_nan(t1, (b[a][c + 2 - 2 * r.neg[a]] - r.org[a]) * r.inv_dir[a]);
+            tn[a] = (b[a][c + 2 * r.neg[a]] - r.org[a]) * r.inv_dir[a];
+            tf[a] = (b[a][c + 2 - 2 * r.neg[a]] - r.org[a]) * r.inv_far[a];
         }
+        const float t0 = max_ignore_nan(max_ignore_nan(r.tmin, tn[0]), max_ignore_nan(tn[2], tn[1]));
+        const float t1 =
+            min_ignore_nan(min_ignore_nan(r.tmax * kRobustFarScale, tf[0]), min_ignore_nan(tf[2], tf[1]));
         t_near[c] = t0;
-        if (t0 <= t1 * kRobustFarScale) mask |= 1 << c;
+        if (t0 <= t1) mask |= 1 << c;
     }
     return mask;
 #endif

@@ -8,7 +8,10 @@
 /// order below, which treats that slab as unbounded, the conservative answer.
 /// Following Ize, "Robust BVH Ray Traversal" (JCGT 2013), the far distance is
 /// enlarged by 1 + 2 gamma(3) so rounding in the slab test never culls a box
-/// the ray actually enters.
+/// the ray actually enters. The factor is folded into the inverse direction used
+/// for far planes (inv_far): the far distance still goes through four roundings
+/// (reciprocal, scaling, subtraction, product), as when the min is scaled after,
+/// but the scaling leaves the per-node dependency chain.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,11 +25,15 @@ namespace sahara {
 /// Marks "no node" in traversal.
 inline constexpr uint32_t kNoNode = 0xFFFFFFFFu;
 
+/// 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Ize 2013; pbrt-v3 sec. 3.9).
+inline constexpr float kRobustFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
+
 /// Per-ray constants of the box test.
 struct BvhRay {
     float org[3];
     float inv_dir[3];
-    int neg[3];  ///< 1 when the direction component is negative (also for -0): near plane is `hi`
+    float inv_far[3];  ///< inv_dir * kRobustFarScale: far-plane distances come out enlarged
+    int neg[3];        ///< 1 when the direction component is negative (also for -0): near plane is `hi`
     float tmin, tmax;
 
     explicit BvhRay(const Ray& r) : tmin(r.tmin), tmax(r.tmax) {
@@ -36,28 +43,31 @@ struct BvhRay {
         org[2] = r.origin.z;
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.0f / d[a];  // +-inf for +-0: handled in intersect_bvh_node
+            inv_far[a] = inv_dir[a] * kRobustFarScale;
             neg[a] = std::signbit(d[a]) ? 1 : 0;
         }
     }
 };
-
-/// 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Ize 2013; pbrt-v3 sec. 3.9).
-inline constexpr float kRobustFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
 
 /// max/min that return the first argument when the second is NaN.
 inline float max_ignore_nan(float acc, float x) { return x > acc ? x : acc; }
 inline float min_ignore_nan(float acc, float x) { return x < acc ? x : acc; }
 
 /// Slab test of one node box; on a hit `t_entry` is the (conservative) entry distance.
+/// The reductions pair the axes as a tree (two steps deep, not three; the SIMD
+/// tests use the same order, so every layout gives the same answers). Each step
+/// keeps its first argument when the second is NaN; an inner step whose second
+/// argument is NaN passes the NaN on, and the outer step then drops that pair,
+/// which only widens the interval.
 inline bool intersect_bvh_node(const BvhNode& n, const BvhRay& r, float& t_entry) {
     const float tx0 = (n.bounds[0 + r.neg[0]] - r.org[0]) * r.inv_dir[0];
-    const float tx1 = (n.bounds[1 - r.neg[0]] - r.org[0]) * r.inv_dir[0];
+    const float tx1 = (n.bounds[1 - r.neg[0]] - r.org[0]) * r.inv_far[0];
     const float ty0 = (n.bounds[2 + r.neg[1]] - r.org[1]) * r.inv_dir[1];
-    const float ty1 = (n.bounds[3 - r.neg[1]] - r.org[1]) * r.inv_dir[1];
+    const float ty1 = (n.bounds[3 - r.neg[1]] - r.org[1]) * r.inv_far[1];
     const float tz0 = (n.bounds[4 + r.neg[2]] - r.org[2]) * r.inv_dir[2];
-    const float tz1 = (n.bounds[5 - r.neg[2]] - r.org[2]) * r.inv_dir[2];
-    const float t0 = max_ignore_nan(max_ignore_nan(max_ignore_nan(r.tmin, tx0), ty0), tz0);
-    const float t1 = min_ignore_nan(min_ignore_nan(min_ignore_nan(r.tmax, tx1), ty1), tz1) * kRobustFarScale;
+    const float tz1 = (n.bounds[5 - r.neg[2]] - r.org[2]) * r.inv_far[2];
+    const float t0 = max_ignore_nan(max_ignore_nan(r.tmin, tx0), max_ignore_nan(tz0, ty0));
+    const float t1 = min_ignore_nan(min_ignore_nan(r.tmax * kRobustFarScale, tx1), min_ignore_nan(tz1, ty1));
     t_entry = t0;
     return t0 <= t1;
 }

@@ -95,7 +95,7 @@ const char* simd_path_name(SimdPath path);
 /// inverse direction, and the byte offsets of each axis's near and far planes in a node.
 template <int N>
 struct WideRaySse {
-    __m128 org[3], inv[3];
+    __m128 org[3], inv[3], inv_far[3];
     uint32_t near_off[3], far_off[3];
 
     explicit WideRaySse(const BvhRay& r) {
@@ -105,6 +105,7 @@ struct WideRaySse {
         for (int a = 0; a < 3; ++a) {
             org[a] = _mm_set1_ps(r.org[a]);
             inv[a] = _mm_set1_ps(r.inv_dir[a]);
+            inv_far[a] = _mm_set1_ps(r.inv_far[a]);
             // Near plane of an axis is `hi` for a negative direction.
             near_off[a] = r.neg[a] ? hi[a] : lo[a];
             far_off[a] = r.neg[a] ? lo[a] : hi[a];
@@ -119,17 +120,21 @@ using Bvh4Ray = WideRaySse<4>;
 template <int N>
 __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N>& n, const WideRaySse<N>& r,
                                                              int g, float tmin, float tmax, __m128& t_near) {
-    // _mm_max_ps(x, acc) and _mm_min_ps(x, acc) return acc when x is NaN (the NaN-ignoring order).
-    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+    // The order of intersect_bvh_node: _mm_max_ps(x, acc) and _mm_min_ps(x, acc)
+    // return acc when x is NaN.
     const char* base = reinterpret_cast<const char*>(&n) + 16 * g;
+    __m128 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
         const __m128 near = _mm_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
         const __m128 far = _mm_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
-        t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, r.org[a]), r.inv[a]), t0);
-        t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, r.org[a]), r.inv[a]), t1);
+        tn[a] = _mm_mul_ps(_mm_sub_ps(near, r.org[a]), r.inv[a]);
+        tf[a] = _mm_mul_ps(_mm_sub_ps(far, r.org[a]), r.inv_far[a]);
     }
+    const __m128 t0 = _mm_max_ps(_mm_max_ps(tn[1], tn[2]), _mm_max_ps(tn[0], _mm_set1_ps(tmin)));
+    const __m128 t1 =
+        _mm_min_ps(_mm_min_ps(tf[1], tf[2]), _mm_min_ps(tf[0], _mm_set1_ps(tmax * kRobustFarScale)));
     t_near = t0;
-    return _mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(kRobustFarScale))));
+    return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 }
 
 /// The four children of a BVH4 node (see intersect_wide_sse).
@@ -139,12 +144,13 @@ __attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, cons
 }
 
 /// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin and
-/// negated inverse direction, and the byte offsets of each axis's near and far planes.
+/// negated inverse directions (for near and far planes, see BvhRay), and the byte
+/// offsets of each axis's near and far planes.
 /// The test computes (org - plane) * -inv, which rounds exactly like (plane - org) * inv
 /// (round-to-nearest is symmetric under negation) but lets the plane be a memory operand
 /// of the subtraction: three instructions per plane instead of five.
 struct Bvh8RayAvx {
-    __m256 org[3], ninv[3];
+    __m256 org[3], ninv[3], ninv_far[3];
     uint32_t near_off[3], far_off[3];
 
     Bvh8RayAvx() = default;
@@ -157,6 +163,7 @@ struct Bvh8RayAvx {
         for (int a = 0; a < 3; ++a) {
             org[a] = _mm256_set1_ps(r.org[a]);
             ninv[a] = _mm256_set1_ps(-r.inv_dir[a]);
+            ninv_far[a] = _mm256_set1_ps(-r.inv_far[a]);
             near_off[a] = uint32_t(64 * a + 32 * r.neg[a]);
             far_off[a] = uint32_t(64 * a + 32 * (1 - r.neg[a]));
         }
@@ -168,17 +175,19 @@ struct Bvh8RayAvx {
 __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
                                                                              const Bvh8RayAvx& r, float tmin,
                                                                              float tmax, float* t_near) {
-    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax);
     const char* base = reinterpret_cast<const char*>(&n);
+    __m256 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
         const __m256 near = _mm256_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
         const __m256 far = _mm256_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
-        t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(r.org[a], near), r.ninv[a]), t0);
-        t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv[a]), t1);
+        tn[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], near), r.ninv[a]);
+        tf[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv_far[a]);
     }
+    const __m256 t0 = _mm256_max_ps(_mm256_max_ps(tn[1], tn[2]), _mm256_max_ps(tn[0], _mm256_set1_ps(tmin)));
+    const __m256 t1 = _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]),
+                                    _mm256_min_ps(tf[0], _mm256_set1_ps(tmax * kRobustFarScale)));
     _mm256_store_ps(t_near, t0);
-    return _mm256_movemask_ps(
-        _mm256_cmp_ps(t0, _mm256_mul_ps(t1, _mm256_set1_ps(kRobustFarScale)), _CMP_LE_OQ));
+    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
