@@ -150,6 +150,46 @@ TEST_CASE("cli: a missing output directory exits 2 and writes nothing") {
     CHECK_FALSE(fs::exists(out));
 }
 
+TEST_CASE("cli: OpenImageIO is loaded only by commands that read or write an image") {
+    // The glibc loader lists every library it opens under LD_DEBUG=files.
+    TempDir dir("codec");
+    RunResult r = run_sahara("info", dir);  // the default scene has no image textures
+    CHECK(r.code == 0);
+    r = run_sahara("--version", dir);
+    CHECK(r.code == 0);
+    const std::string trace = dir / "ld.txt";
+    auto loads_oiio = [&](const std::string& args) {
+        const std::string cmd = "LD_DEBUG=files LD_DEBUG_OUTPUT=" + trace + " " + std::string(SAHARA_EXE) +
+                                " " + args + " >/dev/null 2>&1";
+        for (const auto& e : fs::directory_iterator(dir.path))
+            if (e.path().filename().string().rfind("ld.txt", 0) == 0) fs::remove(e.path());
+        CHECK(std::system(cmd.c_str()) == 0);
+        std::string all;
+        for (const auto& e : fs::directory_iterator(dir.path))
+            if (e.path().filename().string().rfind("ld.txt", 0) == 0) all += slurp(e.path());
+        CHECK_FALSE(all.empty());
+        return all.find("libOpenImageIO") != std::string::npos;
+    };
+    CHECK_FALSE(loads_oiio("--version"));
+    CHECK_FALSE(loads_oiio("info"));
+    CHECK(loads_oiio("render" + kSmall + "--spp 1 -o " + (dir / "out.png")));
+}
+
+TEST_CASE("cli: a missing image codec exits 2 before rendering and writes nothing") {
+    TempDir dir("nocodec");
+    const std::string out = dir / "out.png";
+    const std::string cmd = "SAHARA_IMAGE_CODEC=" + (dir / "no-such-codec.so") + " " +
+                            std::string(SAHARA_EXE) + " render" + kSmall + "--spp 1 -o " + out +
+                            " >/dev/null 2>" + (dir / "err.txt");
+    const int status = std::system(cmd.c_str());
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 2);
+    const std::string err = slurp(dir / "err.txt");
+    CHECK(err.find(out + ": the image codec plugin is missing") != std::string::npos);
+    CHECK(err.find("no-such-codec.so") != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+}
+
 TEST_CASE("cli: the image does not depend on the thread count") {
     TempDir dir("threads");
     REQUIRE(run_sahara("render" + kSmall + "--spp 8 --threads 1 -o " + (dir / "a.png"), dir).code == 0);

@@ -2,8 +2,6 @@
 // as seen by shadow rays, camera rays, the loaders and the BVH layouts.
 #include <doctest/doctest.h>
 
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +9,7 @@
 #include <unistd.h>
 
 #include "accel/accelerator.h"
+#include "io/image_io.h"
 #include "mesh_fixtures.h"
 #include "render/features.h"
 #include "scene/scene.h"
@@ -126,7 +125,8 @@ struct SimdGuard {
 
 std::vector<SimdPath> simd_paths() { return runnable_simd_paths(); }
 
-constexpr BvhLayout kLayouts[] = {BvhLayout::wide4, BvhLayout::wide8, BvhLayout::wide4_slots, BvhLayout::pairs};
+constexpr BvhLayout kLayouts[] = {BvhLayout::wide4, BvhLayout::wide8, BvhLayout::wide4_slots,
+                                  BvhLayout::pairs};
 
 /// 4 standard deviations of a binomial fraction with probability p over n trials.
 double four_sigma(double p, int n) { return 4.0 * std::sqrt(p * (1.0 - p) / double(n)); }
@@ -260,11 +260,7 @@ void write_checker_png(const fs::path& file, bool rgba) {
             else
                 px.push_back(a);
         }
-    auto out = OIIO::ImageOutput::create(file.string());
-    REQUIRE(out);
-    REQUIRE(out->open(file.string(), OIIO::ImageSpec(kChecker, kChecker, channels, OIIO::TypeDesc::UINT8)));
-    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px.data()));
-    REQUIRE(out->close());
+    write_image_u8(file, kChecker, kChecker, channels, px.data());
 }
 
 /// A glTF unit quad in z = 0 (external .bin), alphaMode MASK over an RGBA checker.

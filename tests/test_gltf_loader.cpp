@@ -1,6 +1,5 @@
 #include <doctest/doctest.h>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -12,6 +11,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_bytes.h"
+#include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
 #include "render/texture.h"
@@ -481,16 +481,11 @@ TEST_CASE("glTF buffers: external .bin, data URI and .glb give the same mesh") {
 
 namespace {
 
-/// A 2x2 RGBA PNG written by OpenImageIO: top row red, (0,128,0,128); bottom row blue, white.
+/// A 2x2 RGBA PNG (written through OpenImageIO): top row red, (0,128,0,128); bottom row blue, white.
 std::vector<uint8_t> tiny_png(const fs::path& dir) {
     const uint8_t px[16] = {255, 0, 0, 255, 0, 128, 0, 128, 0, 0, 255, 255, 255, 255, 255, 255};
     const fs::path file = dir / "tiny.png";
-    auto out = OIIO::ImageOutput::create(file.string());
-    REQUIRE(out);
-    OIIO::ImageSpec spec(2, 2, 4, OIIO::TypeDesc::UINT8);
-    REQUIRE(out->open(file.string(), spec));
-    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px));
-    out->close();
+    write_image_u8(file, 2, 2, 4, px);
     return read_all(file);
 }
 

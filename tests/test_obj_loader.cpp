@@ -1,7 +1,5 @@
 #include <doctest/doctest.h>
 
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -9,6 +7,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
 
@@ -300,11 +299,7 @@ TEST_CASE("OBJ map_d grey masks become alpha; map_Ke textures emission") {
     const fs::path dir = scratch("alpha");
     // A 2x1 single-channel mask: 0 (cut) and 255 (kept).
     const uint8_t px[2] = {0, 255};
-    auto out = OIIO::ImageOutput::create((dir / "mask.png").string());
-    REQUIRE(out);
-    REQUIRE(out->open((dir / "mask.png").string(), OIIO::ImageSpec(2, 1, 1, OIIO::TypeDesc::UINT8)));
-    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, px));
-    out->close();
+    write_image_u8(dir / "mask.png", 2, 1, 1, px);
     write(dir / "m.mtl",
           "newmtl leaf\nKd 0.2 0.8 0.2\nd 1\nmap_d mask.png\n"
           "newmtl lamp\nKe 2 2 2\nmap_Ke mask.png\n");

@@ -1,12 +1,10 @@
 #include "io/image_bytes.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
 #include <cstring>
 
 #include "base/error.h"
+#include "io/image_codec.h"
 
 namespace sahara {
 
@@ -95,23 +93,15 @@ std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_
     if (hint == "embedded.png")
         if (const std::string why = png_structure_error(data, size); !why.empty())
             throw input_error(file, element, "cannot decode image: " + why);
-    OIIO::Filesystem::IOMemReader proxy(data, size);
-    auto in = OIIO::ImageInput::open(hint, nullptr, &proxy);
-    if (!in) throw input_error(file, element, "cannot decode image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-        throw input_error(file, element, "image has no pixels");
-    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        throw input_error(file, element,
-                          "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                              ", over " + std::to_string(kMaxImageSide) + " pixels per side");
-    const int channels = std::min(spec.nchannels, 4);
-    std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-        throw input_error(file, element, "cannot decode image: " + in->geterror());
+    DecodedPixels px;
+    if (const std::string why = image_codec(file).decode(hint, data, size, kMaxImageSide, 4, px);
+        !why.empty())
+        throw input_error(file, element, why);
+    const int channels = px.channels;
+    const std::vector<float>& pixels = px.values;
     auto image = std::make_shared<Image>();
-    image->width = spec.width;
-    image->height = spec.height;
+    image->width = px.width;
+    image->height = px.height;
     expand_to_rgba(pixels, channels, srgb_to_linear, *image);
     return image;
 }

@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -10,11 +9,11 @@
 
 #include "base/error.h"
 #include "base/pending_file.h"
+#include "io/image_codec.h"
 
 namespace sahara {
 
 namespace fs = std::filesystem;
-namespace OIIO = OIIO_NAMESPACE;
 
 namespace {
 
@@ -44,25 +43,19 @@ float srgb_decode(float v) {
 std::shared_ptr<const Image> read_image(const fs::path& file, bool srgb_to_linear) {
     const std::string name = file.string();
     if (!fs::exists(file)) throw input_error(name, "", "image file not found");
-    auto in = OIIO::ImageInput::open(name);
-    if (!in) throw input_error(name, "", "cannot decode image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        throw input_error(name, "",
-                          "image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                              " is outside 1..32768 per side");
-    const int channels = spec.nchannels;
-    std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-        throw input_error(name, "", "cannot decode image: " + in->geterror());
-    in->close();
+    DecodedPixels px;
+    if (const std::string why = image_codec(name).decode(name, nullptr, 0, kMaxImageSide, 64, px);
+        !why.empty())
+        throw input_error(name, "", why);
+    const int channels = px.channels;
+    const std::vector<float>& pixels = px.values;
 
     auto img = std::make_shared<Image>();
-    img->width = spec.width;
-    img->height = spec.height;
-    img->rgba.resize(size_t(spec.width) * size_t(spec.height) * 4);
-    const int alpha = spec.alpha_channel;
-    for (size_t i = 0, n = size_t(spec.width) * size_t(spec.height); i < n; ++i) {
+    img->width = px.width;
+    img->height = px.height;
+    img->rgba.resize(size_t(px.width) * size_t(px.height) * 4);
+    const int alpha = px.alpha_channel;
+    for (size_t i = 0, n = size_t(px.width) * size_t(px.height); i < n; ++i) {
         const float* src = &pixels[i * size_t(channels)];
         float* dst = &img->rgba[i * 4];
         for (int c = 0; c < 3; ++c) {
@@ -93,6 +86,7 @@ void check_output_path(const fs::path& file) {
     if (!fs::is_directory(dir, ec))
         throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
+    image_codec(name);  // a missing codec fails here, not after the render
 }
 
 namespace {
@@ -100,38 +94,39 @@ namespace {
 /// Pixel data in the file's layout: RGB as 8-bit sRGB or float, then the extra
 /// uint32 channels (all 4-byte channels share one word buffer).
 struct EncodedPixels {
-    OIIO::ImageSpec spec;
+    PixelsToWrite spec;
     std::vector<unsigned char> bytes;
     std::vector<uint32_t> words;
-    const void* data() const { return bytes.empty() ? static_cast<const void*>(words.data()) : bytes.data(); }
 };
 
-EncodedPixels encode_pixels(const fs::path& file, int width, int height, const std::vector<float>& rgb,
-                            const std::vector<ExtraChannel>& extra) {
+void encode_pixels(const fs::path& file, int width, int height, const std::vector<float>& rgb,
+                   const std::vector<ExtraChannel>& extra, EncodedPixels& e) {
     const bool hdr = is_hdr_output(file);
     const bool with_extra = lower_extension(file) == ".exr" && !extra.empty();
-    EncodedPixels e;
-    e.spec = OIIO::ImageSpec(width, height, 3, hdr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    e.spec.width = width;
+    e.spec.height = height;
+    e.spec.types.assign(3, hdr ? ChannelType::f32 : ChannelType::u8);
+    e.spec.srgb = !hdr;
     const size_t n = size_t(width) * size_t(height);
     if (!hdr) {
         e.bytes.resize(rgb.size());
         for (size_t i = 0; i < rgb.size(); ++i)
             e.bytes[i] = (unsigned char)std::lround(std::clamp(srgb_encode(rgb[i]), 0.0f, 1.0f) * 255.0f);
-        return e;
+        e.spec.data = e.bytes.data();
+        return;
     }
     const size_t stride = 3 + (with_extra ? extra.size() : 0);
     e.words.resize(n * stride);
     for (size_t i = 0; i < n; ++i) std::memcpy(&e.words[i * stride], &rgb[i * 3], 3 * sizeof(float));
-    if (!with_extra) return e;
-    e.spec.channelformats.assign(3, OIIO::TypeDesc::FLOAT);
+    e.spec.data = e.words.data();
+    if (!with_extra) return;
+    e.spec.names = {"R", "G", "B"};
     for (size_t c = 0; c < extra.size(); ++c) {
-        e.spec.channelnames.push_back(extra[c].name);
-        e.spec.channelformats.push_back(OIIO::TypeDesc::UINT32);
+        e.spec.names.push_back(extra[c].name);
+        e.spec.types.push_back(ChannelType::u32);
         for (size_t i = 0; i < n; ++i) e.words[i * stride + 3 + c] = extra[c].values[i];
     }
-    e.spec.nchannels = int(stride);
-    e.spec.attribute("compression", "zip");  // lossless: the extra channels must survive bit for bit
-    return e;
+    e.spec.lossless_zip = true;  // the extra channels must survive bit for bit
 }
 
 fs::path temp_path_for(const fs::path& file) {
@@ -150,21 +145,17 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
                  const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
     const std::string name = file.string();
     const fs::path tmp = temp_path_for(file);
-    EncodedPixels pixels = encode_pixels(file, width, height, rgb, extra);
-    OIIO::ImageSpec& spec = pixels.spec;
-    for (const auto& [key, value] : metadata) spec.attribute("sahara:" + key, value);
-    spec.attribute("Software", std::string("sahara ") + SAHARA_VERSION);
-    if (!is_hdr_output(file)) spec.attribute("oiio:ColorSpace", "sRGB");
+    const ImageCodecApi& codec = image_codec(name);
+    EncodedPixels pixels;
+    encode_pixels(file, width, height, rgb, extra, pixels);
+    for (const auto& [key, value] : metadata) pixels.spec.attributes.emplace_back("sahara:" + key, value);
+    pixels.spec.attributes.emplace_back("Software", std::string("sahara ") + SAHARA_VERSION);
 
     const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) throw input_error(name, "", "cannot create image writer: " + OIIO::geterror());
-    bool ok = out->open(tmp.string(), spec) && out->write_image(OIIO::TypeDesc::UNKNOWN, pixels.data()) &&
-              out->close();
-    if (!ok) {
+    if (const std::string why = codec.encode(tmp.string(), pixels.spec); !why.empty()) {
         std::error_code ec;
         fs::remove(tmp, ec);
-        throw input_error(name, "", "cannot write image: " + out->geterror());
+        throw input_error(name, "", why);
     }
     std::error_code ec;
     fs::rename(tmp, file, ec);
@@ -175,37 +166,37 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
 }
 
 ImageMetadata read_image_metadata(const fs::path& file) {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw input_error(file.string(), "", "cannot open image: " + OIIO::geterror());
+    const std::string name = file.string();
     ImageMetadata meta;
-    for (const OIIO::ParamValue& p : in->spec().extra_attribs) {
-        const std::string key = p.name().string();
-        if (key.rfind("sahara:", 0) == 0) meta.emplace_back(key.substr(7), p.get_string());
-    }
+    if (const std::string why = image_codec(name).read_attributes(name, "sahara:", meta); !why.empty())
+        throw input_error(name, "", why);
+    for (auto& kv : meta) kv.first.erase(0, 7);  // drop "sahara:"
     return meta;
 }
 
 std::vector<ExtraChannel> read_extra_channels(const fs::path& file, const std::vector<std::string>& names,
                                               int* width, int* height) {
     const std::string name = file.string();
-    auto in = OIIO::ImageInput::open(name);
-    if (!in) throw input_error(name, "", "cannot open image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    *width = spec.width;
-    *height = spec.height;
+    std::vector<std::vector<uint32_t>> values;
+    std::string bad_channel;
+    if (const std::string why =
+            image_codec(name).read_u32_channels(name, names, *width, *height, values, bad_channel);
+        !why.empty())
+        throw input_error(name, bad_channel, why);
     std::vector<ExtraChannel> out;
-    for (const std::string& channel : names) {
-        const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), channel);
-        if (it == spec.channelnames.end()) throw input_error(name, channel, "channel missing");
-        const int c = int(it - spec.channelnames.begin());
-        if (spec.channelformat(c) != OIIO::TypeDesc::UINT32)
-            throw input_error(name, channel, "expected uint32 data");
-        ExtraChannel ch{channel, std::vector<uint32_t>(size_t(spec.width) * size_t(spec.height))};
-        if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::UINT32, ch.values.data()))
-            throw input_error(name, channel, "cannot read: " + in->geterror());
-        out.push_back(std::move(ch));
-    }
+    for (size_t c = 0; c < names.size(); ++c) out.push_back(ExtraChannel{names[c], std::move(values[c])});
     return out;
+}
+
+void write_image_u8(const fs::path& file, int width, int height, int channels, const unsigned char* data) {
+    const std::string name = file.string();
+    PixelsToWrite p;
+    p.width = width;
+    p.height = height;
+    p.types.assign(size_t(channels), ChannelType::u8);
+    p.data = data;
+    if (const std::string why = image_codec(name).encode(name, p); !why.empty())
+        throw input_error(name, "", why);
 }
 
 }  // namespace sahara

@@ -1,8 +1,7 @@
 #pragma once
-/// Image files through OpenImageIO. Reading gives linear RGBA float; writing
-/// picks the format by extension (.png: sRGB 8-bit; .exr/.hdr/.pfm: linear
-/// float) and is atomic: a temporary file in the same directory, then rename,
-/// so an interrupted run never leaves a truncated image.
+/// Image files through OpenImageIO (loaded on first use, see image_codec.h). Reading gives linear RGBA float;
+/// writing picks the format by extension (.png: sRGB 8-bit; .exr/.hdr/.pfm: linear float) and is atomic: a
+/// temporary file in the same directory, then rename, so an interrupted run never leaves a truncated image.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -27,7 +26,7 @@ bool is_supported_output(const std::filesystem::path& file);
 bool is_hdr_output(const std::filesystem::path& file);
 
 /// Checks before rendering that `file` can be written (extension, directory
-/// exists). Throws InputError with a clear message otherwise.
+/// exists, image codec loads). Throws InputError with a clear message otherwise.
 void check_output_path(const std::filesystem::path& file);
 
 /// A named per-pixel uint32 channel, stored losslessly in EXR files (other
@@ -42,6 +41,11 @@ struct ExtraChannel {
 /// here. Returns normally only when the complete file is in place.
 void write_image(const std::filesystem::path& file, int width, int height, const std::vector<float>& rgb,
                  const ImageMetadata& metadata = {}, const std::vector<ExtraChannel>& extra = {});
+
+/// Writes 8-bit pixels as they are (1-4 interleaved channels, no colour
+/// conversion, not atomic): for tests and tools that need a small image file.
+void write_image_u8(const std::filesystem::path& file, int width, int height, int channels,
+                    const unsigned char* data);
 
 /// The metadata write_image stored (keys without the "sahara:" prefix); empty
 /// for files sahara did not write. Throws InputError if the file cannot be opened.

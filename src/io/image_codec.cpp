@@ -1,0 +1,75 @@
+// Finds and loads the image codec plugin (image_codec.h).
+#include "io/image_codec.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <climits>
+#include <cstdlib>
+#include <filesystem>
+
+#include "base/error.h"
+
+// Defined when the codec is linked in (the fuzz targets); null otherwise.
+extern "C" const sahara::ImageCodecApi* sahara_image_codec_api() __attribute__((weak));
+
+namespace sahara {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path executable_dir() {
+    char buf[PATH_MAX];
+    const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+    if (n <= 0) return {};
+    buf[n] = '\0';
+    return fs::path(buf).parent_path();
+}
+
+struct Loaded {
+    const ImageCodecApi* api = nullptr;
+    std::string error;
+};
+
+Loaded load() {
+    if (sahara_image_codec_api) return {sahara_image_codec_api(), ""};
+    std::vector<fs::path> candidates;
+    if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) {
+        candidates.emplace_back(forced);
+    } else {
+        if (const fs::path dir = executable_dir(); !dir.empty())
+            candidates.push_back(dir / kImageCodecLibrary);
+#ifdef SAHARA_CODEC_DIR
+        candidates.push_back(fs::path(SAHARA_CODEC_DIR) / kImageCodecLibrary);
+#endif
+    }
+    std::string tried;
+    for (const fs::path& file : candidates) {
+        std::error_code ec;
+        if (!fs::exists(file, ec)) {
+            tried += (tried.empty() ? "" : ", ") + file.string();
+            continue;
+        }
+        void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!handle) return {nullptr, "cannot load the image codec " + file.string() + ": " + ::dlerror()};
+        using Entry = const ImageCodecApi* (*)();
+        const auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecSymbol));
+        const ImageCodecApi* api = entry ? entry() : nullptr;
+        if (!api || api->version != kImageCodecVersion)
+            return {nullptr,
+                    "the image codec " + file.string() + " is from another build of sahara (rebuild it)"};
+        return {api, ""};
+    }
+    return {nullptr, "the image codec plugin is missing (looked for " + tried +
+                         "; build the target sahara_image_codec)"};
+}
+
+}  // namespace
+
+const ImageCodecApi& image_codec(const std::string& file_for_errors) {
+    static const Loaded loaded = load();  // once, thread-safe
+    if (!loaded.api) throw input_error(file_for_errors, "", loaded.error);
+    return *loaded.api;
+}
+
+}  // namespace sahara
