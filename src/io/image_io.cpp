@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "base/pending_file.h"
+#include "io/image_bytes.h"
 #include "io/image_codec.h"
 
 namespace sahara {
@@ -16,8 +17,6 @@ namespace sahara {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr int kMaxImageSide = 32768;
 
 std::string lower_extension(const fs::path& file) {
     std::string ext = file.extension().string();
