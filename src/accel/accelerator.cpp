@@ -308,19 +308,28 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     // rays (most diffuse bounces leaving a convex part) never reach one.
     TriangleRay tr;
     bool tr_ready = false;
+    auto triangle_ray = [&]() __attribute__((always_inline)) -> const TriangleRay& {
+        if (!tr_ready) {
+            tr = TriangleRay(ray);
+            tr_ready = true;
+        }
+        return tr;
+    };
     BvhRay br(ray);
     Hit best;
     const bool found = traverse_wide<kAnyHit, kAvx>(
         tree, br,
         [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
-            if (!tr_ready) {
-                tr = TriangleRay(ray);
-                tr_ready = true;
-            }
             if constexpr (kBlocks)
-                return test_blocks<kAnyHit, kCutouts, kAvx>(ray, tr, first, count, tmax, best);
+                return test_blocks_fast<kAnyHit, kCutouts>(ray, triangle_ray(), first, count, tmax, best);
             else
-                return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
+                return LeafResult::slow;  // slots: every kind through the full test
+        },
+        [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
+            if constexpr (kBlocks)
+                return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
+            else
+                return test_slots<kAnyHit, kCutouts>(ray, triangle_ray(), first, count, tmax, best);
         },
         counters);
     if (found && !kAnyHit) {

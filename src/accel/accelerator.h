@@ -172,6 +172,10 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts, bool kAvx>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
+    /// test_blocks for the traversal's call-free inner loop (LeafResult::slow: use test_blocks).
+    template <bool kAnyHit, bool kCutouts>
+    LeafResult test_blocks_fast(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count,
+                                float& tmax, Hit& hit) const;
     template <int N>
     void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                           const std::vector<TriangleVerts>& tris);

@@ -58,12 +58,15 @@ __attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRa
     return result;
 }
 
-/// Tests the four lanes of `b`; returns the mask of lanes hit in (tmin, tmax)
-/// and their distances and barycentrics.
-__attribute__((always_inline)) inline int intersect_triangle_block4(const TriangleRay& tr,
-                                                                    const TriangleBlock4& b, float tmin,
-                                                                    float tmax, float t_out[4],
-                                                                    float u_out[4], float v_out[4]) {
+/// Tests the four lanes of `b` except those with an edge function of exactly 0,
+/// which it returns in `exact_zero` (intersect_triangle_block4 redoes them; this
+/// part calls no function, so it fits the traversal's call-free inner loop).
+/// Returns the mask of lanes hit in (tmin, tmax) and their distances and barycentrics.
+__attribute__((always_inline)) inline int intersect_triangle_block4_simd(const TriangleRay& tr,
+                                                                         const TriangleBlock4& b, float tmin,
+                                                                         float tmax, float t_out[4],
+                                                                         float u_out[4], float v_out[4],
+                                                                         int& exact_zero) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m128 ox = _mm_set1_ps(tr.org[kx]), oy = _mm_set1_ps(tr.org[ky]), oz = _mm_set1_ps(tr.org[kz]);
     const __m128 sx = _mm_set1_ps(tr.sx), sy = _mm_set1_ps(tr.sy), sz = _mm_set1_ps(tr.sz);
@@ -81,7 +84,7 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
     // A lane with an edge function of exactly 0 goes to the scalar test below. The
     // product also flags products that underflow to 0, which the scalar test then
     // answers just as exactly; NaN (padding) lanes compare unequal.
-    const int exact_zero = _mm_movemask_ps(_mm_cmpeq_ps(_mm_mul_ps(_mm_mul_ps(u, v), w), zero));
+    exact_zero = _mm_movemask_ps(_mm_cmpeq_ps(_mm_mul_ps(_mm_mul_ps(u, v), w), zero));
     // With no zero among them, u, v, w of a hit share one sign: differing sign bits miss.
     const int mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w)));
     int mask = ~(mixed | exact_zero) & 0xF;
@@ -111,6 +114,17 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
             _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
         }
     }
+    return result;
+}
+
+/// Tests the four lanes of `b`; returns the mask of lanes hit in (tmin, tmax)
+/// and their distances and barycentrics.
+__attribute__((always_inline)) inline int intersect_triangle_block4(const TriangleRay& tr,
+                                                                    const TriangleBlock4& b, float tmin,
+                                                                    float tmax, float t_out[4],
+                                                                    float u_out[4], float v_out[4]) {
+    int exact_zero = 0;
+    int result = intersect_triangle_block4_simd(tr, b, tmin, tmax, t_out, u_out, v_out, exact_zero);
     // Lanes with an exactly-zero edge function: the scalar test, double fallback included.
     if (exact_zero) result |= redo_exact_zero_lanes(tr, b, exact_zero, 0, tmin, tmax, t_out, u_out, v_out);
     return result;

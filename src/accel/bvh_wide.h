@@ -221,91 +221,113 @@ struct WideRay<8, true> {
     }
 };
 
+/// What a leaf test inside the traversal's inner loop found.
+enum class LeafResult : uint8_t {
+    miss,
+    hit,   ///< a hit: `tmax` lowered (closest hit) or the search may end (any hit)
+    slow,  ///< not decided and nothing changed: the leaf needs the full test
+};
+
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
 /// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2).
-template <bool kAnyHit, bool kAvx = false, int N, class Counters, class LeafFn>
-__attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray, LeafFn&& leaf,
+///
+/// Leaves go first to `fast_leaf`, which must call no function: the inner loop
+/// then holds no call, and GCC keeps the ray's box constants in registers there
+/// (with a call anywhere in the loop it keeps them on the stack, every vector
+/// register being caller-saved). A leaf it answers `slow` goes to `slow_leaf`
+/// (the complete test: other primitive kinds, the scalar fallback, the alpha
+/// test) in the outer loop.
+template <bool kAnyHit, bool kAvx = false, int N, class Counters, class FastLeaf, class SlowLeaf>
+__attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
+                                                         FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
                                                          Counters& counters) {
     if (bvh.empty) return false;
     // No test of the root box: nodes[0] tests the root's children, which lie inside it.
     if (bvh.root.is_leaf()) {
         counters.on_prims(bvh.root.count);
-        return leaf(bvh.root.index, bvh.root.count, ray.tmax);
+        return slow_leaf(bvh.root.index, bvh.root.count, ray.tmax);
     }
     struct Entry {
         uint32_t index;  ///< node index, or first leaf item
         uint32_t count;  ///< 0: inner node
         float t_entry;
     };
-    const WideRay<N, kAvx && N == 8> rw(ray);
+    const BvhWideNode<N>* const nodes = bvh.nodes.data();
     // Each node pushes at most N - 1 entries per level, plus slack.
     Entry stack[(N - 1) * kBvhMaxDepth + 4];
     int top = 0;
     bool found = false;
     Entry cur{0, 0, ray.tmin};
+    // Pops the nearest pending entry that can still hold a closer hit into `cur`.
+    auto pop = [&]() __attribute__((always_inline)) {
+        for (;;) {
+            if (top == 0) return false;
+            cur = stack[--top];
+            // An occlusion ray's tmax never shrinks: every pushed entry is still in reach.
+            if (kAnyHit || cur.t_entry <= ray.tmax * kRobustFarScale) return true;
+        }
+    };
     for (;;) {
-        if (cur.count) {
-            counters.on_prims(cur.count);
-            if (leaf(cur.index, cur.count, ray.tmax)) {
-                if constexpr (kAnyHit) return true;
-                found = true;
-            }
-        } else {
-            const BvhWideNode<N>& n = bvh.nodes[cur.index];
-            if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
-                for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
-            alignas(32) float t[N];
-            int mask = rw.test(n, ray.tmin, ray.tmax, t);
-            if (mask) {
-                int c = __builtin_ctz(unsigned(mask));
-                mask &= mask - 1;
-                cur = Entry{n.child[c], n.count[c], t[c]};
-                if (!mask) continue;  // one child hit: no ordering, no stack
-                if constexpr (kAnyHit) {
-                    // Any hit ends the search, so order buys little: push in child order
-                    // (Embree's occlusion traversal does the same), the last becomes `cur`.
+        // Made here, not before the loop: their registers then never live across a call.
+        const WideRay<N, kAvx && N == 8> rw(ray);
+        for (;;) {  // the inner loop: no calls
+            if (cur.count) {
+                counters.on_prims(cur.count);
+                const LeafResult r = fast_leaf(cur.index, cur.count, ray.tmax);
+                if (r == LeafResult::slow) break;
+                if (r == LeafResult::hit) {
+                    if constexpr (kAnyHit) return true;
+                    found = true;
+                }
+            } else {
+                const BvhWideNode<N>& n = nodes[cur.index];
+                if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
+                    for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
+                alignas(32) float t[N];
+                int mask = rw.test(n, ray.tmin, ray.tmax, t);
+                if (mask) {
+                    int c = __builtin_ctz(unsigned(mask));
+                    mask &= mask - 1;
+                    cur = Entry{n.child[c], n.count[c], t[c]};
+                    if (!mask) continue;  // one child hit: no ordering, no stack
+                    if constexpr (kAnyHit) {
+                        // Any hit ends the search, so order buys little: push in child order
+                        // (Embree's occlusion traversal does the same), the last becomes `cur`.
+                        do {
+                            stack[top++] = cur;
+                            c = __builtin_ctz(unsigned(mask));
+                            mask &= mask - 1;
+                            cur = Entry{n.child[c], n.count[c], t[c]};
+                        } while (mask);
+                        continue;
+                    }
+                    // Insert the others into the stack top sorted by distance (farthest
+                    // deepest); the nearest of all becomes `cur`.
+                    const int base = top;
                     do {
-                        stack[top++] = cur;
                         c = __builtin_ctz(unsigned(mask));
                         mask &= mask - 1;
-                        cur = Entry{n.child[c], n.count[c], t[c]};
+                        Entry in{n.child[c], n.count[c], t[c]};
+                        if (in.t_entry < cur.t_entry) std::swap(in, cur);
+                        int k = top++;
+                        while (k > base && stack[k - 1].t_entry < in.t_entry) {
+                            stack[k] = stack[k - 1];
+                            --k;
+                        }
+                        stack[k] = in;
                     } while (mask);
                     continue;
                 }
-                // Insert the others into the stack top sorted by distance (farthest
-                // deepest); the nearest of all becomes `cur`.
-                const int base = top;
-                do {
-                    c = __builtin_ctz(unsigned(mask));
-                    mask &= mask - 1;
-                    Entry in{n.child[c], n.count[c], t[c]};
-                    if (in.t_entry < cur.t_entry) std::swap(in, cur);
-                    int k = top++;
-                    while (k > base && stack[k - 1].t_entry < in.t_entry) {
-                        stack[k] = stack[k - 1];
-                        --k;
-                    }
-                    stack[k] = in;
-                } while (mask);
-                continue;
             }
+            if (!pop()) return found;
         }
-        // Pop the nearest pending entry that can still hold a closer hit.
-        for (;;) {
-            if (top == 0) return found;
-            cur = stack[--top];
-            // An occlusion ray's tmax never shrinks: every pushed entry is still in reach.
-            if (kAnyHit || cur.t_entry <= ray.tmax * kRobustFarScale) break;
+        if (slow_leaf(cur.index, cur.count, ray.tmax)) {
+            if constexpr (kAnyHit) return true;
+            found = true;
         }
+        if (!pop()) return found;
     }
-}
-
-/// The BVH4 traversal (traverse_wide with N = 4).
-template <bool kAnyHit, class Counters, class LeafFn>
-__attribute__((always_inline)) inline bool traverse_bvh4(const Bvh4& bvh, BvhRay& ray, LeafFn&& leaf,
-                                                         Counters& counters) {
-    return traverse_wide<kAnyHit, false>(bvh, ray, static_cast<LeafFn&&>(leaf), counters);
 }
 
 }  // namespace sahara

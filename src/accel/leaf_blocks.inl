@@ -33,6 +33,34 @@ inline int other_lanes(const TriangleBlock4& block) {
     return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
 }
 
+/// The common leaf, one block of triangles, without a call: a leaf with other
+/// kinds or more blocks, a lane with an exactly-zero edge function (the scalar
+/// redo) and every leaf of a scene with cut-outs (the alpha test) are `slow`,
+/// answered by test_blocks with nothing changed here.
+template <bool kAnyHit, bool kCutouts>
+__attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(const Ray& ray,
+                                                                               const TriangleRay& tr,
+                                                                               uint32_t first, uint32_t count,
+                                                                               float& tmax, Hit& hit) const {
+    if (kCutouts || count > 4 || other_lanes(blocks_[first])) return LeafResult::slow;
+    alignas(16) float t[4], u[4], v[4];
+    int exact_zero = 0;
+    const int mask = intersect_triangle_block4_simd(tr, blocks_[first], ray.tmin, tmax, t, u, v, exact_zero);
+    if (exact_zero) return LeafResult::slow;
+    if (!mask) return LeafResult::miss;
+    if constexpr (!kAnyHit) {
+        // Ties keep the earlier lane, as test_blocks does.
+        int best = __builtin_ctz(unsigned(mask));
+        for (int m = mask & (mask - 1); m; m &= m - 1) {
+            const int l = __builtin_ctz(unsigned(m));
+            if (t[l] < t[best]) best = l;
+        }
+        tmax = t[best];
+        hit = Hit{t[best], blocks_[first].slot[best], u[best], v[best]};
+    }
+    return LeafResult::hit;
+}
+
 /// Tests the leaf blocks [first, first + ceil(count / 4)): triangles four at a
 /// time (kAvx: eight, two blocks per step), other kinds through intersect_other;
 /// the closest hit lowers `tmax`. Ties keep the earlier lane, as one block at a time would.
