@@ -388,6 +388,14 @@ bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
             return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
         return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
     }
+    return trace_pairs<kAnyHit, kCutouts>(ray, hit, counters);
+}
+
+/// The binary tree in pair layout. Not inlined into trace_layout: its frame and
+/// saved registers would otherwise be paid by every call of the wide layouts, which
+/// trace_layout reaches by a tail call.
+template <bool kAnyHit, bool kCutouts, class Counters>
+__attribute__((noinline)) bool Accelerator::trace_pairs(Ray& ray, Hit& hit, Counters& counters) const {
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;

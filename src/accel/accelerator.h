@@ -157,6 +157,8 @@ class Accelerator {
     bool trace(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, class Counters>
+    bool trace_pairs(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
     bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
