@@ -55,6 +55,30 @@ TEST_CASE("image round trip: EXR is linear and exact in float") {
         for (size_t c = 0; c < 3; ++c) CHECK(img->rgba[i * 4 + c] == rgb[i * 3 + c]);
 }
 
+TEST_CASE("image round trip: PFM is linear, exact in float and stored bottom row first") {
+    const TempDir dir;
+    const fs::path file = dir.path / "round.pfm";
+    std::vector<float> rgb = gradient_pixels(7, 5);
+    rgb[0] = 12.5f;  // top-left red: HDR values are not clipped
+    write_image(file, 7, 5, rgb);
+    // The file as the format defines it (written by sahara, not OpenImageIO).
+    std::ifstream in(file, std::ios::binary);
+    std::string header(12, '\0');
+    in.read(header.data(), 12);
+    CHECK(header == "PF\n7 5\n-1.0\n");
+    float first = 0.0f;
+    in.read(reinterpret_cast<char*>(&first), sizeof first);
+    CHECK(first == rgb[4 * 7 * 3]);  // red of the bottom-left pixel
+    in.seekg(0, std::ios::end);
+    CHECK(size_t(in.tellg()) == 12 + 7 * 5 * 3 * sizeof(float));
+    // And read back through the image reader, top row first again.
+    auto img = read_image(file, false);
+    REQUIRE(img->width == 7);
+    REQUIRE(img->height == 5);
+    for (size_t i = 0; i < 35; ++i)
+        for (size_t c = 0; c < 3; ++c) CHECK(img->rgba[i * 4 + c] == rgb[i * 3 + c]);
+}
+
 TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
     const TempDir dir;
     const fs::path file = dir.path / "round.png";

@@ -3,7 +3,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <system_error>
 
@@ -85,7 +88,7 @@ void check_output_path(const fs::path& file) {
     if (!fs::is_directory(dir, ec))
         throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
-    image_codec(name);  // a missing codec fails here, not after the render
+    if (lower_extension(file) != ".pfm") image_codec(name);  // a missing codec fails here, not after the render
 }
 
 namespace {
@@ -138,20 +141,37 @@ fs::path temp_path_for(const fs::path& file) {
     return tmp;
 }
 
+/// Writes linear RGB as a portable float map: "PF", the size, -1 (little-endian
+/// floats), then the rows bottom to top. Written here, not by OpenImageIO: the
+/// 2.4 release Debian ships reads PFM but has no writer for it. Returns "" or why it failed.
+std::string write_pfm(const fs::path& path, int width, int height, const std::vector<float>& rgb) {
+    static_assert(std::endian::native == std::endian::little, "the header below declares little-endian data");
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return std::string("cannot create the file: ") + std::strerror(errno);
+    bool ok = std::fprintf(f, "PF\n%d %d\n-1.0\n", width, height) > 0;
+    const size_t row = 3 * size_t(width);
+    for (int y = height - 1; ok && y >= 0; --y)
+        ok = std::fwrite(&rgb[size_t(y) * row], sizeof(float), row, f) == row;
+    ok = std::fclose(f) == 0 && ok;
+    return ok ? std::string() : std::string("cannot write the file: ") + std::strerror(errno);
+}
+
 }  // namespace
 
 void write_image(const fs::path& file, int width, int height, const std::vector<float>& rgb,
                  const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
     const std::string name = file.string();
     const fs::path tmp = temp_path_for(file);
-    const ImageCodecApi& codec = image_codec(name);
+    const bool pfm = lower_extension(file) == ".pfm";
+    const ImageCodecApi* codec = pfm ? nullptr : &image_codec(name);
     EncodedPixels pixels;
-    encode_pixels(file, width, height, rgb, extra, pixels);
+    if (!pfm) encode_pixels(file, width, height, rgb, extra, pixels);
     for (const auto& [key, value] : metadata) pixels.spec.attributes.emplace_back("sahara:" + key, value);
     pixels.spec.attributes.emplace_back("Software", std::string("sahara ") + SAHARA_VERSION);
 
     const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
-    if (const std::string why = codec.encode(tmp.string(), pixels.spec); !why.empty()) {
+    if (const std::string why = pfm ? write_pfm(tmp, width, height, rgb) : codec->encode(tmp.string(), pixels.spec);
+        !why.empty()) {
         std::error_code ec;
         fs::remove(tmp, ec);
         throw input_error(name, "", why);
