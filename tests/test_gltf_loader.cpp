@@ -557,7 +557,7 @@ TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, 
     const Image& img = *t.image;
     REQUIRE(img.width == 2);
     CHECK(img.rgba[0] == doctest::Approx(1.0f));                                // top-left red, row 0 = top
-    CHECK(img.rgba[5] == doctest::Approx(srgb_to_linear_value(128 / 255.0f)));  // sRGB decoded
+    CHECK(img.rgba[5] == doctest::Approx(srgb_decode(128 / 255.0f)));  // sRGB decoded
     CHECK(img.rgba[5] == doctest::Approx(0.2158605f).epsilon(1e-4));
     CHECK(img.rgba[7] == doctest::Approx(128 / 255.0f));  // alpha stays linear
     CHECK(img.rgba[10] == doctest::Approx(1.0f));         // bottom-left blue
@@ -767,7 +767,7 @@ TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/t
     // tiny_png: top row red, (0,128,0); bottom row blue, white. uv 0.25/0.75 hit texel centres.
     const fs::path dir = scratch("texels");
     const std::vector<uint8_t> png = tiny_png(dir);
-    const Rgb red(1, 0, 0), blue(0, 0, 1), green(0, srgb_to_linear_value(128 / 255.0f), 0);
+    const Rgb red(1, 0, 0), blue(0, 0, 1), green(0, srgb_decode(128 / 255.0f), 0);
     auto sample = [](const LoadedModel& m, size_t vertex) {
         const TriangleMesh& mesh = m.meshes.at(0);
         return sample_texture_rgb(m.textures.at(0), mesh.uvs.at(vertex));

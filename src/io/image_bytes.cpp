@@ -5,13 +5,9 @@
 
 #include "base/error.h"
 #include "io/image_codec.h"
+#include "io/image_io.h"
 
 namespace sahara {
-
-float srgb_to_linear_value(float c) {
-    if (c <= 0.04045f) return c * (1.0f / 12.92f);
-    return std::pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);
-}
 
 namespace {
 
@@ -58,33 +54,26 @@ std::string png_structure_error(const unsigned char* data, size_t size) {
     }
 }
 
-/// Expands 1-4 channel float pixels to RGBA (grey, grey+alpha, RGB, RGBA).
-void expand_to_rgba(const std::vector<float>& src, int channels, bool srgb, Image& out) {
-    const size_t n = size_t(out.width) * size_t(out.height);
+}  // namespace
+
+void expand_to_rgba(const DecodedPixels& px, bool srgb_to_linear, Image& out) {
+    out.width = px.width;
+    out.height = px.height;
+    const size_t n = size_t(px.width) * size_t(px.height);
+    const int channels = px.channels, alpha = px.alpha_channel;
     out.rgba.resize(n * 4);
     for (size_t i = 0; i < n; ++i) {
-        const float* s = &src[i * size_t(channels)];
-        float r = s[0], g = s[0], b = s[0], a = 1.0f;
-        if (channels == 2) a = s[1];
-        if (channels >= 3) {
-            g = s[1];
-            b = s[2];
+        const float* src = &px.values[i * size_t(channels)];
+        float* dst = &out.rgba[i * 4];
+        for (int c = 0; c < 3; ++c) {
+            // Grey (and grey+alpha) images replicate their one colour channel.
+            float v = src[channels >= 3 ? c : 0];
+            if (!std::isfinite(v)) v = 0.0f;
+            dst[c] = srgb_to_linear ? srgb_decode(v) : v;
         }
-        if (channels >= 4) a = s[3];
-        if (srgb) {
-            r = srgb_to_linear_value(r);
-            g = srgb_to_linear_value(g);
-            b = srgb_to_linear_value(b);
-        }
-        float* d = &out.rgba[i * 4];
-        d[0] = r;
-        d[1] = g;
-        d[2] = b;
-        d[3] = a;
+        dst[3] = alpha >= 0 ? src[alpha] : (channels == 2 ? src[1] : (channels >= 4 ? src[3] : 1.0f));
     }
 }
-
-}  // namespace
 
 std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_t size, bool srgb_to_linear,
                                                 const std::string& file, const std::string& element) {
@@ -97,12 +86,8 @@ std::shared_ptr<const Image> decode_image_bytes(const unsigned char* data, size_
     if (const std::string why = image_codec(file).decode(hint, data, size, kMaxImageSide, 4, px);
         !why.empty())
         throw input_error(file, element, why);
-    const int channels = px.channels;
-    const std::vector<float>& pixels = px.values;
     auto image = std::make_shared<Image>();
-    image->width = px.width;
-    image->height = px.height;
-    expand_to_rgba(pixels, channels, srgb_to_linear, *image);
+    expand_to_rgba(px, srgb_to_linear, *image);
     return image;
 }
 

@@ -12,8 +12,13 @@ namespace sahara {
 /// Largest accepted width or height of a decoded image.
 inline constexpr int kMaxImageSide = 32768;
 
-/// sRGB transfer function inverse (IEC 61966-2-1) for one channel value.
-float srgb_to_linear_value(float c);
+struct DecodedPixels;
+
+/// Expands decoded 1-4 channel pixels (grey, grey+alpha, RGB, RGBA, or more with
+/// a declared alpha channel) to RGBA: grey replicates its one colour channel, a
+/// missing alpha is 1, non-finite colour values become 0, and with
+/// srgb_to_linear the colour channels are sRGB-decoded (srgb_decode).
+void expand_to_rgba(const DecodedPixels& px, bool srgb_to_linear, Image& out);
 
 /// Decodes an encoded PNG/JPEG (any format OpenImageIO reads from memory) to
 /// linear RGBA. Errors throw InputError "FILE: ELEMENT: what".

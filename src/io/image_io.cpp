@@ -49,25 +49,8 @@ std::shared_ptr<const Image> read_image(const fs::path& file, bool srgb_to_linea
     if (const std::string why = image_codec(name).decode(name, nullptr, 0, kMaxImageSide, 64, px);
         !why.empty())
         throw input_error(name, "", why);
-    const int channels = px.channels;
-    const std::vector<float>& pixels = px.values;
-
     auto img = std::make_shared<Image>();
-    img->width = px.width;
-    img->height = px.height;
-    img->rgba.resize(size_t(px.width) * size_t(px.height) * 4);
-    const int alpha = px.alpha_channel;
-    for (size_t i = 0, n = size_t(px.width) * size_t(px.height); i < n; ++i) {
-        const float* src = &pixels[i * size_t(channels)];
-        float* dst = &img->rgba[i * 4];
-        for (int c = 0; c < 3; ++c) {
-            // Grey (and grey+alpha) images replicate their one colour channel.
-            float v = src[channels >= 3 ? c : 0];
-            if (!std::isfinite(v)) v = 0.0f;
-            dst[c] = srgb_to_linear ? srgb_decode(v) : v;
-        }
-        dst[3] = alpha >= 0 ? src[alpha] : (channels == 2 ? src[1] : (channels >= 4 ? src[3] : 1.0f));
-    }
+    expand_to_rgba(px, srgb_to_linear, *img);
     return img;
 }
 
