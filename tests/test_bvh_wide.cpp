@@ -8,6 +8,7 @@
 #include <string>
 
 #include "accel/accelerator.h"
+#include "accel/bvh_stats.h"
 #include "accel/bvh_wide.h"
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
@@ -358,4 +359,51 @@ TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
     CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide8), layout));
     CHECK(layout == BvhLayout::wide8);
     CHECK_FALSE(parse_bvh_layout("bvh8", layout));
+}
+
+TEST_CASE("wide tree statistics follow Embree's definitions") {
+    // One 8-wide node holding two leaves: unit cubes at x = 0 and x = 2, of 5 and 4
+    // primitives (two blocks of four and one). Root box: 3 x 1 x 1, area 14; each leaf area 6.
+    Bvh8 tree;
+    tree.empty = false;
+    tree.root.set_box(Bounds3{Vec3(0.0f), Vec3(3.0f, 1.0f, 1.0f)});
+    tree.root.index = 0;
+    tree.root.count = 0;
+    Bvh8Node n{};
+    for (int c = 0; c < 8; ++c) {
+        n.lo_x[c] = n.lo_y[c] = n.lo_z[c] = kInfinity;
+        n.hi_x[c] = n.hi_y[c] = n.hi_z[c] = -kInfinity;
+        n.child[c] = kNoNode;
+        n.count[c] = 0;
+    }
+    for (int c = 0; c < 2; ++c) {
+        n.lo_x[c] = 2.0f * float(c), n.hi_x[c] = 2.0f * float(c) + 1.0f;
+        n.lo_y[c] = n.lo_z[c] = 0.0f;
+        n.hi_y[c] = n.hi_z[c] = 1.0f;
+        n.child[c] = uint32_t(9 * c);
+        n.count[c] = c == 0 ? 5 : 4;
+    }
+    tree.nodes.push_back(n);
+    const WideBvhStats s = compute_wide_bvh_stats(tree, 4);
+    CHECK(s.nodes == 1);
+    CHECK(s.children == 2);
+    CHECK(s.leaves == 2);
+    CHECK(s.leaf_primitives == 9);
+    CHECK(s.leaf_blocks == 3);
+    CHECK(s.sah_nodes == doctest::Approx(1.0));
+    CHECK(s.sah_leaves == doctest::Approx((6.0 * 2 + 6.0 * 1) / 14.0));
+    // Counted one primitive at a time (the slots layout), the leaves weigh 5 and 4.
+    CHECK(compute_wide_bvh_stats(tree, 1).sah_leaves == doctest::Approx((6.0 * 5 + 6.0 * 4) / 14.0));
+
+    // A built tree: every primitive in one leaf, every node but the first a child of another.
+    const TriangleMesh mesh = make_icosphere(3);
+    Scene scene;
+    scene.triangles.positions = mesh.positions;
+    scene.triangles.indices = mesh.indices;
+    const Accelerator acc(scene);
+    const WideBvhStats b = compute_wide_bvh_stats(acc.bvh8(), 4);
+    CHECK(b.leaf_primitives == mesh.indices.size() / 3);
+    CHECK(b.children == b.nodes - 1 + b.leaves);
+    CHECK(b.sah_nodes >= 1.0);
+    CHECK(b.leaf_blocks * 4 >= b.leaf_primitives);
 }

@@ -11,7 +11,43 @@ struct StackItem {
     int depth;
 };
 
+template <int N>
+WideBvhStats wide_stats(const BvhWide<N>& bvh, uint32_t block_size) {
+    WideBvhStats s;
+    s.nodes = bvh.nodes.size();
+    if (bvh.empty || bvh.nodes.empty()) return s;
+    auto child_box = [](const BvhWideNode<N>& n, int c) {
+        return Bounds3{Vec3(n.lo_x[c], n.lo_y[c], n.lo_z[c]), Vec3(n.hi_x[c], n.hi_y[c], n.hi_z[c])};
+    };
+    const double root_area = bvh.root.box().surface_area();
+    const double inv_root = root_area > 0 ? 1.0 / root_area : 0.0;
+    for (const BvhWideNode<N>& n : bvh.nodes) {
+        Bounds3 node_box;
+        for (int c = 0; c < N; ++c) {
+            if (!n.has_child(c)) continue;
+            const Bounds3 b = child_box(n, c);
+            node_box.extend(b);
+            ++s.children;
+            if (!n.count[c]) continue;
+            const size_t blocks = (n.count[c] + block_size - 1) / block_size;
+            ++s.leaves;
+            s.leaf_primitives += n.count[c];
+            s.leaf_blocks += blocks;
+            s.sah_leaves += double(b.surface_area()) * double(blocks) * inv_root;
+        }
+        s.sah_nodes += double(node_box.surface_area()) * inv_root;
+    }
+    return s;
+}
+
 }  // namespace
+
+WideBvhStats compute_wide_bvh_stats(const Bvh4& bvh, uint32_t block_size) {
+    return wide_stats(bvh, std::max(block_size, 1u));
+}
+WideBvhStats compute_wide_bvh_stats(const Bvh8& bvh, uint32_t block_size) {
+    return wide_stats(bvh, std::max(block_size, 1u));
+}
 
 BvhStats compute_bvh_stats(const Bvh& bvh, const BvhBuildParams& params) {
     BvhStats s;

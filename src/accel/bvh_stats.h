@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_wide.h"
 
 namespace sahara {
 
@@ -25,6 +26,23 @@ struct BvhStats {
 
 /// Walks the tree once; `params` supplies the cost constants of the SAH cost.
 BvhStats compute_bvh_stats(const Bvh& bvh, const BvhBuildParams& params = {});
+
+/// Shape of a wide (4- or 8-wide) tree, with the SAH statistics defined as
+/// Embree's verbose build report defines them, so the two trees compare directly:
+/// node term = sum over wide nodes of area(node) / area(root); leaf term = sum
+/// over leaves of area(leaf) * (leaf blocks) / area(root).
+struct WideBvhStats {
+    size_t nodes = 0;
+    size_t children = 0;  ///< over all nodes (children / nodes: the fill)
+    size_t leaves = 0;
+    size_t leaf_primitives = 0;
+    size_t leaf_blocks = 0;  ///< leaves counted in blocks of `block_size` primitives
+    double sah_nodes = 0, sah_leaves = 0;
+};
+
+/// `block_size`: primitives tested together in a leaf (4 for the block layouts, else 1).
+WideBvhStats compute_wide_bvh_stats(const Bvh4& bvh, uint32_t block_size);
+WideBvhStats compute_wide_bvh_stats(const Bvh8& bvh, uint32_t block_size);
 
 /// Checks the invariants of a built tree against the boxes it was built from:
 /// every primitive in exactly one leaf, every node reached once, every child's
