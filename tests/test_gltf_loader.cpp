@@ -556,7 +556,7 @@ TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, 
     CHECK(t.wrap_v == WrapMode::mirror);
     const Image& img = *t.image;
     REQUIRE(img.width == 2);
-    CHECK(img.rgba[0] == doctest::Approx(1.0f));                                // top-left red, row 0 = top
+    CHECK(img.rgba[0] == doctest::Approx(1.0f));                       // top-left red, row 0 = top
     CHECK(img.rgba[5] == doctest::Approx(srgb_decode(128 / 255.0f)));  // sRGB decoded
     CHECK(img.rgba[5] == doctest::Approx(0.2158605f).epsilon(1e-4));
     CHECK(img.rgba[7] == doctest::Approx(128 / 255.0f));  // alpha stays linear

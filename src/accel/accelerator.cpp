@@ -308,7 +308,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     // rays (most diffuse bounces leaving a convex part) never reach one.
     TriangleRay tr;
     bool tr_ready = false;
-    auto triangle_ray = [&]() __attribute__((always_inline)) -> const TriangleRay& {
+    auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
         if (!tr_ready) {
             tr = TriangleRay(ray);
             tr_ready = true;

@@ -154,13 +154,15 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["intersection_cost"].get<double>());
     if (j.contains("wide")) {
         const auto& w = j["wide"];
-        std::printf("wide tree         %zu nodes, %.2f children per node, %zu leaves, blocks of %u %.1f%% full\n",
-                    w["nodes"].get<size_t>(), w["children_per_node"].get<double>(), w["leaves"].get<size_t>(),
-                    w["leaf_block_size"].get<unsigned>(), 100.0 * w["leaf_block_fill"].get<double>());
-        std::printf("wide SAH          nodes %.3f + leaves %.3f = %.3f (Embree's verbose report: area / root\n"
-                    "                  area summed over nodes, and over leaves times their blocks)\n",
-                    w["sah_nodes"].get<double>(), w["sah_leaves"].get<double>(),
-                    w["sah_nodes"].get<double>() + w["sah_leaves"].get<double>());
+        std::printf(
+            "wide tree         %zu nodes, %.2f children per node, %zu leaves, blocks of %u %.1f%% full\n",
+            w["nodes"].get<size_t>(), w["children_per_node"].get<double>(), w["leaves"].get<size_t>(),
+            w["leaf_block_size"].get<unsigned>(), 100.0 * w["leaf_block_fill"].get<double>());
+        std::printf(
+            "wide SAH          nodes %.3f + leaves %.3f = %.3f (Embree's verbose report: area / root\n"
+            "                  area summed over nodes, and over leaves times their blocks)\n",
+            w["sah_nodes"].get<double>(), w["sah_leaves"].get<double>(),
+            w["sah_nodes"].get<double>() + w["sah_leaves"].get<double>());
     }
     std::printf("build             %.1f ms (%.2f Mprims/s), CPU time %.1f ms (%.2f Mprims/s), %d threads\n",
                 j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),

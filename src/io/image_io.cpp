@@ -71,7 +71,8 @@ void check_output_path(const fs::path& file) {
     if (!fs::is_directory(dir, ec))
         throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
-    if (lower_extension(file) != ".pfm") image_codec(name);  // a missing codec fails here, not after the render
+    if (lower_extension(file) != ".pfm")
+        image_codec(name);  // a missing codec fails here, not after the render
 }
 
 namespace {
@@ -153,7 +154,8 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
     pixels.spec.attributes.emplace_back("Software", std::string("sahara ") + SAHARA_VERSION);
 
     const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
-    if (const std::string why = pfm ? write_pfm(tmp, width, height, rgb) : codec->encode(tmp.string(), pixels.spec);
+    if (const std::string why =
+            pfm ? write_pfm(tmp, width, height, rgb) : codec->encode(tmp.string(), pixels.spec);
         !why.empty()) {
         std::error_code ec;
         fs::remove(tmp, ec);
