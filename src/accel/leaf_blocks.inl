@@ -9,6 +9,16 @@
 
 namespace sahara {
 
+/// The lane of `mask` (not 0) with the smallest t; ties keep the earlier lane.
+__attribute__((always_inline)) inline int nearest_lane(int mask, const float* t) {
+    int best = __builtin_ctz(unsigned(mask));
+    for (int m = mask & (mask - 1); m; m &= m - 1) {
+        const int l = __builtin_ctz(unsigned(m));
+        if (t[l] < t[best]) best = l;
+    }
+    return best;
+}
+
 template <bool kAnyHit>
 __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ray& ray, uint32_t first,
                                                                         int mask, const float* t,
@@ -16,12 +26,7 @@ __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ra
                                                                         const float* v) const {
     // Nearest first, so at most the lanes in front of the kept one are alpha-tested.
     while (mask) {
-        int best = __builtin_ctz(unsigned(mask));
-        if constexpr (!kAnyHit)
-            for (int m = mask & (mask - 1); m; m &= m - 1) {
-                const int l = __builtin_ctz(unsigned(m));
-                if (t[l] < t[best]) best = l;
-            }
+        const int best = kAnyHit ? __builtin_ctz(unsigned(mask)) : nearest_lane(mask, t);
         if (keep_triangle_hit(ray, block_slot(first, best), u[best], v[best])) return 1 << best;
         mask &= ~(1 << best);
     }
@@ -49,12 +54,7 @@ __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(c
     if (exact_zero) return LeafResult::slow;
     if (!mask) return LeafResult::miss;
     if constexpr (!kAnyHit) {
-        // Ties keep the earlier lane, as test_blocks does.
-        int best = __builtin_ctz(unsigned(mask));
-        for (int m = mask & (mask - 1); m; m &= m - 1) {
-            const int l = __builtin_ctz(unsigned(m));
-            if (t[l] < t[best]) best = l;
-        }
+        const int best = nearest_lane(mask, t);
         tmax = t[best];
         hit = Hit{t[best], blocks_[first].slot[best], u[best], v[best]};
     }
@@ -88,11 +88,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
             if constexpr (kAnyHit) return true;
-            int best = __builtin_ctz(unsigned(mask));
-            for (int m = mask & (mask - 1); m; m &= m - 1) {
-                const int l = __builtin_ctz(unsigned(m));
-                if (t[l] < t[best]) best = l;
-            }
+            const int best = nearest_lane(mask, t);
             tmax = t[best];
             hit = Hit{t[best], block_slot(b, best), u[best], v[best]};
             found = true;
