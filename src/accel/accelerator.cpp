@@ -321,7 +321,8 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
         tree, br,
         [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
             if constexpr (kBlocks)
-                return test_blocks_fast<kAnyHit, kCutouts>(ray, triangle_ray(), first, count, tmax, best);
+                return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax,
+                                                                 best);
             else
                 return LeafResult::slow;  // slots: every kind through the full test
         },

@@ -175,7 +175,7 @@ class Accelerator {
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
     /// test_blocks for the traversal's call-free inner loop (LeafResult::slow: use test_blocks).
-    template <bool kAnyHit, bool kCutouts>
+    template <bool kAnyHit, bool kCutouts, bool kAvx>
     LeafResult test_blocks_fast(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count,
                                 float& tmax, Hit& hit) const;
     template <int N>

@@ -137,14 +137,13 @@ __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(con
                                 _mm_load_ps(b[1].p[v][axis]), 1);
 }
 
-/// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step:
-/// bit l of the result is lane l & 3 of block l >> 2; t/u/v_out hold 8 lanes.
-/// Not always_inline, like WideRay<8, true>::test (bvh_wide.h): it is inlined
-/// once its generic caller sits inside the AVX2 traversal.
-__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
-                                                                          const TriangleBlock4* b, float tmin,
-                                                                          float tmax, float t_out[8],
-                                                                          float u_out[8], float v_out[8]) {
+/// intersect_triangle_block4_simd over the two blocks b[0], b[1] in one AVX step:
+/// bit l of the result (and of `exact_zero`) is lane l & 3 of block l >> 2;
+/// t/u/v_out hold 8 lanes. Not always_inline, like WideRay<8, true>::test
+/// (bvh_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
+__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
+    const TriangleRay& tr, const TriangleBlock4* b, float tmin, float tmax, float t_out[8], float u_out[8],
+    float v_out[8], int& exact_zero) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m256 ox = _mm256_set1_ps(tr.org[kx]), oy = _mm256_set1_ps(tr.org[ky]),
                  oz = _mm256_set1_ps(tr.org[kz]);
@@ -159,8 +158,7 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const 
     const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
     const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
     const __m256 zero = _mm256_setzero_ps();
-    const int exact_zero =
-        _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(u, v), w), zero, _CMP_EQ_OQ));
+    exact_zero = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(u, v), w), zero, _CMP_EQ_OQ));
     const int mixed = _mm256_movemask_ps(_mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w)));
     int mask = ~(mixed | exact_zero) & 0xFF;
     int result = 0;
@@ -189,6 +187,17 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const 
             _mm256_storeu_ps(v_out, _mm256_mul_ps(w, inv_det));
         }
     }
+    return result;
+}
+
+/// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step (lanes as
+/// in intersect_triangle_blocks2_avx_simd), exactly-zero lanes redone by the scalar test.
+__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
+                                                                          const TriangleBlock4* b, float tmin,
+                                                                          float tmax, float t_out[8],
+                                                                          float u_out[8], float v_out[8]) {
+    int exact_zero = 0;
+    int result = intersect_triangle_blocks2_avx_simd(tr, b, tmin, tmax, t_out, u_out, v_out, exact_zero);
     if (exact_zero) {
         result |= redo_exact_zero_lanes(tr, b[0], exact_zero & 0xF, 0, tmin, tmax, t_out, u_out, v_out);
         result |= redo_exact_zero_lanes(tr, b[1], exact_zero >> 4, 4, tmin, tmax, t_out, u_out, v_out);

@@ -38,25 +38,39 @@ inline int other_lanes(const TriangleBlock4& block) {
     return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
 }
 
-/// The common leaf, one block of triangles, without a call: a leaf with other
-/// kinds or more blocks, a lane with an exactly-zero edge function (the scalar
-/// redo) and every leaf of a scene with cut-outs (the alpha test) are `slow`,
-/// answered by test_blocks with nothing changed here.
-template <bool kAnyHit, bool kCutouts>
+/// The common leaf, one or two blocks of triangles, without a call: a leaf with
+/// other kinds or more blocks, a lane with an exactly-zero edge function (the
+/// scalar redo) and every leaf of a scene with cut-outs (the alpha test) are
+/// `slow`, answered by test_blocks with nothing changed here. kAvx: two blocks
+/// in one AVX step, as test_blocks does.
+template <bool kAnyHit, bool kCutouts, bool kAvx>
 __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(const Ray& ray,
                                                                                const TriangleRay& tr,
                                                                                uint32_t first, uint32_t count,
                                                                                float& tmax, Hit& hit) const {
-    if (kCutouts || count > 4 || other_lanes(blocks_[first])) return LeafResult::slow;
-    alignas(16) float t[4], u[4], v[4];
-    int exact_zero = 0;
-    const int mask = intersect_triangle_block4_simd(tr, blocks_[first], ray.tmin, tmax, t, u, v, exact_zero);
+    if (kCutouts || count > 8) return LeafResult::slow;
+    const bool pair = count > 4;
+    if (other_lanes(blocks_[first]) | (pair ? other_lanes(blocks_[first + 1]) : 0)) return LeafResult::slow;
+    alignas(32) float t[8], u[8], v[8];
+    int exact_zero = 0, mask = 0;
+    if (kAvx && pair) {
+        mask = intersect_triangle_blocks2_avx_simd(tr, &blocks_[first], ray.tmin, tmax, t, u, v, exact_zero);
+    } else {
+        mask = intersect_triangle_block4_simd(tr, blocks_[first], ray.tmin, tmax, t, u, v, exact_zero);
+        if (pair && !exact_zero) {
+            // Distances of the first block's hits are not yet below tmax here: the
+            // nearest of all eight lanes is picked below, as the AVX step does.
+            mask |= intersect_triangle_block4_simd(tr, blocks_[first + 1], ray.tmin, tmax, t + 4, u + 4,
+                                                   v + 4, exact_zero)
+                    << 4;
+        }
+    }
     if (exact_zero) return LeafResult::slow;
     if (!mask) return LeafResult::miss;
     if constexpr (!kAnyHit) {
         const int best = nearest_lane(mask, t);
         tmax = t[best];
-        hit = Hit{t[best], blocks_[first].slot[best], u[best], v[best]};
+        hit = Hit{t[best], block_slot(first, best), u[best], v[best]};
     }
     return LeafResult::hit;
 }
