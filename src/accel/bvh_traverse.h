@@ -37,10 +37,10 @@ struct BvhRay {
     float tmin, tmax;
 
     explicit BvhRay(const Ray& r) : tmin(r.tmin), tmax(r.tmax) {
-        const float d[3] = {r.dir.x, r.dir.y, r.dir.z};
-        org[0] = r.origin.x;
-        org[1] = r.origin.y;
-        org[2] = r.origin.z;
+        const float d[3] = {load_scalar(r.dir.x), load_scalar(r.dir.y), load_scalar(r.dir.z)};
+        org[0] = load_scalar(r.origin.x);
+        org[1] = load_scalar(r.origin.y);
+        org[2] = load_scalar(r.origin.z);
         for (int a = 0; a < 3; ++a) {
             inv_dir[a] = 1.0f / d[a];  // +-inf for +-0: handled in intersect_bvh_node
             inv_far[a] = inv_dir[a] * kRobustFarScale;

@@ -25,10 +25,10 @@ struct TriangleRay {
 
     TriangleRay() = default;
     __attribute__((always_inline)) explicit TriangleRay(const Ray& ray) {
-        org[0] = ray.origin.x;
-        org[1] = ray.origin.y;
-        org[2] = ray.origin.z;
-        const Vec3 a = abs(ray.dir);
+        org[0] = load_scalar(ray.origin.x);
+        org[1] = load_scalar(ray.origin.y);
+        org[2] = load_scalar(ray.origin.z);
+        const Vec3 a = abs(Vec3(load_scalar(ray.dir.x), load_scalar(ray.dir.y), load_scalar(ray.dir.z)));
         kz = max_dimension(a);
         kx = kz == 2 ? 0 : kz + 1;
         ky = kx == 2 ? 0 : kx + 1;
