@@ -68,7 +68,7 @@ void check_against_brute_force(const TriangleMesh& mesh, BvhBuilder builder, uin
     const Accelerator acc(scene, opt);
     const std::vector<Ray> rays =
         make_random_rays(mesh_bounds(mesh), ray_budget(mesh.triangle_count(), max_rays), seed);
-    INFO(mesh.name, " builder ", bvh_builder_name(builder), " rays ", rays.size());
+    INFO(mesh.name, " builder ", std::string(bvh_builder_name(builder)), " rays ", rays.size());
     CHECK(count_disagreements(acc, rays) == 0);
 }
 
@@ -100,7 +100,7 @@ TEST_CASE("every builder produces valid trees") {
     for (const auto& f : shared_obj_files()) meshes.push_back(read_obj_triangles(f));
     for (const TriangleMesh& m : meshes)
         for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert}) {
-            INFO(m.name, " ", bvh_builder_name(builder));
+            INFO(m.name, " ", std::string(bvh_builder_name(builder)));
             const Bvh bvh = build_for_mesh(m, builder);
             CHECK(validate_bvh(bvh, triangle_boxes(m)) == "");
             const BvhStats s = compute_bvh_stats(bvh);
@@ -156,7 +156,8 @@ TEST_CASE("SAH with leaf blocks of 4 leaves fewer padding lanes, with both build
             return pad;
         };
         const size_t per_prim = padding(1), blocked = padding(4);
-        INFO(bvh_builder_name(builder), " padding lanes: block 1 ", per_prim, ", block 4 ", blocked);
+        INFO(std::string(bvh_builder_name(builder)), " padding lanes: block 1 ", per_prim, ", block 4 ",
+             blocked);
         CHECK(blocked * 2 < per_prim);
     }
 }
@@ -204,7 +205,7 @@ TEST_CASE("reinsertion never raises the SAH cost of its input") {
             if (input_builder == BvhBuilder::sweep && !sweep_too) continue;
             const Bvh input = build_for_mesh(m, input_builder);
             const Bvh optimized = reinsert_optimize_bvh(input, boxes, BvhBuildParams{});
-            INFO(m.name, " from ", bvh_builder_name(input_builder));
+            INFO(m.name, " from ", std::string(bvh_builder_name(input_builder)));
             CHECK(validate_bvh(optimized, boxes) == "");
             CHECK(compute_bvh_stats(optimized).sah_cost <= compute_bvh_stats(input).sah_cost * (1 + 1e-9));
         }

@@ -159,8 +159,9 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
-            INFO(mesh.name, " layout ", bvh_layout_name(layout), " builder ", bvh_builder_name(builder),
-                 " path ", simd_path_name(path), " rays ", rays.size());
+            INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " builder ",
+                 std::string(bvh_builder_name(builder)), " path ", std::string(simd_path_name(path)),
+                 " rays ", rays.size());
             CHECK(active_simd_path() == path);
             CHECK(disagreements(acc, rays) == 0);
         }
@@ -339,7 +340,7 @@ TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
-            INFO(bvh_layout_name(layout), " ", simd_path_name(path));
+            INFO(std::string(bvh_layout_name(layout)), " ", std::string(simd_path_name(path)));
             CHECK(disagreements(acc, make_random_rays(acc.bounds(), 20000 / kSanitizerDivisor, 91)) == 0);
         }
         TraversalCounters counters;
