@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <cmath>
 #include <filesystem>
@@ -407,4 +408,68 @@ TEST_CASE("wide tree statistics follow Embree's definitions") {
     CHECK(b.children == b.nodes - 1 + b.leaves);
     CHECK(b.sah_nodes >= 1.0);
     CHECK(b.leaf_blocks * 4 >= b.leaf_primitives);
+}
+
+namespace {
+
+/// Every way to cut the subtree of binary node `x` into at most `limit` pieces
+/// (x itself, or a cut of each child), as lists of binary node indices.
+std::vector<std::vector<uint32_t>> cuts(const Bvh& bvh, uint32_t x, size_t limit) {
+    std::vector<std::vector<uint32_t>> out{{x}};
+    const BvhNode& n = bvh.nodes[x];
+    if (n.is_leaf() || limit < 2) return out;
+    for (const auto& a : cuts(bvh, n.index, limit - 1))
+        for (const auto& b : cuts(bvh, n.index + 1, limit - a.size())) {
+            std::vector<uint32_t> both = a;
+            both.insert(both.end(), b.begin(), b.end());
+            out.push_back(both);
+        }
+    return out;
+}
+
+/// Least summed surface area of the wide nodes of any N-wide collapse of the
+/// subtree of inner node `x` (x's own node included), by trying every cut.
+double least_node_area(const Bvh& bvh, uint32_t x, size_t width, std::map<uint32_t, double>& memo) {
+    if (auto it = memo.find(x); it != memo.end()) return it->second;
+    double best = std::numeric_limits<double>::infinity();
+    const BvhNode& n = bvh.nodes[x];
+    for (const auto& a : cuts(bvh, n.index, width - 1))
+        for (const auto& b : cuts(bvh, n.index + 1, width - a.size())) {
+            double sum = 0.0;
+            for (const auto* part : {&a, &b})
+                for (uint32_t y : *part)
+                    if (!bvh.nodes[y].is_leaf()) sum += least_node_area(bvh, y, width, memo);
+            best = std::min(best, sum);
+        }
+    best += double(n.box().surface_area());
+    memo[x] = best;
+    return best;
+}
+
+}  // namespace
+
+TEST_CASE("wide collapse: least summed node area, as an exhaustive search finds it") {
+    for (const TriangleMesh& mesh : {make_icosphere(1), make_icosphere(2), make_slivers(150)}) {
+        Scene scene;
+        scene.triangles.positions = mesh.positions;
+        scene.triangles.indices = mesh.indices;
+        for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+            INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)));
+            AcceleratorOptions opt;
+            opt.layout = layout;
+            opt.keep_binary_tree = true;
+            opt.flat_loop_max_prims = 0;
+            const Accelerator acc(scene, opt);
+            const Bvh& bvh = acc.bvh();
+            REQUIRE(!bvh.nodes[0].is_leaf());
+            std::map<uint32_t, double> memo;
+            const size_t width = layout == BvhLayout::wide8 ? 8 : 4;
+            const double best =
+                least_node_area(bvh, 0, width, memo) / double(bvh.nodes[0].box().surface_area());
+            const WideBvhStats s = layout == BvhLayout::wide8 ? compute_wide_bvh_stats(acc.bvh8(), 4)
+                                                              : compute_wide_bvh_stats(acc.bvh4(), 4);
+            CHECK(s.sah_nodes == doctest::Approx(best).epsilon(1e-5));
+            check_bvh4_valid(acc);
+        }
+    }
 }

@@ -2,9 +2,8 @@
 /// Wide BVHs (BVH4, BVH8) collapsed from the binary SAH tree: each node holds
 /// the boxes of up to N children in structure-of-arrays form, so one ray tests
 /// all children in one SIMD step (SSE for 4, AVX for 8; the SSE2 fallback tests
-/// an 8-wide node as two halves). Collapsing follows the usual "open the
-/// largest inner child" rule (Wald, Benthin and Boulos, "Getting Rid of
-/// Packets", 2008; Dammertz et al., "Shallow Bounding Volume Hierarchies", 2008).
+/// an 8-wide node as two halves). Which binary nodes are merged into one wide
+/// node is chosen to minimise the summed area of the wide nodes (bvh_wide.cpp).
 ///
 /// Traversal is ordered: the hit children are sorted by entry distance and
 /// visited nearest first. Robustness is that of bvh_traverse.h: NaN from
