@@ -137,10 +137,14 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     layout_ = options.layout;
     if (layout_ == BvhLayout::pairs)
         pairs_ = make_bvh_pairs(bvh_);
-    else if (layout_ == BvhLayout::wide8)
-        wide8_ = make_bvh_wide<8>(bvh_);
-    else
-        wide_ = make_bvh4(bvh_);
+    else {
+        // Merging leaves only pays where a leaf is tested in blocks.
+        const WideCollapse wc = layout_has_blocks(layout_) ? options.collapse : WideCollapse{};
+        if (layout_ == BvhLayout::wide8)
+            wide8_ = make_bvh_wide<8>(bvh_, wc);
+        else
+            wide_ = make_bvh4(bvh_, wc);
+    }
     if (layout_has_blocks(layout_)) {
         // The tree and the blocks are all the block layouts keep (plus others_).
         if (layout_ == BvhLayout::wide8)

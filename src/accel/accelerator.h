@@ -78,6 +78,15 @@ struct AcceleratorOptions {
     /// 1138, ogre 1310 / 1253 / 1252; 0.5 is the smaller tree of the two best. Blocks of
     /// eight (two blocks per AVX step) measured worse: bunny 1214 at 0.5.
     float wide8_leaf_cost_scale = 0.5f;
+    /// How the block layouts collapse the binary tree into the wide one: subtrees of up
+    /// to 8 primitives (two blocks, the fast leaf test's limit) may become one leaf, and
+    /// a block test costs as much as a node visit (Embree's weights in its SAH report).
+    /// Against keeping the binary leaves (`sahara bench --threads 1 --size 512`, medians
+    /// of 3-4 runs, 2026-11-25), the Embree ratios of bunny, suzanne, ogre, spot and
+    /// teapot moved by +0.00 to +0.07 (camera rays), -0.02 to +0.02 (diffuse) and -0.01
+    /// to +0.03 (occlusion); a block cost of 0.7 or 0.5 (larger leaves) measured the same
+    /// within the machine's noise.
+    WideCollapse collapse{8, 1.0};
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;

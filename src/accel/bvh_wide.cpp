@@ -16,49 +16,70 @@ float half_area(const BvhNode& n) {
     return dx < 0.0f ? 0.0f : dx * dy + dy * dz + dz * dx;
 }
 
-/// Which binary-tree nodes become the children of each N-wide node. The leaves
-/// stay as built, so the SAH cost of the wide tree varies only in its node term:
-/// the summed surface area of the wide nodes (the expected number of node visits
-/// of a random ray, up to the root's area). A dynamic programme over the binary
-/// tree minimises that sum exactly (the collapse step of Ylitie, Karras and
-/// Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
-/// BVHs", 2017, with the leaves fixed); the usual greedy rule, opening the
-/// largest inner child until N are gathered, gave 2-4% more (`sahara bvh`).
+/// Which binary-tree nodes become the children of each N-wide node, and which
+/// small subtrees become one leaf. The cost is the wide tree's SAH: summed surface
+/// area of its nodes (the expected node visits of a random ray, up to the root's
+/// area) plus `block_cost` times each leaf's area and block count. A dynamic
+/// programme over the binary tree minimises it exactly (the collapse step of
+/// Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through
+/// Compressed Wide BVHs", 2017). The usual greedy rule, opening the largest
+/// inner child until N are gathered, left 4-11% more node area (`sahara bvh`).
 template <int N>
 class CollapsePlan {
    public:
-    explicit CollapsePlan(const Bvh& bvh) : bvh_(bvh), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()) {
+    CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
+        : bvh_(bvh), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
         // Children follow their parent in the canonical (depth-first) order.
         for (size_t x = bvh.nodes.size(); x-- > 0;) {
             const BvhNode& node = bvh.nodes[x];
+            const double area = double(half_area(node));
             Costs& f = cost_[x];
+            Choice& plan = plan_[x];
             if (node.is_leaf()) {
-                f.fill(0.0);
+                range_[x] = {node.index, node.count};
+                f.fill(opt.block_cost * area * double(blocks(node.count)));
                 continue;
             }
+            const Range& l = range_[node.index];
+            const Range& r = range_[node.index + 1];
+            // A subtree whose primitives are contiguous slots may become one leaf.
+            const bool contiguous = l.first != kNoNode && r.first == l.first + l.count;
+            range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
             const Costs& left = cost_[node.index];
             const Costs& right = cost_[node.index + 1];
             // opened[k]: both children share k slots of the parent's node.
             Costs opened;
-            opened.fill(std::numeric_limits<double>::infinity());
+            opened.fill(inf);
             for (int k = 2; k <= N; ++k)
                 for (int j = 1; j < k; ++j)
                     if (left[j] + right[k - j] < opened[k]) {
                         opened[k] = left[j] + right[k - j];
-                        plan_[x].left_slots[k] = uint8_t(j);
+                        plan.left_slots[k] = uint8_t(j);
                     }
-            // Kept as one child, x is a node of its own: its area plus its children in N slots.
-            const double as_node = double(half_area(node)) + opened[N];
-            f[1] = as_node;
+            // As one child, x is a node of its own (its area plus its children in N
+            // slots) or, when small enough, a leaf.
+            const double as_node = area + opened[N];
+            const double as_leaf = contiguous && range_[x].count <= opt.merge_leaves_up_to
+                                       ? opt.block_cost * area * double(blocks(range_[x].count))
+                                       : inf;
+            plan.leaf = as_leaf < as_node;
+            f[1] = std::min(as_node, as_leaf);
             for (int k = 2; k <= N; ++k) {
-                plan_[x].open[k] = opened[k] < as_node;
-                f[k] = plan_[x].open[k] ? opened[k] : as_node;
+                plan.open[k] = opened[k] < f[1];
+                f[k] = plan.open[k] ? opened[k] : f[1];
             }
         }
     }
 
+    /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).
+    struct Child {
+        uint32_t node;
+        uint32_t first, count;  ///< count 0: an inner node
+    };
+
     /// The children of the N-wide node made for binary inner node `inner`.
-    int children(uint32_t inner, uint32_t out[N]) const {
+    int children(uint32_t inner, Child out[N]) const {
         int n = 0;
         const uint32_t first = bvh_.nodes[inner].index;
         const int j = plan_[inner].left_slots[N];
@@ -68,37 +89,48 @@ class CollapsePlan {
     }
 
    private:
-    using Costs = std::array<double, N + 1>;  ///< [k]: least node area of a subtree in k slots
+    using Costs = std::array<double, N + 1>;  ///< [k]: least cost of a subtree in k slots
     struct Choice {
         std::array<uint8_t, N + 1> left_slots{};  ///< [k]: slots of the left child when opened
         std::array<bool, N + 1> open{};           ///< [k]: opened into k slots, or kept as one child
+        bool leaf = false;                        ///< kept as one child: a leaf, not a node
     };
+    struct Range {
+        uint32_t first, count;  ///< the subtree's slots; first = kNoNode: not contiguous
+    };
+    static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
 
-    void emit(uint32_t x, int k, uint32_t out[N], int& n) const {
-        if (bvh_.nodes[x].is_leaf() || !plan_[x].open[k]) {
-            out[n++] = x;
-            return;
+    void emit(uint32_t x, int k, Child out[N], int& n) const {
+        const BvhNode& node = bvh_.nodes[x];
+        if (node.is_leaf()) {
+            out[n++] = {x, node.index, node.count};
+        } else if (plan_[x].open[k]) {
+            const int j = plan_[x].left_slots[k];
+            emit(node.index, j, out, n);
+            emit(node.index + 1, k - j, out, n);
+        } else {
+            out[n++] = {x, plan_[x].leaf ? range_[x].first : 0, plan_[x].leaf ? range_[x].count : 0};
         }
-        const int j = plan_[x].left_slots[k];
-        emit(bvh_.nodes[x].index, j, out, n);
-        emit(bvh_.nodes[x].index + 1, k - j, out, n);
     }
 
     const Bvh& bvh_;
     std::vector<Costs> cost_;
     std::vector<Choice> plan_;
+    std::vector<Range> range_;
 };
 
+/// Child slot `c` of `p`: the box of binary node `box`, a leaf of `count` slots
+/// from `first`, or (count 0) an inner node, patched when its node is placed.
 template <int N>
-void set_child(BvhWideNode<N>& p, int c, const BvhNode& child) {
-    p.lo_x[c] = child.bounds[0];
-    p.hi_x[c] = child.bounds[1];
-    p.lo_y[c] = child.bounds[2];
-    p.hi_y[c] = child.bounds[3];
-    p.lo_z[c] = child.bounds[4];
-    p.hi_z[c] = child.bounds[5];
-    p.count[c] = child.count;
-    p.child[c] = child.count ? child.index : kNoNode;  // inner: patched when its node is placed
+void set_child(BvhWideNode<N>& p, int c, const BvhNode& box, uint32_t first, uint32_t count) {
+    p.lo_x[c] = box.bounds[0];
+    p.hi_x[c] = box.bounds[1];
+    p.lo_y[c] = box.bounds[2];
+    p.hi_y[c] = box.bounds[3];
+    p.lo_z[c] = box.bounds[4];
+    p.hi_z[c] = box.bounds[5];
+    p.count[c] = count;
+    p.child[c] = count ? first : kNoNode;
 }
 
 template <int N>
@@ -117,7 +149,7 @@ BvhWideNode<N> empty_node() {
 }  // namespace
 
 template <int N>
-BvhWide<N> make_bvh_wide(const Bvh& bvh) {
+BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     BvhWide<N> out;
     if (bvh.empty()) return out;
     out.empty = false;
@@ -130,26 +162,26 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh) {
         uint32_t parent;
         int slot;
     };
-    const CollapsePlan<N> plan(bvh);
+    const CollapsePlan<N> plan(bvh, opt);
     std::vector<Pending> stack{{0, kNoNode, 0}};
     while (!stack.empty()) {
         const Pending it = stack.back();
         stack.pop_back();
         const auto index = uint32_t(out.nodes.size());
         if (it.parent != kNoNode) out.nodes[it.parent].child[it.slot] = index;
-        uint32_t kids[N];
+        typename CollapsePlan<N>::Child kids[N];
         const int n = plan.children(it.node, kids);
         BvhWideNode<N> p = empty_node<N>();
-        for (int c = 0; c < n; ++c) set_child(p, c, bvh.nodes[kids[c]]);
+        for (int c = 0; c < n; ++c) set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
         out.nodes.push_back(p);
         for (int c = n - 1; c >= 0; --c)
-            if (!bvh.nodes[kids[c]].is_leaf()) stack.push_back({kids[c], index, c});
+            if (!kids[c].count) stack.push_back({kids[c].node, index, c});
     }
     return out;
 }
 
-template Bvh4 make_bvh_wide<4>(const Bvh& bvh);
-template Bvh8 make_bvh_wide<8>(const Bvh& bvh);
+template Bvh4 make_bvh_wide<4>(const Bvh& bvh, const WideCollapse& opt);
+template Bvh8 make_bvh_wide<8>(const Bvh& bvh, const WideCollapse& opt);
 
 bool cpu_has_avx2() {
 #if defined(__x86_64__) || defined(__i386__)

@@ -54,10 +54,19 @@ struct BvhWide {
 using Bvh4 = BvhWide<4>;
 using Bvh8 = BvhWide<8>;
 
+/// Cost model of the collapse (bvh_wide.cpp): a wide node visit costs 1.
+struct WideCollapse {
+    /// A subtree of at most this many primitives (in contiguous slots) may become one
+    /// leaf; 0 keeps the binary tree's leaves.
+    uint32_t merge_leaves_up_to = 0;
+    /// Cost of testing one leaf block of four primitives.
+    double block_cost = 1.0;
+};
+
 /// Collapses a canonical binary Bvh (slots unchanged; nodes in depth-first order).
 template <int N>
-BvhWide<N> make_bvh_wide(const Bvh& bvh);
-inline Bvh4 make_bvh4(const Bvh& bvh) { return make_bvh_wide<4>(bvh); }
+BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt = {});
+inline Bvh4 make_bvh4(const Bvh& bvh, const WideCollapse& opt = {}) { return make_bvh_wide<4>(bvh, opt); }
 
 /// Which instruction set the wide-BVH traversal is compiled for (one body, three instantiations).
 enum class SimdPath : uint8_t {
