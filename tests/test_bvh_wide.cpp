@@ -262,8 +262,9 @@ TEST_CASE("BVH8 box test (SSE halves and AVX) matches the single-node test") {
         if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
         const BvhRay r(ray);
         alignas(32) float t_sse[8], t_avx[8];
-        const int mask_sse = WideRay<8, false>(r).test(n, r.tmin, r.tmax, t_sse);
-        const int mask_avx = cpu_has_avx2() ? WideRay<8, true>(r).test(n, r.tmin, r.tmax, t_avx) : mask_sse;
+        const int mask_sse = WideRay<8, false>(r).test(n, r.tmin, r.tmax * kRobustFarScale, t_sse);
+        const int mask_avx =
+            cpu_has_avx2() ? WideRay<8, true>(r).test(n, r.tmin, r.tmax * kRobustFarScale, t_avx) : mask_sse;
         if (!cpu_has_avx2()) std::copy(t_sse, t_sse + 8, t_avx);
         for (int c = 0; c < 8; ++c) {
             float t = 0.0f;

@@ -127,7 +127,8 @@ using Bvh4Ray = WideRaySse<4>;
 /// distance. Same answers as intersect_bvh_node per child.
 template <int N>
 __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N>& n, const WideRaySse<N>& r,
-                                                             int g, float tmin, float tmax, __m128& t_near) {
+                                                             int g, float tmin, float tmax_far,
+                                                             __m128& t_near) {
     // The order of intersect_bvh_node: _mm_max_ps(x, acc) and _mm_min_ps(x, acc)
     // return acc when x is NaN.
     const char* base = reinterpret_cast<const char*>(&n) + 16 * g;
@@ -139,8 +140,7 @@ __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N
         tf[a] = _mm_mul_ps(_mm_sub_ps(far, r.org[a]), r.inv_far[a]);
     }
     const __m128 t0 = _mm_max_ps(_mm_max_ps(tn[1], tn[2]), _mm_max_ps(tn[0], _mm_set1_ps(tmin)));
-    const __m128 t1 =
-        _mm_min_ps(_mm_min_ps(tf[1], tf[2]), _mm_min_ps(tf[0], _mm_set1_ps(tmax * kRobustFarScale)));
+    const __m128 t1 = _mm_min_ps(_mm_min_ps(tf[1], tf[2]), _mm_min_ps(tf[0], _mm_set1_ps(tmax_far)));
     t_near = t0;
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 }
@@ -148,7 +148,7 @@ __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N
 /// The four children of a BVH4 node (see intersect_wide_sse).
 __attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin,
                                                          float tmax, __m128& t_near) {
-    return intersect_wide_sse<4>(n, r, 0, tmin, tmax, t_near);
+    return intersect_wide_sse<4>(n, r, 0, tmin, tmax * kRobustFarScale, t_near);
 }
 
 /// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin and
@@ -159,7 +159,8 @@ __attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, cons
 /// of the subtraction: three instructions per plane instead of five.
 struct Bvh8RayAvx {
     __m256 org[3], ninv[3], ninv_far[3];
-    uint32_t near_off[3], far_off[3];
+    /// Pointer-sized, so that the addressing needs no extension of them at every node.
+    size_t near_off[3], far_off[3];
 
     Bvh8RayAvx() = default;
     /// Not always_inline, like WideRay<8, true>::test below: it is inlined once its
@@ -172,8 +173,8 @@ struct Bvh8RayAvx {
             org[a] = _mm256_set1_ps(r.org[a]);
             ninv[a] = _mm256_set1_ps(-r.inv_dir[a]);
             ninv_far[a] = _mm256_set1_ps(-r.inv_far[a]);
-            near_off[a] = uint32_t(64 * a + 32 * r.neg[a]);
-            far_off[a] = uint32_t(64 * a + 32 * (1 - r.neg[a]));
+            near_off[a] = size_t(64 * a + 32 * r.neg[a]);
+            far_off[a] = near_off[a] ^ 32;
         }
     }
 };
@@ -182,7 +183,7 @@ struct Bvh8RayAvx {
 /// intersect_wide_sse, eight lanes wide; entry distances go to t_near[0..8).
 __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
                                                                              const Bvh8RayAvx& r, float tmin,
-                                                                             float tmax, float* t_near) {
+                                                                             float tmax_far, float* t_near) {
     const char* base = reinterpret_cast<const char*>(&n);
     __m256 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
@@ -192,8 +193,8 @@ __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(con
         tf[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv_far[a]);
     }
     const __m256 t0 = _mm256_max_ps(_mm256_max_ps(tn[1], tn[2]), _mm256_max_ps(tn[0], _mm256_set1_ps(tmin)));
-    const __m256 t1 = _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]),
-                                    _mm256_min_ps(tf[0], _mm256_set1_ps(tmax * kRobustFarScale)));
+    const __m256 t1 =
+        _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]), _mm256_min_ps(tf[0], _mm256_set1_ps(tmax_far)));
     _mm256_store_ps(t_near, t0);
     return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
 }
@@ -206,12 +207,14 @@ template <int N>
 struct WideRay<N, false> {
     WideRaySse<N> sse;
     explicit WideRay(const BvhRay& r) : sse(r) {}
-    /// Tests all N children: mask of hit children, entry distances in t[0..N).
-    __attribute__((always_inline)) int test(const BvhWideNode<N>& n, float tmin, float tmax, float* t) const {
+    /// Tests all N children against (tmin, tmax_far = tmax * kRobustFarScale): mask of
+    /// hit children, entry distances in t[0..N).
+    __attribute__((always_inline)) int test(const BvhWideNode<N>& n, float tmin, float tmax_far,
+                                            float* t) const {
         int mask = 0;
         for (int g = 0; g < N / 4; ++g) {
             __m128 tv;
-            mask |= intersect_wide_sse<N>(n, sse, g, tmin, tmax, tv) << (4 * g);
+            mask |= intersect_wide_sse<N>(n, sse, g, tmin, tmax_far, tv) << (4 * g);
             _mm_store_ps(t + 4 * g, tv);
         }
         return mask;
@@ -224,8 +227,8 @@ struct WideRay<8, true> {
     /// Not always_inline: GCC inlines callees into traverse_wide before traverse_wide
     /// itself is inlined into its AVX2 caller, and refuses AVX2 code in that generic
     /// body; as a plain inline function it is inlined once it sits in the AVX2 caller.
-    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax, float* t) const {
-        return intersect_bvh8_avx(n, avx, tmin, tmax, t);
+    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax_far, float* t) const {
+        return intersect_bvh8_avx(n, avx, tmin, tmax_far, t);
     }
 };
 
@@ -267,13 +270,15 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     int top = 0;
     bool found = false;
     Entry cur{0, 0, ray.tmin};
+    // tmax scaled for the far planes; changes only when a leaf lowers tmax.
+    float tmax_far = ray.tmax * kRobustFarScale;
     // Pops the nearest pending entry that can still hold a closer hit into `cur`.
     auto pop = [&]() __attribute__((always_inline)) {
         for (;;) {
             if (top == 0) return false;
             cur = stack[--top];
             // An occlusion ray's tmax never shrinks: every pushed entry is still in reach.
-            if (kAnyHit || cur.t_entry <= ray.tmax * kRobustFarScale) return true;
+            if (kAnyHit || cur.t_entry <= tmax_far) return true;
         }
     };
     for (;;) {
@@ -287,13 +292,14 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 if (r == LeafResult::hit) {
                     if constexpr (kAnyHit) return true;
                     found = true;
+                    tmax_far = ray.tmax * kRobustFarScale;
                 }
             } else {
                 const BvhWideNode<N>& n = nodes[cur.index];
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
                 alignas(32) float t[N];
-                int mask = rw.test(n, ray.tmin, ray.tmax, t);
+                int mask = rw.test(n, ray.tmin, tmax_far, t);
                 if (mask) {
                     int c = __builtin_ctz(unsigned(mask));
                     mask &= mask - 1;
@@ -333,6 +339,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         if (slow_leaf(cur.index, cur.count, ray.tmax)) {
             if constexpr (kAnyHit) return true;
             found = true;
+            tmax_far = ray.tmax * kRobustFarScale;
         }
         if (!pop()) return found;
     }
