@@ -424,9 +424,10 @@ bool Accelerator::intersect(Ray& ray, Hit& hit) const {
 
 bool Accelerator::occluded(const Ray& ray) const {
     NoTraversalCounters none;
-    Ray r = ray;
     Hit h;
-    return trace<true>(r, h, none);
+    // Any-hit traces only read the ray (only closest-hit ones write tmax back), so it
+    // is not copied: reading a copy just made waits for its stores to be forwarded.
+    return trace<true>(const_cast<Ray&>(ray), h, none);
 }
 
 bool Accelerator::intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const {
@@ -434,9 +435,8 @@ bool Accelerator::intersect_counted(Ray& ray, Hit& hit, TraversalCounters& count
 }
 
 bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) const {
-    Ray r = ray;
     Hit h;
-    return trace<true>(r, h, counters);
+    return trace<true>(const_cast<Ray&>(ray), h, counters);  // read only, as in occluded()
 }
 
 /// The block layouts' brute force: every lane of every block, triangles by the scalar test.
