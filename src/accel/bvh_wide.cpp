@@ -28,13 +28,14 @@ template <int N>
 class CollapsePlan {
    public:
     CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
-        : bvh_(bvh), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
+        : bvh_(bvh), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
         constexpr double inf = std::numeric_limits<double>::infinity();
+        std::vector<Costs> cost(bvh.nodes.size());  // [x][k]: least cost of subtree x in k slots
         // Children follow their parent in the canonical (depth-first) order.
         for (size_t x = bvh.nodes.size(); x-- > 0;) {
             const BvhNode& node = bvh.nodes[x];
             const double area = double(half_area(node));
-            Costs& f = cost_[x];
+            Costs& f = cost[x];
             Choice& plan = plan_[x];
             if (node.is_leaf()) {
                 range_[x] = {node.index, node.count};
@@ -46,8 +47,8 @@ class CollapsePlan {
             // A subtree whose primitives are contiguous slots may become one leaf.
             const bool contiguous = l.first != kNoNode && r.first == l.first + l.count;
             range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
-            const Costs& left = cost_[node.index];
-            const Costs& right = cost_[node.index + 1];
+            const Costs& left = cost[node.index];
+            const Costs& right = cost[node.index + 1];
             // opened[k]: both children share k slots of the parent's node.
             Costs opened;
             opened.fill(inf);
@@ -114,7 +115,6 @@ class CollapsePlan {
     }
 
     const Bvh& bvh_;
-    std::vector<Costs> cost_;
     std::vector<Choice> plan_;
     std::vector<Range> range_;
 };
