@@ -244,9 +244,10 @@ enum class LeafResult : uint8_t {
 /// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2).
 ///
 /// Leaves go first to `fast_leaf`, which must call no function: the inner loop
-/// then holds no call, and GCC keeps the ray's box constants in registers there
-/// (with a call anywhere in the loop it keeps them on the stack, every vector
-/// register being caller-saved). A leaf it answers `slow` goes to `slow_leaf`
+/// then holds no call, and GCC keeps what of the ray's box constants fits in
+/// registers there (the AVX2 build: the origins; the inverse directions are read
+/// as memory operands). With a call anywhere in the loop it would keep them all on
+/// the stack, every vector register being caller-saved. A leaf it answers `slow` goes to `slow_leaf`
 /// (the complete test: other primitive kinds, the scalar fallback, the alpha
 /// test) in the outer loop.
 template <bool kAnyHit, bool kAvx = false, int N, class Counters, class FastLeaf, class SlowLeaf>
