@@ -247,9 +247,9 @@ enum class LeafResult : uint8_t {
 /// then holds no call, and GCC keeps what of the ray's box constants fits in
 /// registers there (the AVX2 build: the origins; the inverse directions are read
 /// as memory operands). With a call anywhere in the loop it would keep them all on
-/// the stack, every vector register being caller-saved. A leaf it answers `slow` goes to `slow_leaf`
-/// (the complete test: other primitive kinds, the scalar fallback, the alpha
-/// test) in the outer loop.
+/// the stack, every vector register being caller-saved. A leaf it answers `slow`
+/// goes to `slow_leaf` (the complete test: other primitive kinds, the scalar
+/// fallback, the alpha test) in the outer loop.
 template <bool kAnyHit, bool kAvx = false, int N, class Counters, class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
