@@ -717,6 +717,15 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
         CHECK(bench.second.find("\"embree_build_ms\"") != std::string::npos);
         CHECK(bench.second.find("\"embree_mtris_s\"") != std::string::npos);
         CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
+        CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
+        // Embree's robust mode (watertight, conservative) answers the same rays alike.
+        const auto robust =
+            run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--rays",
+                                             "diffuse", "--embree-robust", "--json"});
+        REQUIRE(robust.first == 0);
+        CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
+        CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
+        CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
     }
     const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1",
                                                        "--rays", "shadow", "--no-embree"});

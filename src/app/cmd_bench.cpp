@@ -25,7 +25,7 @@ constexpr const char* kBenchUsage =
     "usage: sahara bench FILE [--threads N] [--rays primary|primary_packet|diffuse|shadow|all]\n"
     "                         [--json]\n"
     "                         [--builder binned|sweep|reinsert] [--layout L] [--size N] [--repeat K]\n"
-    "                         [--no-embree]\n"
+    "                         [--no-embree] [--embree-robust]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
     "              its triangles, spheres, boxes and quadrics (planes are unbounded: not in the\n"
@@ -46,6 +46,10 @@ constexpr const char* kBenchUsage =
     "  --size N    primary image side (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
+    "  --embree-robust\n"
+    "              build Embree's scene with RTC_SCENE_FLAG_ROBUST: its robust traversal and\n"
+    "              watertight triangle test, the guarantees sahara always gives (default: Embree's\n"
+    "              default mode, faster and not watertight)\n"
     "  --json      print one JSON object\n"
     "Both tracers run with flush-to-zero and denormals-are-zero (Embree's recommendation) on the\n"
     "same rays. Disagreements: hit/miss differ, t differs beyond 1e-4 relative, or a different\n"
@@ -69,6 +73,7 @@ struct BenchOptions {
     int size = 1024;
     int repeat = 3;
     bool embree = true;
+    bool embree_robust = false;
     bool json = false;
 };
 
@@ -169,7 +174,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     std::unique_ptr<EmbreeReference> embree;
     const std::string embree_status = embree_plan(opt, scene);
     if (embree_status == "compared")
-        embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, false, opt.threads);
+        embree =
+            std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust, opt.threads);
     const BenchRaySets rays =
         make_bench_rays(scene, accel, opt.size, opt.size,
                         input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
@@ -180,6 +186,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"primitive_kinds", primitive_kinds_text(scene)},
         {"planes_outside_tree", scene.planes.size()},
         {"embree", embree_status},
+        {"embree_mode", opt.embree_robust ? "robust" : "default"},
         {"threads", opt.threads},
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
@@ -225,9 +232,9 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms"))
-        std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads)",
+        std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s mode",
                     j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
-                    j["threads"].get<int>());
+                    j["threads"].get<int>(), j["embree_mode"].get<std::string>().c_str());
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)",
                 j["tree_bytes_per_primitive"].get<double>());
     if (j.contains("embree_bvh_bytes_per_primitive"))
@@ -329,6 +336,7 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
     else
         return "--rays must be primary, primary_packet, diffuse, shadow or all";
     opt.embree = !args.switches.count("--no-embree");
+    opt.embree_robust = args.switches.count("--embree-robust") != 0;
     opt.json = args.switches.count("--json") != 0;
     return "";
 }
@@ -339,7 +347,7 @@ int run_bench_command(int argc, char** argv) {
     ToolArgs args;
     std::string err =
         parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat"},
-                        {"--json", "--no-embree", "--small-scenes"}, args);
+                        {"--json", "--no-embree", "--embree-robust", "--small-scenes"}, args);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     if (args.help) {
         std::fputs(kBenchUsage, stdout);
