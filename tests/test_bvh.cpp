@@ -718,7 +718,7 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
         CHECK(bench.second.find("\"embree_mtris_s\"") != std::string::npos);
         CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
         CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
-        // Embree's robust mode (watertight, conservative) answers the same rays alike.
+        // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.
         const auto robust =
             run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--rays",
                                              "diffuse", "--embree-robust", "--json"});
