@@ -11,6 +11,7 @@
 /// on the thread count, and every node owns a fixed region of the node array
 /// (compacted at the end), so the tree is the same for any thread count.
 #include "accel/bvh_binned.h"
+#include "accel/build_chunks.h"
 
 #include <emmintrin.h>
 #include <xmmintrin.h>
@@ -24,8 +25,10 @@ namespace sahara {
 namespace {
 
 constexpr uint32_t kMaxBins = 64;
-constexpr uint32_t kParallelScanThreshold = 1u << 15;
-constexpr uint32_t kScanChunks = 8;
+using build::chunk_begin;
+using build::for_chunks;
+using build::kParallelScanThreshold;
+using build::kScanChunks;
 
 struct alignas(16) PrimRef {
     float lo[3];
@@ -124,24 +127,6 @@ struct Range {
     Bounds3 box, centroids;
     PrimRef* refs = nullptr;
 };
-
-/// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
-/// else as kScanChunks tasks (the caller is inside the build's parallel region).
-template <class Fn>
-void for_chunks(uint32_t begin, uint32_t end, const Fn& fn) {
-    const uint32_t n = end - begin;
-    if (n <= kParallelScanThreshold) {
-        fn(0u, begin, end);
-        return;
-    }
-    for (uint32_t c = 0; c < kScanChunks; ++c) {
-        const auto b = begin + uint32_t(uint64_t(n) * c / kScanChunks);
-        const auto e = begin + uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
-#pragma omp task default(shared) firstprivate(c, b, e)
-        fn(c, b, e);
-    }
-#pragma omp taskwait
-}
 
 class BinnedBuild {
    public:
@@ -363,8 +348,7 @@ class BinnedBuild {
         for (uint32_t c = 0; c < kScanChunks; ++c) {
             uint32_t lcount = 0;
             for (uint32_t b = 0; b < s.pos; ++b) lcount += parts[c].count[s.axis][b];
-            const auto cb = uint32_t(uint64_t(n) * c / kScanChunks);
-            const auto ce = uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
+            const uint32_t cb = chunk_begin(0, n, c), ce = chunk_begin(0, n, c + 1);
             left_at[c] = lsum;
             right_at[c] = rsum;
             lsum += lcount;

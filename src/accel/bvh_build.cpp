@@ -11,10 +11,14 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh_binned.h"
+#include "accel/build_chunks.h"
 
 namespace sahara {
 
 namespace {
+
+using build::for_chunks;
+using build::kScanChunks;
 
 /// The chosen partition of a node's range.
 struct Split {
@@ -43,30 +47,6 @@ class BvhBuildJob {
     }
 
    private:
-    /// Ranges longer than this are scanned (bounds, bins) as kScanChunks OpenMP tasks: near the
-    /// root there are fewer subtree tasks than threads. The chunks do not depend on the thread
-    /// count and merging boxes and counts is exact, so the tree does not either.
-    static constexpr uint32_t kParallelScanThreshold = 1u << 15;
-    static constexpr uint32_t kScanChunks = 8;
-
-    /// Calls fn(chunk, chunk_begin, chunk_end) over [begin, end): inline for short ranges,
-    /// else as kScanChunks tasks (the caller is inside the build's parallel region).
-    template <class Fn>
-    static void for_chunks(uint32_t begin, uint32_t end, const Fn& fn) {
-        const uint32_t n = end - begin;
-        if (n <= kParallelScanThreshold) {
-            fn(0u, begin, end);
-            return;
-        }
-        for (uint32_t c = 0; c < kScanChunks; ++c) {
-            const auto b = begin + uint32_t(uint64_t(n) * c / kScanChunks);
-            const auto e = begin + uint32_t(uint64_t(n) * (c + 1) / kScanChunks);
-#pragma omp task default(shared) firstprivate(c, b, e)
-            fn(c, b, e);
-        }
-#pragma omp taskwait
-    }
-
     /// Step 1 of every node: bounds of the boxes and of the centroids in the range.
     void range_bounds(uint32_t begin, uint32_t end, Bounds3& box, Bounds3& centroids) const {
         Bounds3 boxes[kScanChunks], cents[kScanChunks];
