@@ -323,10 +323,11 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     Hit best;
     const bool found = traverse_wide<kAnyHit, kAvx>(
         tree, br,
-        [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
+        [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
+            float& tmax) __attribute__((always_inline)) {
             if constexpr (kBlocks)
-                return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax,
-                                                                 best);
+                return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count,
+                                                                 next_first, next_count, paired, tmax, best);
             else
                 return LeafResult::slow;  // slots: every kind through the full test
         },

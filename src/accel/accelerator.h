@@ -186,7 +186,8 @@ class Accelerator {
     /// test_blocks for the traversal's call-free inner loop (LeafResult::slow: use test_blocks).
     template <bool kAnyHit, bool kCutouts, bool kAvx>
     LeafResult test_blocks_fast(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count,
-                                float& tmax, Hit& hit) const;
+                                uint32_t next_first, uint32_t next_count, bool& paired, float& tmax,
+                                Hit& hit) const;
     template <int N>
     void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                           const std::vector<TriangleVerts>& tris);

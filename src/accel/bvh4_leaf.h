@@ -130,11 +130,12 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
     return result;
 }
 
-/// Loads lane group [v][axis] of blocks b[0] (low half) and b[1] (high half).
-__attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b, int v,
+/// Loads lane group [v][axis] of blocks b0 (low half) and b1 (high half).
+__attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b0,
+                                                                             const TriangleBlock4* b1, int v,
                                                                              int axis) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b[0].p[v][axis])),
-                                _mm_load_ps(b[1].p[v][axis]), 1);
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b0->p[v][axis])),
+                                _mm_load_ps(b1->p[v][axis]), 1);
 }
 
 /// intersect_triangle_block4_simd over the two blocks b[0], b[1] in one AVX step:
@@ -142,17 +143,17 @@ __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(con
 /// t/u/v_out hold 8 lanes. Not always_inline, like WideRay<8, true>::test
 /// (bvh_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
 __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
-    const TriangleRay& tr, const TriangleBlock4* b, float tmin, float tmax, float t_out[8], float u_out[8],
-    float v_out[8], int& exact_zero) {
+    const TriangleRay& tr, const TriangleBlock4* b0, const TriangleBlock4* b1, float tmin, float tmax,
+    float t_out[8], float u_out[8], float v_out[8], int& exact_zero) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const __m256 ox = _mm256_set1_ps(tr.org[kx]), oy = _mm256_set1_ps(tr.org[ky]),
                  oz = _mm256_set1_ps(tr.org[kz]);
     const __m256 sx = _mm256_set1_ps(tr.sx), sy = _mm256_set1_ps(tr.sy), sz = _mm256_set1_ps(tr.sz);
     __m256 x[3], y[3], rz[3];
     for (int v = 0; v < 3; ++v) {
-        rz[v] = _mm256_sub_ps(load_block_pair(b, v, kz), oz);
-        x[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b, v, kx), ox), _mm256_mul_ps(sx, rz[v]));
-        y[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b, v, ky), oy), _mm256_mul_ps(sy, rz[v]));
+        rz[v] = _mm256_sub_ps(load_block_pair(b0, b1, v, kz), oz);
+        x[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b0, b1, v, kx), ox), _mm256_mul_ps(sx, rz[v]));
+        y[v] = _mm256_sub_ps(_mm256_sub_ps(load_block_pair(b0, b1, v, ky), oy), _mm256_mul_ps(sy, rz[v]));
     }
     const __m256 u = _mm256_sub_ps(_mm256_mul_ps(x[2], y[1]), _mm256_mul_ps(y[2], x[1]));
     const __m256 v = _mm256_sub_ps(_mm256_mul_ps(x[0], y[2]), _mm256_mul_ps(y[0], x[2]));
@@ -197,7 +198,8 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const 
                                                                           float tmax, float t_out[8],
                                                                           float u_out[8], float v_out[8]) {
     int exact_zero = 0;
-    int result = intersect_triangle_blocks2_avx_simd(tr, b, tmin, tmax, t_out, u_out, v_out, exact_zero);
+    int result =
+        intersect_triangle_blocks2_avx_simd(tr, b, b + 1, tmin, tmax, t_out, u_out, v_out, exact_zero);
     if (exact_zero) {
         result |= redo_exact_zero_lanes(tr, b[0], exact_zero & 0xF, 0, tmin, tmax, t_out, u_out, v_out);
         result |= redo_exact_zero_lanes(tr, b[1], exact_zero >> 4, 4, tmin, tmax, t_out, u_out, v_out);

@@ -288,8 +288,20 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         for (;;) {  // the inner loop: no calls
             if (cur.count) {
                 counters.on_prims(cur.count);
-                const LeafResult r = fast_leaf(cur.index, cur.count, ray.tmax);
+                // The entry visited next, when it is a leaf, may be tested in the same step.
+                uint32_t next_first = 0, next_count = 0;
+                if (top > 0 && (kAnyHit || stack[top - 1].t_entry <= tmax_far)) {
+                    next_first = stack[top - 1].index;
+                    next_count = stack[top - 1].count;
+                }
+                bool paired = false;
+                const LeafResult r =
+                    fast_leaf(cur.index, cur.count, next_first, next_count, paired, ray.tmax);
                 if (r == LeafResult::slow) break;
+                if (paired) {
+                    --top;
+                    counters.on_prims(next_count);
+                }
                 if (r == LeafResult::hit) {
                     if constexpr (kAnyHit) return true;
                     found = true;
