@@ -138,8 +138,9 @@ __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(con
                                 _mm_load_ps(b1->p[v][axis]), 1);
 }
 
-/// intersect_triangle_block4_simd over the two blocks b[0], b[1] in one AVX step:
-/// bit l of the result (and of `exact_zero`) is lane l & 3 of block l >> 2;
+/// intersect_triangle_block4_simd over two blocks in one AVX step (b0 and b1 need
+/// not be adjacent: a leaf's two blocks, or two one-block leaves): bit l of the
+/// result (and of `exact_zero`) is lane l & 3 of b0 for l < 4, of b1 otherwise;
 /// t/u/v_out hold 8 lanes. Not always_inline, like WideRay<8, true>::test
 /// (bvh_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
 __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
