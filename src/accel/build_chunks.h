@@ -12,7 +12,7 @@ namespace sahara::build {
 inline constexpr uint32_t kParallelScanThreshold = 1u << 15;
 inline constexpr uint32_t kScanChunks = 8;
 
-/// Bounds of chunk c of the n-element range starting at `begin`.
+/// Start of chunk c (and end of chunk c - 1) of the n-element range starting at `begin`.
 inline uint32_t chunk_begin(uint32_t begin, uint32_t n, uint32_t c) {
     return begin + uint32_t(uint64_t(n) * c / kScanChunks);
 }

@@ -250,6 +250,11 @@ enum class LeafResult : uint8_t {
 /// the stack, every vector register being caller-saved. A leaf it answers `slow`
 /// goes to `slow_leaf` (the complete test: other primitive kinds, the scalar
 /// fallback, the alpha test) in the outer loop.
+///
+/// fast_leaf(first, count, next_first, next_count, paired, tmax) also gets the
+/// stack entry that would be visited next (next_count 0: none, or an inner node);
+/// when it tests that leaf in the same step it sets `paired`, and the entry is
+/// dropped from the stack.
 template <bool kAnyHit, bool kAvx = false, int N, class Counters, class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
