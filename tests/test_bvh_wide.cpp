@@ -100,7 +100,10 @@ void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
                 if (n.count[c]) {
                     use_leaf(acc, n.child[c], n.count[c], slot_uses);
                 } else {
-                    stack.push_back({n.child[c], child_box(n, c)});
+                    // Inner children hold node byte offsets (BvhWide::node_at).
+                    CHECK(n.child[c] % sizeof(BvhWideNode<N>) == 0);
+                    CHECK(&t.node_at(n.child[c]) == &t.nodes[BvhWide<N>::index_of(n.child[c])]);
+                    stack.push_back({uint32_t(BvhWide<N>::index_of(n.child[c])), child_box(n, c)});
                 }
             }
             CHECK(children >= 2);

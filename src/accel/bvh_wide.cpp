@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <string>
+
+#include "base/error.h"
 
 namespace sahara {
 
@@ -168,7 +171,7 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
         const Pending it = stack.back();
         stack.pop_back();
         const auto index = uint32_t(out.nodes.size());
-        if (it.parent != kNoNode) out.nodes[it.parent].child[it.slot] = index;
+        if (it.parent != kNoNode) out.nodes[it.parent].child[it.slot] = BvhWide<N>::offset_of(index);
         typename CollapsePlan<N>::Child kids[N];
         const int n = plan.children(it.node, kids);
         BvhWideNode<N> p = empty_node<N>();
@@ -177,6 +180,10 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
         for (int c = n - 1; c >= 0; --c)
             if (!kids[c].count) stack.push_back({kids[c].node, index, c});
     }
+    if (out.nodes.size() > BvhWide<N>::kMaxNodes)
+        throw InputError("scene too large: its wide BVH has " + std::to_string(out.nodes.size()) +
+                         " nodes, more than the " + std::to_string(BvhWide<N>::kMaxNodes) +
+                         " that 32-bit node offsets reach");
     return out;
 }
 

@@ -182,9 +182,10 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
         leaf(wide8_.root.index, wide8_.root.count, p.active);
     } else {
         struct Entry {
-            uint32_t index, count;  ///< node, or first block and slot count of a leaf
-            uint32_t parent;        ///< a leaf's parent node * 8 + its lane there
-            float t_entry;          ///< the frustum's entry distance: at most any ray's
+            uint32_t index,
+                count;        ///< node offset (BvhWide::node_at), or first block and slot count of a leaf
+            uint32_t parent;  ///< a leaf's parent node offset + its lane there
+            float t_entry;    ///< the frustum's entry distance: at most any ray's
         };
         Entry stack[7 * kBvhMaxDepth + 4];
         int top = 0;
@@ -193,10 +194,10 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
         for (;;) {
             if (cur.count) {
                 const uint32_t mask =
-                    rays_in_box(sr, wide8_.nodes[cur.parent >> 3], int(cur.parent & 7)) & p.active;
+                    rays_in_box(sr, wide8_.node_at(cur.parent & ~7u), int(cur.parent & 7)) & p.active;
                 if (mask && leaf(cur.index, cur.count, mask)) reach = max16(sr.tmax_scaled);
             } else {
-                const Bvh8Node& n = wide8_.nodes[cur.index];
+                const Bvh8Node& n = wide8_.node_at(cur.index);
                 const char* base = reinterpret_cast<const char*>(&n);
                 __m256 t0 = t_lo, t1 = _mm256_set1_ps(kInfinity);
                 for (int a = 0; a < 3; ++a) {
@@ -210,7 +211,7 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
                 if (any) {
                     alignas(32) float order[8];
                     _mm256_store_ps(order, t0);
-                    const uint32_t parent = cur.index * 8;
+                    const uint32_t parent = cur.index;  // a node offset: its low 8 bits are 0
                     int c = std::countr_zero(unsigned(any));
                     any &= any - 1;
                     cur = Entry{n.child[c], n.count[c], parent + uint32_t(c), order[c]};
