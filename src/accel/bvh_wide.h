@@ -53,7 +53,7 @@ struct BvhWide {
     /// An inner child holds its node's byte offset (index * sizeof(node)), not its
     /// index: the traversal's next node address is then one addition. The address
     /// depends on the node test just made, so a multiplication there lengthens every
-    /// step of the chain (diffuse and shadow rays: 2-4% faster without it).
+    /// step of the chain (without it: diffuse rays 1-5%, occlusion rays 0-4% faster).
     static uint32_t offset_of(size_t index) { return uint32_t(index * sizeof(BvhWideNode<N>)); }
     static size_t index_of(uint32_t offset) { return offset / sizeof(BvhWideNode<N>); }
     const BvhWideNode<N>& node_at(uint32_t offset) const {

@@ -182,8 +182,8 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
         leaf(wide8_.root.index, wide8_.root.count, p.active);
     } else {
         struct Entry {
-            uint32_t index,
-                count;        ///< node offset (BvhWide::node_at), or first block and slot count of a leaf
+            uint32_t index;   ///< node offset (BvhWide::node_at), or a leaf's first block
+            uint32_t count;   ///< a leaf's slot count; 0: inner node
             uint32_t parent;  ///< a leaf's parent node offset + its lane there
             float t_entry;    ///< the frustum's entry distance: at most any ray's
         };
