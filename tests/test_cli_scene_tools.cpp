@@ -84,6 +84,9 @@ TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree sk
     CHECK(j["rays"]["primary"]["count"] == 32 * 32);
     CHECK(j["rays"]["diffuse"]["count"] == 32 * 32);  // the camera sees the scene: there are hits
     CHECK(j["rays"]["primary"]["nodes_visited"].get<double>() > 0.0);
+    // Occlusion rays from the primary hits towards the light: counted like the others.
+    CHECK(j["rays"]["shadow"]["count"] == 32 * 32);
+    CHECK(j["rays"]["shadow"]["nodes_visited"].get<double>() > 0.0);
 
     const ToolRun bench = run_tool("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
     REQUIRE(bench.code == 0);

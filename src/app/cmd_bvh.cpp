@@ -1,6 +1,6 @@
 /// `sahara bvh`: builds the BVH over a mesh or a scene file's bounded primitives
 /// and prints its statistics, plus
-/// the mean traversal work per ray for primary and diffuse-bounce rays.
+/// the mean traversal work per ray for primary, diffuse-bounce and shadow (occlusion) rays.
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
@@ -32,19 +32,24 @@ constexpr const char* kBvhUsage =
     "  --layout L  traversal structure the counts below are taken on: wide8 (default), wide4,\n"
     "              wide4-slots or pairs (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
-    "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays;\n"
+    "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays and\n"
+    "              as many shadow rays (occlusion, to a light above; the sets of `sahara bench`);\n"
     "              a mesh is framed from (0.4, 0.3, 1), a scene is seen through its own camera\n"
     "  --json      print one JSON object instead of text\n"
     "SAH costs: traversal 1, primitive intersection 1 (relative), normalised to the root's area.\n";
 
 /// Mean nodes visited and primitives tested per ray, counted in parallel with per-thread counters.
-TraversalCounters count_work(const Accelerator& accel, const std::vector<Ray>& rays) {
+TraversalCounters count_work(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion = false) {
     TraversalCounters total;
 #pragma omp parallel
     {
         TraversalCounters local;
 #pragma omp for schedule(dynamic, 1024)
         for (size_t i = 0; i < rays.size(); ++i) {
+            if (occlusion) {
+                accel.occluded_counted(rays[i], local);
+                continue;
+            }
             Ray r = rays[i];
             Hit h;
             accel.intersect_counted(r, h, local);
@@ -129,6 +134,7 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
     }
     j["rays"]["primary"] = work_json(count_work(accel, rays.primary), rays.primary.size());
     j["rays"]["diffuse"] = work_json(count_work(accel, rays.diffuse), rays.diffuse.size());
+    j["rays"]["shadow"] = work_json(count_work(accel, rays.shadow, true), rays.shadow.size());
     return j;
 }
 
@@ -170,7 +176,7 @@ void print_text(const nlohmann::ordered_json& j) {
     std::printf(
         "memory            %zu bytes (%.1f per primitive; tree %zu, leaf-ordered primitives the rest)\n",
         j["bytes"].get<size_t>(), j["bytes_per_primitive"].get<double>(), j["tree_bytes"].get<size_t>());
-    for (const char* set : {"primary", "diffuse"}) {
+    for (const char* set : {"primary", "diffuse", "shadow"}) {
         const auto& r = j["rays"][set];
         std::printf("%-7s rays      %zu: %.1f nodes visited, %.2f primitives tested per ray\n", set,
                     r["count"].get<size_t>(), r["nodes_visited"].get<double>(),
