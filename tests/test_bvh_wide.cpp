@@ -281,6 +281,52 @@ TEST_CASE("BVH8 box test (SSE halves and AVX) matches the single-node test") {
     CHECK(hits > 0);
 }
 
+TEST_CASE("BVH8 AVX-512 node step: the AVX step's hits, compressed in slot order") {
+    if (!cpu_has_avx512()) {
+        MESSAGE("this CPU has no AVX-512: the AVX-512 node step is not run here");
+        return;
+    }
+    std::mt19937 rng(33);
+    std::uniform_int_distribution<int> coord(-2, 2);
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0, multi = 0;
+    for (int i = 0; i < 50000 / kSanitizerDivisor; ++i) {
+        Bvh8Node n{};
+        for (int c = 0; c < 8; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 8 == 0) b = Bounds3{};  // empty slot
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+            n.child[c] = b.empty() ? kNoNode : uint32_t(rng());
+            n.count[c] = b.empty() ? 0 : uint32_t(rng() % 3);
+        }
+        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+        for (int a = 0; a < 3; ++a)
+            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+        const BvhRay r(ray);
+        const float tmax_far = r.tmax * kRobustFarScale;
+        alignas(32) float t_avx[8], t[8];
+        alignas(32) uint32_t child[8], count[8];
+        const WideRay<8, true> rw(r);
+        const int mask = rw.test(n, r.tmin, tmax_far, t_avx);
+        const Bvh8HitChildren h =
+            intersect_bvh8_compress_avx512(n, rw.avx, r.tmin, tmax_far, child, count, t);
+        if (int(h.mask) != mask) ++bad;
+        multi += __builtin_popcount(unsigned(mask)) > 1;
+        int i_hit = 0;
+        for (int c = 0; c < 8; ++c) {
+            if (!(mask & (1 << c))) continue;
+            if (child[i_hit] != n.child[c] || count[i_hit] != n.count[c] || t[i_hit] != t_avx[c]) ++bad;
+            if (i_hit == 0 && (h.child0 != n.child[c] || h.count0 != n.count[c] || h.t0 != t_avx[c])) ++bad;
+            ++i_hit;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(multi > 0);
+}
+
 TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar watertight test") {
     // A fine grid: rays through shared edges and vertices give exactly-zero edge functions.
     const TriangleMesh m = make_tiny_grid(12, 1.0f, 1.0f);

@@ -304,8 +304,9 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 
 /// The wide-BVH traversal; trace_wide_avx2 is the same code compiled for AVX2
 /// (both inline this body, so each gets its own instruction selection; an
-/// 8-wide node is tested in one AVX step there, as two SSE halves otherwise).
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
+/// 8-wide node is tested in one AVX step there, as two SSE halves otherwise), and
+/// trace_wide_avx512 for AVX-512 (kAvx512: its node step compresses the hit children).
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
                                                                         Hit& hit, Counters& counters) const {
     // The triangle constants (three divisions) are made at the first leaf: many
@@ -321,7 +322,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     };
     BvhRay br(ray);
     Hit best;
-    const bool found = traverse_wide<kAnyHit, kAvx>(
+    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512>(
         tree, br,
         [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
             float& tmax) __attribute__((always_inline)) {
@@ -347,19 +348,19 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
 bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
 __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
     const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, true>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, class Counters>

@@ -168,7 +168,7 @@ class Accelerator {
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_pairs(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
     bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
     bool trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;

