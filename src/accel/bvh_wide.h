@@ -86,7 +86,7 @@ inline Bvh4 make_bvh4(const Bvh& bvh, const WideCollapse& opt = {}) { return mak
 enum class SimdPath : uint8_t {
     sse2,    ///< baseline of every x86-64 CPU
     avx2,    ///< VEX encoding, 8-wide node tests in one AVX step
-    avx512,  ///< the AVX2 code with AVX-512VL available: 32 vector registers, fewer spills
+    avx512,  ///< the AVX2 code with AVX-512VL (32 vector registers) and its own 8-wide node step
 };
 
 namespace detail {
