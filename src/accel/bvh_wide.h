@@ -235,7 +235,7 @@ struct Bvh8HitChildren {
 /// compressed to the front of child/count/t (slot order). The first hit child also
 /// comes back in registers, so the next node's address waits for neither a bit scan
 /// nor a load (against the AVX2 step on an AVX-512 Xeon: diffuse rays 4-7%, occlusion
-/// rays 2-4% faster).
+/// rays 3-5% faster).
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                                uint32_t* child, uint32_t* count, float* t) {
@@ -346,8 +346,9 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     };
     // Puts the nearer of a and b into a without a branch: which of two hit children is
     // nearer is a coin toss for the predictor (AVX-512 step, diffuse rays: 2-3% faster
-    // than a branch). Entry distances are >= 0 (or +inf), so their bit patterns order
-    // like the floats; on a tie, a stays.
+    // than a branch). Entry distances are at least tmin >= 0, so their bit patterns order
+    // like the floats (were one negative, only the order of visits would suffer, not the
+    // answer); on a tie, a stays.
     auto nearer_first = [](Entry & a, Entry & b) __attribute__((always_inline)) {
         static_assert(sizeof(Entry) == 12 && offsetof(Entry, t_entry) == 8);
         uint64_t ka, kb;
