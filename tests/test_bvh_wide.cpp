@@ -172,6 +172,18 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
     }
 }
 
+/// A ray for the box-test cases: integer origin (often exactly on a slab plane),
+/// direction components zeroed (+0 or -0) a third of the time, sometimes a short tmax.
+Ray random_slab_test_ray(std::mt19937& rng, std::uniform_int_distribution<int>& coord,
+                         std::uniform_real_distribution<float>& u) {
+    // Braced initialisation: the draws happen left to right.
+    Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+    for (int a = 0; a < 3; ++a)
+        if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+    if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+    return ray;
+}
+
 }  // namespace
 
 TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on every SIMD path") {
@@ -225,11 +237,7 @@ TEST_CASE("BVH4 box test matches the single-node test, including zero directions
             n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
             n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
         }
-        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
-        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
-        const BvhRay r(ray);
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
         __m128 tv;
         const int mask = intersect_bvh4(n, Bvh4Ray(r), r.tmin, r.tmax, tv);
         alignas(16) float t4[4];
@@ -259,11 +267,7 @@ TEST_CASE("BVH8 box test (SSE halves and AVX) matches the single-node test") {
             n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
             n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
         }
-        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
-        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
-        const BvhRay r(ray);
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
         alignas(32) float t_sse[8], t_avx[8];
         const int mask_sse = WideRay<8, false>(r).test(n, r.tmin, r.tmax * kRobustFarScale, t_sse);
         const int mask_avx =
@@ -301,11 +305,7 @@ TEST_CASE("BVH8 AVX-512 node step: the AVX step's hits, compressed in slot order
             n.child[c] = b.empty() ? kNoNode : uint32_t(rng());
             n.count[c] = b.empty() ? 0 : uint32_t(rng() % 3);
         }
-        Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
-        for (int a = 0; a < 3; ++a)
-            if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
-        if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
-        const BvhRay r(ray);
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
         const float tmax_far = r.tmax * kRobustFarScale;
         alignas(32) float t_avx[8], t[8];
         alignas(32) uint32_t child[8], count[8];
