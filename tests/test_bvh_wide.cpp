@@ -285,7 +285,7 @@ TEST_CASE("BVH8 box test (SSE halves and AVX) matches the single-node test") {
     CHECK(hits > 0);
 }
 
-TEST_CASE("BVH8 AVX-512 node step: the exact slab test's hits, compressed in slot order") {
+TEST_CASE("BVH8 AVX-512 node steps: the exact slab test's hits, compressed in slot order") {
     if (!cpu_has_avx512()) {
         MESSAGE("this CPU has no AVX-512: the AVX-512 node step is not run here");
         return;
@@ -337,6 +337,15 @@ TEST_CASE("BVH8 AVX-512 node step: the exact slab test's hits, compressed in slo
         const Bvh8HitChildren h =
             intersect_bvh8_compress_avx512(n, rw.avx, r.tmin, tmax_far, child, count, t);
         if (int(h.mask) != mask) ++bad;
+        // The any-hit form: the same hits as 12-byte stack entries (reference, count, unused).
+        struct StackEntry {
+            uint32_t index, count;
+            float unused;
+        } entries[8];
+        const Bvh8HitChildren ha = intersect_bvh8_entries_avx512(n, rw.avx, r.tmin, tmax_far, entries);
+        if (ha.mask != h.mask || ha.child0 != h.child0 || ha.count0 != h.count0) ++bad;
+        for (int i = 0; i < __builtin_popcount(h.mask); ++i)
+            if (entries[i].index != child[i] || entries[i].count != count[i]) ++bad;
         multi += __builtin_popcount(unsigned(mask)) > 1;
         int i_hit = 0;
         for (int c = 0; c < 8; ++c) {

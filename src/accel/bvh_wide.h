@@ -253,9 +253,10 @@ struct Bvh8HitChildren {
 /// for a negative exit. A negated exit of +0 (the origin exactly on the far plane of a
 /// positive direction) wraps to all ones and counts as a hit: a superset of the AVX2
 /// step's hits, never fewer.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
-intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
-                               uint32_t* child, uint32_t* count, float* t) {
+/// The hit test of the AVX-512 node step (see intersect_bvh8_compress_avx512): mask of
+/// the hit children, entry distances (bit patterns) in `entry`.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmask8 bvh8_hits_avx512(
+    const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry) {
     const char* base = reinterpret_cast<const char*>(&n);
     __m256i tn[3], ntf[3];
     for (int a = 0; a < 3; ++a) {
@@ -266,12 +267,19 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
     }
     // max with 0: a tmin of -0 would be the smallest integer, not 0.
     const __m256i lo = _mm256_max_epi32(_mm256_castps_si256(_mm256_set1_ps(tmin)), _mm256_setzero_si256());
-    const __m256i entry = _mm256_max_epi32(_mm256_max_epi32(tn[1], tn[2]), _mm256_max_epi32(tn[0], lo));
+    entry = _mm256_max_epi32(_mm256_max_epi32(tn[1], tn[2]), _mm256_max_epi32(tn[0], lo));
     const __m256i neg_exit =
         _mm256_min_epu32(_mm256_min_epu32(ntf[1], ntf[2]),
                          _mm256_min_epu32(ntf[0], _mm256_castps_si256(_mm256_set1_ps(-tmax_far))));
-    const __mmask8 k = _mm256_cmp_epu32_mask(_mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF)),
-                                             _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1)), _MM_CMPINT_LE);
+    return _mm256_cmp_epu32_mask(_mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF)),
+                                 _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1)), _MM_CMPINT_LE);
+}
+
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
+                               uint32_t* child, uint32_t* count, float* t) {
+    __m256i entry;
+    const __mmask8 k = bvh8_hits_avx512(n, r, tmin, tmax_far, entry);
     const __m256 t0 = _mm256_castsi256_ps(entry);
     const __m256i ch =
         _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
@@ -283,6 +291,29 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
     _mm256_store_ps(t, tc);
     return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), uint32_t(_mm256_cvtsi256_si32(cn)),
             _mm256_cvtss_f32(tc)};
+}
+
+/// The AVX-512 node step of an any-hit ray: the hit children as 12-byte stack entries
+/// (reference, count, an unused third word) in slot order, all eight lanes written to
+/// entries[0..8) (96 bytes), so that pushing them takes no loop over the hits.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
+                              void* entries) {
+    __m256i entry;
+    const __mmask8 k = bvh8_hits_avx512(n, r, tmin, tmax_far, entry);
+    const __m256i ch =
+        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
+    const __m256i cn =
+        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.count)));
+    // Interleave: word 3 i is child i, word 3 i + 1 its count (index 8 + j picks cn lane j).
+    char* out = static_cast<char*>(entries);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(0, 8, 0, 1, 9, 1, 2, 10), cn));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 32),
+                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(2, 3, 11, 3, 4, 12, 4, 5), cn));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 64),
+                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(13, 5, 6, 14, 6, 7, 15, 7), cn));
+    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), uint32_t(_mm256_cvtsi256_si32(cn)), 0.0f};
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
@@ -360,7 +391,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     };
     const char* const nodes = reinterpret_cast<const char*>(bvh.nodes.data());
     // Each node pushes at most N - 1 entries per level, plus slack.
-    Entry stack[(N - 1) * kBvhMaxDepth + 4];
+    Entry stack[(N - 1) * kBvhMaxDepth + 4 + 8];  // + 8: the AVX-512 any-hit step writes 8 entries
     int top = 0;
     bool found = false;
     Entry cur{0, 0, ray.tmin};
@@ -431,7 +462,21 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 const auto& n = *reinterpret_cast<const BvhWideNode<N>*>(nodes + cur.index);  // node_at
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
-                if constexpr (kAvx512 && N == 8) {
+                if constexpr (kAvx512 && N == 8 && kAnyHit) {
+                    static_assert(sizeof(Entry) == 12);
+                    const Bvh8HitChildren h =
+                        intersect_bvh8_entries_avx512(n, rw.avx, ray.tmin, tmax_far, &stack[top]);
+                    if (h.mask) {
+                        cur = Entry{h.child0, h.count0, 0.0f};
+                        if (!(h.mask & (h.mask - 1))) continue;  // one child hit
+                        // Child order: the last hit child becomes `cur`, the others stay pushed.
+                        top += __builtin_popcount(h.mask) - 1;
+                        cur = stack[top];
+                        continue;
+                    }
+                    if (!pop()) return found;
+                    continue;
+                } else if constexpr (kAvx512 && N == 8) {
                     alignas(32) uint32_t child[8], count[8];
                     alignas(32) float t[8];
                     const Bvh8HitChildren h =
