@@ -476,7 +476,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     }
                     if (!pop()) return found;
                     continue;
-                } else if constexpr (kAvx512 && N == 8) {
+                } else if constexpr (kAvx512 && N == 8) {  // closest hit
                     alignas(32) uint32_t child[8], count[8];
                     alignas(32) float t[8];
                     const Bvh8HitChildren h =
@@ -485,13 +485,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         cur = Entry{h.child0, h.count0, h.t0};
                         if (!(h.mask & (h.mask - 1))) continue;  // one child hit
                         const int hits = __builtin_popcount(h.mask);
-                        if constexpr (kAnyHit) {
-                            // Child order, as below: the last hit child becomes `cur`.
-                            stack[top++] = cur;
-                            for (int i = 1; i < hits - 1; ++i) stack[top++] = Entry{child[i], count[i], t[i]};
-                            cur = Entry{child[hits - 1], count[hits - 1], t[hits - 1]};
-                            continue;
-                        }
                         const int base = top;
                         for (int i = 1; i < hits; ++i) {
                             Entry in{child[i], count[i], t[i]};
