@@ -165,15 +165,15 @@ __attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, cons
     return intersect_wide_sse<4>(n, r, 0, tmin, tmax * kRobustFarScale, t_near);
 }
 
-/// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin and
-/// negated inverse directions (for near and far planes, see BvhRay), and the byte
-/// offsets of each axis's near and far planes.
-/// The test computes (org - plane) * -inv, which rounds exactly like (plane - org) * inv
-/// (round-to-nearest is symmetric under negation) but lets the plane be a memory operand
-/// of the subtraction: three instructions per plane instead of five.
+/// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin, negated
+/// inverse direction for the near planes and inverse direction for the far planes (see
+/// BvhRay), and the byte offsets of each axis's near and far planes.
+/// The near planes' test computes (org - plane) * -inv, which rounds exactly like
+/// (plane - org) * inv (round-to-nearest is symmetric under negation) but lets the plane
+/// be a memory operand of the subtraction; the far planes' (org - plane) * inv_far is the
+/// negated exit distance that bvh8_distances_avx reduces.
 struct Bvh8RayAvx {
-    __m256 org[3], ninv[3], ninv_far[3];
-    __m256 inv_far[3];  ///< -ninv_far, for the AVX-512 step
+    __m256 org[3], ninv[3], inv_far[3];
     /// Pointer-sized, so that the addressing needs no extension of them at every node.
     size_t near_off[3], far_off[3];
 
@@ -187,7 +187,6 @@ struct Bvh8RayAvx {
         for (int a = 0; a < 3; ++a) {
             org[a] = _mm256_set1_ps(r.org[a]);
             ninv[a] = _mm256_set1_ps(-r.inv_dir[a]);
-            ninv_far[a] = _mm256_set1_ps(-r.inv_far[a]);
             inv_far[a] = _mm256_set1_ps(r.inv_far[a]);
             near_off[a] = size_t(64 * a + 32 * r.neg[a]);
             far_off[a] = near_off[a] ^ 32;
@@ -195,64 +194,29 @@ struct Bvh8RayAvx {
     }
 };
 
-/// The distances of an 8-wide node's children in one AVX step: t0 (entry) and t1
-/// (exit, enlarged) per lane, the answers of intersect_wide_sse eight lanes wide;
-/// a child is hit when t0 <= t1.
-__attribute__((target("avx2"), always_inline)) inline void bvh8_slabs_avx(const Bvh8Node& n,
-                                                                          const Bvh8RayAvx& r, float tmin,
-                                                                          float tmax_far, __m256& t0,
-                                                                          __m256& t1) {
-    const char* base = reinterpret_cast<const char*>(&n);
-    __m256 tn[3], tf[3];
-    for (int a = 0; a < 3; ++a) {
-        const __m256 near = _mm256_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
-        const __m256 far = _mm256_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
-        tn[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], near), r.ninv[a]);
-        tf[a] = _mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.ninv_far[a]);
-    }
-    t0 = _mm256_max_ps(_mm256_max_ps(tn[1], tn[2]), _mm256_max_ps(tn[0], _mm256_set1_ps(tmin)));
-    t1 = _mm256_min_ps(_mm256_min_ps(tf[1], tf[2]), _mm256_min_ps(tf[0], _mm256_set1_ps(tmax_far)));
-}
-
-/// The eight children of a BVH8 node in one AVX step (bvh8_slabs_avx): mask of the
-/// hit children, entry distances to t_near[0..8).
-__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
-                                                                             const Bvh8RayAvx& r, float tmin,
-                                                                             float tmax_far, float* t_near) {
-    __m256 t0, t1;
-    bvh8_slabs_avx(n, r, tmin, tmax_far, t0, t1);
-    _mm256_store_ps(t_near, t0);
-    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
-}
-
-/// What the AVX-512 node step found: the hit mask and the first hit child (lowest slot).
-struct Bvh8HitChildren {
-    unsigned mask;
-    uint32_t child0, count0;
-    float t0;
-};
-
-/// The box test of the AVX-512 node steps: mask of the hit children, their entry
-/// distances (as bit patterns) in `entry`. The slab distances are those of
-/// bvh8_slabs_avx, but they are reduced as integers, one cycle where a float max or
-/// min takes four (diffuse and occlusion rays 2-4% faster on six of the seven test
-/// meshes, the Cornell box unchanged). That needs tmin >= 0:
+/// The slab distances of an 8-wide node's children in one AVX step, reduced as
+/// integers: one cycle where a float max or min takes four (AVX-512 Xeon: diffuse and
+/// occlusion rays 2-4% faster on the AVX-512 step, 3-8% on the AVX2 step). That needs
+/// tmin >= 0:
 ///  - entry: the signed-integer max of the near distances and tmin. Non-negative
 ///    floats order like their bit patterns, and every negative float, the NaN of
 ///    0 * inf (sign bit set on x86: a ray in a slab plane) included, is a negative
 ///    integer and loses to tmin, so that axis is dropped as it should be;
-///  - exit: the far distances are computed negated, (org - far) * inv_far = -t1
+///  - neg_exit: the far distances are computed negated, (org - far) * inv_far = -t1
 ///    exactly, and reduced with -tmax_far by an unsigned min. Negative floats (exits
 ///    ahead) order by magnitude as unsigned integers; the NaN (0xFFC00000) is above
 ///    them all and loses; a non-negative one (an exit behind the origin) is below them
 ///    all and wins, and the child is then missed.
-/// A child is hit when exit - 1 >= entry + 0x7FFFFFFF (unsigned), i.e. |exit| >= entry
-/// for a negative exit. A negated exit of +0 (the origin exactly on the far plane of a
-/// positive direction) wraps to all ones and counts as a hit: never a miss the exact
-/// slab test would hit. Each NaN is dropped on its own, so the hits can be fewer than
-/// the AVX2 step's, which drops a whole pair (intersect_bvh_node); both are conservative.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmask8 bvh8_hits_avx512(
-    const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry) {
+/// A child is hit when neg_exit - 1 >= entry + 0x7FFFFFFF (unsigned), i.e. |exit| >=
+/// entry for a negative exit. A negated exit of +0 (the origin exactly on the far plane
+/// of a positive direction) wraps to all ones and counts as a hit: never a miss the
+/// exact slab test would hit. Each NaN is dropped on its own, so the hits can be fewer
+/// than those of intersect_bvh_node and the SSE test, which drop a whole pair of
+/// distances around a NaN; both are conservative.
+__attribute__((target("avx2"), always_inline)) inline void bvh8_distances_avx(const Bvh8Node& n,
+                                                                              const Bvh8RayAvx& r, float tmin,
+                                                                              float tmax_far, __m256i& entry,
+                                                                              __m256i& neg_exit) {
     const char* base = reinterpret_cast<const char*>(&n);
     __m256i tn[3], ntf[3];
     for (int a = 0; a < 3; ++a) {
@@ -264,9 +228,39 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmas
     // max with 0: a tmin of -0 would be the smallest integer, not 0.
     const __m256i lo = _mm256_max_epi32(_mm256_castps_si256(_mm256_set1_ps(tmin)), _mm256_setzero_si256());
     entry = _mm256_max_epi32(_mm256_max_epi32(tn[1], tn[2]), _mm256_max_epi32(tn[0], lo));
-    const __m256i neg_exit =
-        _mm256_min_epu32(_mm256_min_epu32(ntf[1], ntf[2]),
-                         _mm256_min_epu32(ntf[0], _mm256_castps_si256(_mm256_set1_ps(-tmax_far))));
+    neg_exit = _mm256_min_epu32(_mm256_min_epu32(ntf[1], ntf[2]),
+                                _mm256_min_epu32(ntf[0], _mm256_castps_si256(_mm256_set1_ps(-tmax_far))));
+}
+
+/// The eight children of a BVH8 node in one AVX2 step (bvh8_distances_avx): mask of the
+/// hit children, entry distances to t_near[0..8). AVX2 has no unsigned compare, so the
+/// hit test flips the sign bits of both sides: neg_exit - 1 >=u entry + 0x7FFFFFFF is
+/// neg_exit + 0x7FFFFFFF >=s entry - 1.
+__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
+                                                                             const Bvh8RayAvx& r, float tmin,
+                                                                             float tmax_far, float* t_near) {
+    __m256i entry, neg_exit;
+    bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(t_near), entry);
+    const __m256i miss = _mm256_cmpgt_epi32(_mm256_add_epi32(entry, _mm256_set1_epi32(-1)),
+                                            _mm256_add_epi32(neg_exit, _mm256_set1_epi32(0x7FFFFFFF)));
+    return ~_mm256_movemask_ps(_mm256_castsi256_ps(miss)) & 0xFF;
+}
+
+/// What the AVX-512 node step found: the hit mask and the first hit child (lowest slot).
+struct Bvh8HitChildren {
+    unsigned mask;
+    uint32_t child0, count0;
+    float t0;
+};
+
+/// The box test of the AVX-512 node steps (bvh8_distances_avx, then one unsigned
+/// compare into a mask register): mask of the hit children, their entry distances (as
+/// bit patterns) in `entry`.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmask8 bvh8_hits_avx512(
+    const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry) {
+    __m256i neg_exit;
+    bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
     return _mm256_cmp_epu32_mask(_mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF)),
                                  _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1)), _MM_CMPINT_LE);
 }
