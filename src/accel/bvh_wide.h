@@ -512,13 +512,14 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         continue;
                     }
                     // Insert the others into the stack top sorted by distance (farthest
-                    // deepest); the nearest of all becomes `cur`.
+                    // deepest); the nearest of all becomes `cur`, without a branch as in
+                    // the AVX-512 step (AVX2 step, diffuse rays: -2 to +3% by mesh).
                     const int base = top;
                     do {
                         c = unsigned(__builtin_ctz(unsigned(mask)));
                         mask &= mask - 1;
                         Entry in{n.child[c], n.count[c], t[c]};
-                        if (in.t_entry < cur.t_entry) std::swap(in, cur);
+                        nearer_first(cur, in);
                         push_sorted(base, in);
                     } while (mask);
                     continue;
