@@ -726,7 +726,14 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
         CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
         CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
         CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
+        const auto capped =
+            run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays",
+                                             "shadow", "--embree-isa", "sse2", "--json"});
+        REQUIRE(capped.first == 0);
+        CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
+        CHECK(capped.second.find("\"disagreements\":0") != std::string::npos);
     }
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-isa", "avx512skx"}).first == 2);
     const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1",
                                                        "--rays", "shadow", "--no-embree"});
     CHECK(only.first == 0);

@@ -36,11 +36,15 @@ struct EmbreeReference::Impl {
 bool EmbreeReference::available() { return true; }
 
 EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                                 bool robust, int build_threads)
+                                 bool robust, int build_threads, std::string_view max_isa)
     : impl_(std::make_unique<Impl>()) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    const std::string config = build_threads > 0 ? "threads=" + std::to_string(build_threads) : "";
+    std::string config = build_threads > 0 ? "threads=" + std::to_string(build_threads) : "";
+    if (!max_isa.empty() && max_isa != "best") {
+        if (!config.empty()) config += ",";
+        config += "max_isa=" + std::string(max_isa);
+    }
     impl_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!impl_->device) throw std::runtime_error("embree: rtcNewDevice failed");
     rtcSetDeviceMemoryMonitorFunction(
@@ -157,7 +161,8 @@ bool EmbreeReference::occluded(const Ray& ray) const {
 
 struct EmbreeReference::Impl {};
 bool EmbreeReference::available() { return false; }
-EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool, int) {
+EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool, int,
+                                 std::string_view) {
     throw std::runtime_error("this sahara was built without Embree");
 }
 EmbreeReference::~EmbreeReference() = default;

@@ -6,12 +6,17 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string_view>
 
 #include "accel/packet.h"
 #include "math/ray.h"
 #include "math/vec3.h"
 
 namespace sahara {
+
+/// The values EmbreeReference accepts for max_isa: Embree 3 falls back to SSE2 for any
+/// name it does not know, so only names its device configuration documents are passed.
+inline constexpr std::string_view kEmbreeIsas[] = {"best", "sse2", "avx", "avx2", "avx512"};
 
 class EmbreeReference {
    public:
@@ -21,8 +26,10 @@ class EmbreeReference {
     /// RTC_SCENE_FLAG_ROBUST (Embree's slower, watertight-leaning mode); the
     /// default mode is the fast one and can let rays slip through shared edges.
     /// `build_threads` > 0 limits Embree's build threads (0: Embree's default, all cores).
+    /// `max_isa` (one of kEmbreeIsas but "best"; empty or "best": Embree's choice, the widest
+    /// the CPU has) caps the instruction set of Embree's kernels, its `max_isa` device setting.
     EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false,
-                    int build_threads = 0);
+                    int build_threads = 0, std::string_view max_isa = {});
     ~EmbreeReference();
     EmbreeReference(const EmbreeReference&) = delete;
     EmbreeReference& operator=(const EmbreeReference&) = delete;

@@ -25,7 +25,7 @@ constexpr const char* kBenchUsage =
     "usage: sahara bench FILE [--threads N] [--rays primary|primary_packet|diffuse|shadow|all]\n"
     "                         [--json]\n"
     "                         [--builder binned|sweep|reinsert] [--layout L] [--size N] [--repeat K]\n"
-    "                         [--no-embree] [--embree-robust]\n"
+    "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
     "              its triangles, spheres, boxes and quadrics (planes are unbounded: not in the\n"
@@ -51,6 +51,10 @@ constexpr const char* kBenchUsage =
     "              accuracy-reducing optimisations (meant to stop rays slipping through shared\n"
     "              edges), the nearest Embree comes to sahara's guarantees (default: Embree's\n"
     "              default mode, faster and not watertight)\n"
+    "  --embree-isa ISA\n"
+    "              cap Embree's kernels at sse2, avx, avx2 or avx512 (default best: the widest the\n"
+    "              CPU has); with SAHARA_SIMD=avx2 and --embree-isa avx2 an AVX-512 machine\n"
+    "              compares both tracers as an AVX2-only machine would\n"
     "  --json      print one JSON object\n"
     "Both tracers run with flush-to-zero and denormals-are-zero (Embree's recommendation) on the\n"
     "same rays. Disagreements: hit/miss differ, t differs beyond 1e-4 relative, or a different\n"
@@ -75,6 +79,7 @@ struct BenchOptions {
     int repeat = 3;
     bool embree = true;
     bool embree_robust = false;
+    std::string embree_isa = "best";
     bool json = false;
 };
 
@@ -175,8 +180,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     std::unique_ptr<EmbreeReference> embree;
     const std::string embree_status = embree_plan(opt, scene);
     if (embree_status == "compared")
-        embree =
-            std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust, opt.threads);
+        embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust,
+                                                   opt.threads, opt.embree_isa);
     const BenchRaySets rays =
         make_bench_rays(scene, accel, opt.size, opt.size,
                         input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
@@ -188,6 +193,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"planes_outside_tree", scene.planes.size()},
         {"embree", embree_status},
         {"embree_mode", opt.embree_robust ? "robust" : "default"},
+        {"embree_isa", opt.embree_isa},
         {"threads", opt.threads},
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
@@ -233,9 +239,11 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
     if (j.contains("embree_build_ms"))
-        std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s mode",
+        std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s mode, %s%s",
                     j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
-                    j["threads"].get<int>(), j["embree_mode"].get<std::string>().c_str());
+                    j["threads"].get<int>(), j["embree_mode"].get<std::string>().c_str(),
+                    j["embree_isa"] == "best" ? "" : "ISA up to ",
+                    j["embree_isa"].get<std::string>().c_str());
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)",
                 j["tree_bytes_per_primitive"].get<double>());
     if (j.contains("embree_bvh_bytes_per_primitive"))
@@ -338,6 +346,9 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
         return "--rays must be primary, primary_packet, diffuse, shadow or all";
     opt.embree = !args.switches.count("--no-embree");
     opt.embree_robust = args.switches.count("--embree-robust") != 0;
+    opt.embree_isa = args.value_or("--embree-isa", "best");
+    if (std::find(std::begin(kEmbreeIsas), std::end(kEmbreeIsas), opt.embree_isa) == std::end(kEmbreeIsas))
+        return "--embree-isa must be best, sse2, avx, avx2 or avx512";
     opt.json = args.switches.count("--json") != 0;
     return "";
 }
@@ -346,9 +357,9 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
 
 int run_bench_command(int argc, char** argv) {
     ToolArgs args;
-    std::string err =
-        parse_tool_args(argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat"},
-                        {"--json", "--no-embree", "--embree-robust", "--small-scenes"}, args);
+    std::string err = parse_tool_args(
+        argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat", "--embree-isa"},
+        {"--json", "--no-embree", "--embree-robust", "--small-scenes"}, args);
     if (!err.empty()) return usage_error("bench", err, kBenchUsage);
     if (args.help) {
         std::fputs(kBenchUsage, stdout);
