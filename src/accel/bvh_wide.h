@@ -196,7 +196,7 @@ struct Bvh8RayAvx {
 
 /// The slab distances of an 8-wide node's children in one AVX step, reduced as
 /// integers: one cycle where a float max or min takes four (AVX-512 Xeon: diffuse and
-/// occlusion rays 2-4% faster on the AVX-512 step, 3-8% on the AVX2 step). That needs
+/// occlusion rays 2-4% faster on the AVX-512 step, 0-9% on the AVX2 step). That needs
 /// tmin >= 0:
 ///  - entry: the signed-integer max of the near distances and tmin. Non-negative
 ///    floats order like their bit patterns, and every negative float, the NaN of
