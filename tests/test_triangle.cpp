@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "accel/accelerator.h"
@@ -38,6 +39,27 @@ TEST_CASE("triangle hit gives t and barycentrics of vertices 1 and 2") {
     CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 0.0f, 0.5f}, a, b, c, h));
     CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 0.0f, 1.0f}, a, b, c, h));
     CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 1.0f, 2.0f}, a, b, c, h));
+}
+
+TEST_CASE("TriangleRay::scattered gives the constructor's axes and shear, ties and signed zeros included") {
+    // Components drawn from a small set, so that ties between |x|, |y|, |z|, negative
+    // zeros and every dominant axis and sign occur many times.
+    const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 3.0f, -3.0f, 1e-30f, -2.5e7f};
+    int checked = 0, mismatched = 0;
+    for (float x : values)
+        for (float y : values)
+            for (float z : values) {
+                if (x == 0.0f && y == 0.0f && z == 0.0f) continue;  // no direction
+                const Ray r{{0.25f, -1.5f, 2.0f}, {x, y, z}};
+                const TriangleRay a(r), b = TriangleRay::scattered(r);
+                ++checked;
+                if (a.kx != b.kx || a.ky != b.ky || a.kz != b.kz || std::memcmp(&a.sx, &b.sx, 4) ||
+                    std::memcmp(&a.sy, &b.sy, 4) || std::memcmp(&a.sz, &b.sz, 4) ||
+                    std::memcmp(a.org, b.org, sizeof a.org))
+                    ++mismatched;
+            }
+    CHECK(checked == 992);  // 1000 less the eight all-zero combinations of +0 and -0
+    CHECK(mismatched == 0);
 }
 
 TEST_CASE("degenerate triangles never hit") {

@@ -315,7 +315,8 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     bool tr_ready = false;
     auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
         if (!tr_ready) {
-            tr = TriangleRay(ray);
+            // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
+            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray);
             tr_ready = true;
         }
         return tr;
