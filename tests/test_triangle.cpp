@@ -51,7 +51,8 @@ TEST_CASE("TriangleRay::scattered gives the constructor's axes and shear, ties a
             for (float z : values) {
                 if (x == 0.0f && y == 0.0f && z == 0.0f) continue;  // no direction
                 const Ray r{{0.25f, -1.5f, 2.0f}, {x, y, z}};
-                const TriangleRay a(r), b = TriangleRay::scattered(r);
+                const float inv[3] = {1.0f / x, 1.0f / y, 1.0f / z};  // as BvhRay has them
+                const TriangleRay a(r), b = TriangleRay::scattered(r, inv);
                 ++checked;
                 if (a.kx != b.kx || a.ky != b.ky || a.kz != b.kz || std::memcmp(&a.sx, &b.sx, 4) ||
                     std::memcmp(&a.sy, &b.sy, 4) || std::memcmp(&a.sz, &b.sz, 4) ||

@@ -309,19 +309,20 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
                                                                         Hit& hit, Counters& counters) const {
-    // The triangle constants (three divisions) are made at the first leaf: many
-    // rays (most diffuse bounces leaving a convex part) never reach one.
+    // The triangle constants (axes and shear, from the box test's inverse direction)
+    // are made at the first leaf: many rays (most diffuse bounces leaving a convex
+    // part) never reach one.
+    BvhRay br(ray);
     TriangleRay tr;
     bool tr_ready = false;
     auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
         if (!tr_ready) {
             // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
-            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray);
+            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray, br.inv_dir);
             tr_ready = true;
         }
         return tr;
     };
-    BvhRay br(ray);
     Hit best;
     const bool found = traverse_wide<kAnyHit, kAvx, kAvx512>(
         tree, br,

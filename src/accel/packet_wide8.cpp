@@ -129,10 +129,10 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
     for (int h = 0; h < kPacketSize; h += 8) {
         for (int a = 0; a < 3; ++a)
             _mm256_store_ps(sr.inv[a] + h, _mm256_div_ps(one, _mm256_load_ps(dir[a] + h)));
-        const __m256 dz = _mm256_load_ps(dir[kz] + h);
-        _mm256_store_ps(sx + h, _mm256_div_ps(_mm256_load_ps(dir[kx] + h), dz));
-        _mm256_store_ps(sy + h, _mm256_div_ps(_mm256_load_ps(dir[ky] + h), dz));
-        _mm256_store_ps(sz + h, _mm256_div_ps(one, dz));
+        const __m256 inv_dz = _mm256_load_ps(sr.inv[kz] + h);  // TriangleRay::shear
+        _mm256_store_ps(sx + h, _mm256_mul_ps(_mm256_load_ps(dir[kx] + h), inv_dz));
+        _mm256_store_ps(sy + h, _mm256_mul_ps(_mm256_load_ps(dir[ky] + h), inv_dz));
+        _mm256_store_ps(sz + h, inv_dz);
         _mm256_store_ps(sr.tmax_scaled + h,
                         _mm256_mul_ps(_mm256_load_ps(p.tmax + h), _mm256_set1_ps(kRobustFarScale)));
     }
