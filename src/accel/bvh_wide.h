@@ -261,8 +261,14 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmas
     const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry) {
     __m256i neg_exit;
     bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
-    return _mm256_cmp_epu32_mask(_mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF)),
-                                 _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1)), _MM_CMPINT_LE);
+    const __m256i a = _mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF));
+    const __m256i b = _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1));
+    // _mm256_cmp_epu32_mask(a, b, _MM_CMPINT_LE), written out so that the mask lands in
+    // k1-k7 ("Yk"), which can predicate the compressions: GCC picks k0 and then needs a
+    // kmov on the node step's dependency chain.
+    __mmask8 k;
+    asm("vpcmpud $2, %[b], %[a], %[k]" : [k] "=Yk"(k) : [a] "v"(a), [b] "v"(b));
+    return k;
 }
 
 /// The AVX-512 node step of a closest-hit ray: the hit children's references, counts
