@@ -52,14 +52,18 @@ TEST_CASE("TriangleRay::scattered gives the constructor's axes and shear, ties a
                 if (x == 0.0f && y == 0.0f && z == 0.0f) continue;  // no direction
                 const Ray r{{0.25f, -1.5f, 2.0f}, {x, y, z}};
                 const float inv[3] = {1.0f / x, 1.0f / y, 1.0f / z};  // as BvhRay has them
-                const TriangleRay a(r), b = TriangleRay::scattered(r, inv);
-                ++checked;
-                if (a.kx != b.kx || a.ky != b.ky || a.kz != b.kz || std::memcmp(&a.sx, &b.sx, 4) ||
-                    std::memcmp(&a.sy, &b.sy, 4) || std::memcmp(&a.sz, &b.sz, 4) ||
-                    std::memcmp(a.org, b.org, sizeof a.org))
-                    ++mismatched;
+                const TriangleRay a(r);
+                // With the box test's inverse direction, and dividing itself.
+                for (const TriangleRay& b :
+                     {TriangleRay::scattered(r, inv), TriangleRay::scattered(r, nullptr)}) {
+                    ++checked;
+                    if (a.kx != b.kx || a.ky != b.ky || a.kz != b.kz || std::memcmp(&a.sx, &b.sx, 4) ||
+                        std::memcmp(&a.sy, &b.sy, 4) || std::memcmp(&a.sz, &b.sz, 4) ||
+                        std::memcmp(a.org, b.org, sizeof a.org))
+                        ++mismatched;
+                }
             }
-    CHECK(checked == 992);  // 1000 less the eight all-zero combinations of +0 and -0
+    CHECK(checked == 2 * 992);  // 1000 less the eight all-zero combinations of +0 and -0, twice
     CHECK(mismatched == 0);
 }
 

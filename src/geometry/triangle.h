@@ -59,7 +59,7 @@ struct TriangleRay {
     /// whose dominant axis is a coin toss for the branch predictor. AVX-512 Xeon, against
     /// the constructor: diffuse rays 2-3% faster (0.9 mispredictions fewer per ray on the
     /// bunny), shadow rays 1-3% slower (the axes come later: no speculation).
-    /// `inv_dir` is 1 / ray.dir per axis (BvhRay::inv_dir).
+    /// `inv_dir` is 1 / ray.dir per axis (BvhRay::inv_dir), or null: then it divides.
     __attribute__((always_inline)) static TriangleRay scattered(const Ray& ray, const float inv_dir[3]) {
         TriangleRay tr;
         tr.org[0] = load_scalar(ray.origin.x);
@@ -76,7 +76,7 @@ struct TriangleRay {
         const int next = 0x09 >> (2 * tr.kz) & 3, after = 0x12 >> (2 * tr.kz) & 3;
         tr.kx = next ^ ((next ^ after) & swap);
         tr.ky = after ^ ((next ^ after) & swap);
-        tr.shear(d[tr.kx], d[tr.ky], inv_dir[tr.kz]);
+        tr.shear(d[tr.kx], d[tr.ky], inv_dir ? inv_dir[tr.kz] : 1.0f / d[tr.kz]);
         return tr;
     }
 };
