@@ -302,8 +302,9 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
 /// address then waits for neither the stack nor a bit count: against visiting the last
 /// hit child first (read back from the stack, Embree's order), shadow rays on the AVX-512
 /// Xeon gained 4-18% on the bunny, teapot, spot and ogre and lost 8-10% on suzanne and
-/// 17-19% on the Cornell box. Much of that is the visit order, not the latency: on the AVX2 step
-/// the order alone moves the same meshes by -12 to +13%, so the AVX2 step keeps Embree's.
+/// 17-19% on the Cornell box. Much of that is the visit order, not the latency: on the
+/// AVX2 step the order alone moves the same meshes by -12 to +13%, so the AVX2 step keeps
+/// Embree's.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                               void* entries) {
