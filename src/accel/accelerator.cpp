@@ -309,9 +309,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
                                                                         Hit& hit, Counters& counters) const {
-    // The triangle constants (axes and shear, from the box test's inverse direction)
-    // are made at the first leaf: many rays (most diffuse bounces leaving a convex
-    // part) never reach one.
+    // The triangle constants (axes and shear) are made at the first leaf: many rays
+    // (most diffuse bounces leaving a convex part) never reach one.
     BvhRay br(ray);
     TriangleRay tr;
     bool tr_ready = false;
