@@ -1,12 +1,15 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <limits>
 #include <map>
 #include <cmath>
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "accel/accelerator.h"
 #include "accel/bvh_stats.h"
@@ -143,29 +146,39 @@ int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
 }
 
 /// The wide layouts on every runnable SIMD path: valid trees, brute-force answers;
-/// `reinsert` adds the wide8 layout over the reinsertion builder's tree.
+/// `reinsert` adds the wide8 layout over the reinsertion builder's tree. The wide8 tree
+/// is also traced with node pairing for every closest-hit ray (the AVX-512 path).
 void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
     const Scene scene = scene_from_mesh(mesh);
     const double budget = 2.5e7 / double(std::max<size_t>(mesh.triangle_count(), 1));
     const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
     const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
     SimdPathGuard guard;
-    for (auto [layout, builder] :
-         {std::pair{BvhLayout::wide4, BvhBuilder::binned}, std::pair{BvhLayout::wide8, BvhBuilder::binned},
-          std::pair{BvhLayout::wide4_slots, BvhBuilder::binned},
-          std::pair{BvhLayout::wide8, BvhBuilder::reinsert}}) {
+    struct Config {
+        BvhLayout layout;
+        BvhBuilder builder;
+        NodePairing pairing;
+    };
+    for (auto [layout, builder, pairing] :
+         {Config{BvhLayout::wide4, BvhBuilder::binned, NodePairing::automatic},
+          Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::never},
+          Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::always},
+          Config{BvhLayout::wide4_slots, BvhBuilder::binned, NodePairing::automatic},
+          Config{BvhLayout::wide8, BvhBuilder::reinsert, NodePairing::always}}) {
         if (builder == BvhBuilder::reinsert && !reinsert) continue;
         AcceleratorOptions opt;
         opt.layout = layout;
         opt.builder = builder;
+        opt.node_pairing = pairing;
         const Accelerator acc(scene, opt);
         REQUIRE(acc.layout() == layout);
+        if (pairing != NodePairing::automatic) CHECK(acc.pairs_nodes() == (pairing == NodePairing::always));
         check_bvh4_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
             INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " builder ",
-                 std::string(bvh_builder_name(builder)), " path ", std::string(simd_path_name(path)),
-                 " rays ", rays.size());
+                 std::string(bvh_builder_name(builder)), " pairing ", int(pairing), " path ",
+                 std::string(simd_path_name(path)), " rays ", rays.size());
             CHECK(active_simd_path() == path);
             CHECK(disagreements(acc, rays) == 0);
         }
@@ -293,7 +306,9 @@ TEST_CASE(
     std::mt19937 rng(33);
     std::uniform_int_distribution<int> coord(-2, 2);
     std::uniform_real_distribution<float> u(-2.0f, 2.0f);
-    int bad = 0, multi = 0, on_far_plane = 0, tighter = 0;
+    int bad = 0, multi = 0, on_far_plane = 0, tighter = 0, paired_both = 0;
+    // The previous iteration's node: the paired step's `a`.
+    Bvh8Node prev{};
     for (int i = 0; i < 50000 / kSanitizerDivisor; ++i) {
         Bvh8Node n{};
         BvhNode single[8];
@@ -361,14 +376,44 @@ TEST_CASE(
         for (int i = 1; i < __builtin_popcount(h.mask); ++i)
             if (entries[i - 1].index != child[i] || entries[i - 1].count != count[i]) ++bad;
         int i_hit = 0;
+        std::vector<std::array<uint32_t, 3>> hits;  // child, count, entry bits (slot order)
         for (int c = 0; c < 8; ++c) {
             if (!(mask & (1 << c))) continue;
             if (child[i_hit] != n.child[c] || count[i_hit] != n.count[c] || t[i_hit] != entry[c]) ++bad;
             if (i_hit == 0 && (h.child0 != n.child[c] || h.count0 != n.count[c] || h.t0 != entry[c])) ++bad;
+            hits.push_back({n.child[c], n.count[c], std::bit_cast<uint32_t>(entry[c])});
             ++i_hit;
         }
+        // The paired step over the previous node (tested with this ray) and this one: the
+        // hit children of both, the previous node's first, all of them with their distances.
+        if (i > 0) {
+            std::vector<std::array<uint32_t, 3>> expected;
+            alignas(32) float tp[8];
+            const int mask_prev = rw.test(prev, r.tmin, tmax_far, tp);
+            for (int c = 0; c < 8; ++c)
+                if (mask_prev & (1 << c))
+                    expected.push_back({prev.child[c], prev.count[c], std::bit_cast<uint32_t>(tp[c])});
+            paired_both += !expected.empty() && !hits.empty();
+            expected.insert(expected.end(), hits.begin(), hits.end());
+            alignas(32) uint32_t pc[16], pn[16];
+            alignas(32) float pt[16];
+            const Bvh8HitPair hp = intersect_bvh8_pair_avx512(prev, n, rw.avx, r.tmin, tmax_far, pc, pn, pt);
+            if (hp.hits != int(expected.size())) {
+                ++bad;
+            } else if (hp.hits > 0) {
+                if (hp.child0 != expected[0][0] || hp.count0 != expected[0][1] ||
+                    std::bit_cast<uint32_t>(hp.t0) != expected[0][2])
+                    ++bad;
+                for (int k = 0; k < hp.hits; ++k)
+                    if (pc[k] != expected[size_t(k)][0] || pn[k] != expected[size_t(k)][1] ||
+                        std::bit_cast<uint32_t>(pt[k]) != expected[size_t(k)][2])
+                        ++bad;
+            }
+        }
+        prev = n;
     }
     CHECK(bad == 0);
+    if (avx512) CHECK(paired_both > 0);
     CHECK(multi > 0);
     CHECK(on_far_plane > 0);
     CHECK(tighter > 0);

@@ -1,6 +1,7 @@
 #include "accel/accelerator.h"
 
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -56,6 +57,12 @@ PrimitiveList collect_primitives(const Scene& scene) {
     for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
         list.set(k++, scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
+}
+
+/// Bytes of L2 cache per core (1 MiB when the system does not say).
+size_t l2_cache_bytes() {
+    const long bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
+    return bytes > 0 ? size_t(bytes) : size_t(1) << 20;
 }
 
 double process_cpu_ms() {
@@ -158,6 +165,12 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
     if (layout_has_blocks(layout_) && !options.keep_binary_tree) bvh_ = Bvh{};
+    if (layout_ == BvhLayout::wide8 && options.node_pairing != NodePairing::never) {
+        if (options.node_pairing == NodePairing::always)
+            pair_rays_ = PairRays::all;
+        else if (bytes() > l2_cache_bytes())
+            pair_rays_ = PairRays::inside;
+    }
     build_cpu_ms_ = process_cpu_ms() - cpu_start;
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -306,7 +319,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
 /// (both inline this body, so each gets its own instruction selection; an
 /// 8-wide node is tested in one AVX step there, as two SSE halves otherwise), and
 /// trace_wide_avx512 for AVX-512 (kAvx512: its node step compresses the hit children).
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
+          class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
                                                                         Hit& hit, Counters& counters) const {
     // The triangle constants (axes and shear) are made at the first leaf: many rays
@@ -325,7 +339,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
         return tr;
     };
     Hit best;
-    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512>(
+    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512, kPairNodes>(
         tree, br,
         [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
             float& tmax) __attribute__((always_inline)) {
@@ -351,19 +365,19 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
 bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false, false>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
 __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false, false>(tree, ray, hit, counters);
 }
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
     const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, true>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, true, kPairNodes>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, class Counters>
@@ -379,21 +393,27 @@ bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
         const SimdPath path = active_simd_path();
         const bool blocks = layout_ != BvhLayout::wide4_slots;
         if (layout_ == BvhLayout::wide8) {
-            if (path == SimdPath::avx512)
-                return trace_wide_avx512<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            if (path == SimdPath::avx512) {
+                // Closest-hit rays pair nodes until their first hit (traverse_wide) where
+                // AcceleratorOptions::node_pairing says so.
+                if (!kAnyHit && pair_rays_ != PairRays::none &&
+                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                    return trace_wide_avx512<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
+                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
+            }
             if (path == SimdPath::avx2)
                 return trace_wide_avx2<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
             return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
         }
         if (blocks) {
             if (path == SimdPath::avx512)
-                return trace_wide_avx512<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
             if (path == SimdPath::avx2)
                 return trace_wide_avx2<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
             return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
         }
         if (path == SimdPath::avx512)
-            return trace_wide_avx512<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+            return trace_wide_avx512<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
         if (path == SimdPath::avx2)
             return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
         return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);

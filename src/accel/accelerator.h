@@ -56,6 +56,14 @@ const char* bvh_layout_name(BvhLayout layout);
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 
+/// When closest-hit rays on the AVX-512 path test the inner node on top of the stack
+/// together with the one they visit (traverse_wide, intersect_bvh8_pair_avx512).
+enum class NodePairing : uint8_t {
+    automatic,  ///< wide8 trees larger than the L2 cache, for rays from inside the scene's bounds
+    always,     ///< every closest-hit ray on a wide8 tree (tests)
+    never,
+};
+
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
     /// wide8 by default: against wide4 it cut CPU time per ray by 10-25% on every
@@ -90,6 +98,13 @@ struct AcceleratorOptions {
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
+    /// Node pairing pays where node fetches miss the L2 cache: against none (`sahara bench
+    /// --threads 1 --size 512`, five alternating runs, 2026-11-27, AVX-512 Xeon with 2 MiB
+    /// of L2), diffuse rays on the bunny (3.7 MB of tree and blocks) and the ogre (6.8 MB)
+    /// 4-6% faster; on the five meshes of 0.3 MB or less, -1.5 to +2%. Camera rays from
+    /// outside the bounds usually hit in the first subtree they enter, so the pending node
+    /// would never be visited: with pairing, 4-7% slower on the bunny and spot.
+    NodePairing node_pairing = NodePairing::automatic;
     /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.
     bool keep_binary_tree = false;
@@ -139,6 +154,9 @@ class Accelerator {
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
+    /// Whether closest-hit rays pair nodes (NodePairing; only on the AVX-512 path, and with
+    /// NodePairing::automatic only for rays from inside bounds()).
+    bool pairs_nodes() const { return pair_rays_ != PairRays::none; }
     BvhLayout layout() const { return layout_; }
     /// The 4-wide tree (empty unless the layout is wide4 or wide4-slots; with the
     /// wide4 layout a leaf's child index is its first TriangleBlock4, not its first slot).
@@ -168,14 +186,15 @@ class Accelerator {
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_pairs(Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
+              class Counters>
     bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
     bool trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
     __attribute__((target("avx2"))) bool trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                          Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
     __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
         const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     /// Packets over the wide8 tree with the single-ray box and leaf tests (packet_wide8.cpp).
@@ -217,6 +236,9 @@ class Accelerator {
     std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>>
         blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
     BvhLayout layout_ = BvhLayout::wide4;
+    /// Which closest-hit rays pair nodes (NodePairing resolved for this tree).
+    enum class PairRays : uint8_t { none, inside, all };
+    PairRays pair_rays_ = PairRays::none;
     /// What a leaf slot holds: the primitive id and, for triangles, the vertices
     /// (together, so a leaf's data is one contiguous read).
     struct Slot {

@@ -294,6 +294,48 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
             _mm256_cvtss_f32(tc)};
 }
 
+/// The words v[0..8) of the lanes in k, moved to the front (zeros after them).
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i compress_words(
+    __mmask8 k, const uint32_t* v) {
+    return _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(v)));
+}
+
+/// What the paired AVX-512 node step found: the number of hit children of both nodes and
+/// the first of them.
+struct Bvh8HitPair {
+    int hits;
+    uint32_t child0, count0;
+    float t0;
+};
+
+/// The AVX-512 node step of a closest-hit ray over two nodes: `a`, the node visited now,
+/// and `b`, the inner node on top of the stack. The hit children of a, then those of b
+/// (slot order), are compressed to child/count/t[0..16); the first of them also comes back
+/// in registers. The two box tests depend on nothing of each other, so the out-of-order
+/// core overlaps them, where visiting b later would wait for a chain of its own.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitPair intersect_bvh8_pair_avx512(
+    const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAvx& r, float tmin, float tmax_far, uint32_t* child,
+    uint32_t* count, float* t) {
+    __m256i entry_a, entry_b;
+    const __mmask8 ka = bvh8_hits_avx512(a, r, tmin, tmax_far, entry_a);
+    const __mmask8 kb = bvh8_hits_avx512(b, r, tmin, tmax_far, entry_b);
+    const __m256i ca = compress_words(ka, a.child), na = compress_words(ka, a.count);
+    const __m256i cb = compress_words(kb, b.child), nb = compress_words(kb, b.count);
+    const __m256 ta = _mm256_maskz_compress_ps(ka, _mm256_castsi256_ps(entry_a));
+    const __m256 tb = _mm256_maskz_compress_ps(kb, _mm256_castsi256_ps(entry_b));
+    const int hits_a = __builtin_popcount(unsigned(ka));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(child), ca);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count), na);
+    _mm256_storeu_ps(t, ta);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(child + hits_a), cb);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count + hits_a), nb);
+    _mm256_storeu_ps(t + hits_a, tb);
+    const bool from_a = ka != 0;
+    return {hits_a + __builtin_popcount(unsigned(kb)),
+            uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)), uint32_t(_mm256_cvtsi256_si32(from_a ? na : nb)),
+            _mm256_cvtss_f32(from_a ? ta : tb)};
+}
+
 /// The AVX-512 node step of an any-hit ray: the first hit child (lowest slot) comes back
 /// in registers, the other hit children as 12-byte stack entries (reference, count, an
 /// unused third word: any hit needs no distance) in slot order, all eight entries written
@@ -383,8 +425,8 @@ enum class LeafResult : uint8_t {
 /// stack entry that would be visited next (next_count 0: none, or an inner node);
 /// when it tests that leaf in the same step it sets `paired`, and the entry is
 /// dropped from the stack.
-template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, int N, class Counters, class FastLeaf,
-          class SlowLeaf>
+template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false, int N, class Counters,
+          class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
                                                          Counters& counters) {
@@ -400,8 +442,12 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         float t_entry;
     };
     const char* const nodes = reinterpret_cast<const char*>(bvh.nodes.data());
-    // Each node pushes at most N - 1 entries per level, plus slack.
-    Entry stack[(N - 1) * kBvhMaxDepth + 4 + 8];  // + 8: the AVX-512 any-hit step writes 8 entries
+    // Each node pushes at most N - 1 entries per level, plus slack. A paired step (AVX-512,
+    // closest hit) pops one entry and pushes up to 2 N - 1, and pairs only while
+    // top <= kPairMaxTop; above that the steps push N - 1 per level of one path down the
+    // tree, so the stack stays below kPairMaxTop + 2 N + (N - 1) * kBvhMaxDepth.
+    constexpr int kPairMaxTop = (N - 1) * kBvhMaxDepth;
+    Entry stack[2 * (N - 1) * kBvhMaxDepth + 2 * N + 8];  // + 8: the AVX-512 any-hit step writes 8 entries
     int top = 0;
     bool found = false;
     Entry cur{0, 0, ray.tmin};
@@ -486,6 +532,29 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     if (!pop()) return found;
                     continue;
                 } else if constexpr (kAvx512 && N == 8) {  // closest hit
+                    // Until the first hit, an inner node on top of the stack is tested in the
+                    // same step (intersect_bvh8_pair_avx512): before a hit nothing culls it,
+                    // so it is visited anyway, unless a hit below `cur` comes first.
+                    if (kPairNodes && !found && top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0 &&
+                        stack[top - 1].t_entry <= tmax_far) {
+                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
+                        alignas(32) uint32_t child[2 * N], count[2 * N];
+                        alignas(32) float t[2 * N];
+                        const Bvh8HitPair h =
+                            intersect_bvh8_pair_avx512(n, b, rw.avx, ray.tmin, tmax_far, child, count, t);
+                        if (h.hits) {
+                            cur = Entry{h.child0, h.count0, h.t0};
+                            const int base = top;
+                            for (int i = 1; i < h.hits; ++i) {
+                                Entry in{child[i], count[i], t[i]};
+                                nearer_first(cur, in);
+                                push_sorted(base, in);
+                            }
+                            continue;
+                        }
+                        if (!pop()) return found;
+                        continue;
+                    }
                     alignas(32) uint32_t child[8], count[8];
                     alignas(32) float t[8];
                     const Bvh8HitChildren h =

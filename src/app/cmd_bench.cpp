@@ -198,6 +198,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
         {"simd", simd_path_name(active_simd_path())},
+        {"node_pairing", accel.pairs_nodes() && active_simd_path() == SimdPath::avx512},
         {"tree_bytes_per_primitive",
          double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
         {"build_ms", accel.build_ms()},
@@ -234,10 +235,11 @@ void print_text(const nlohmann::ordered_json& j) {
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
     std::printf("threads     %d\n", j["threads"].get<int>());
-    std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s)",
+    std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s%s)",
                 j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),
                 j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
-                j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str());
+                j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str(),
+                j["node_pairing"].get<bool>() ? ", node pairing" : "");
     if (j.contains("embree_build_ms"))
         std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s mode, %s%s",
                     j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
