@@ -368,10 +368,10 @@ bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counter
     return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false, false>(tree, ray, hit, counters);
 }
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
 __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false, false>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false, kPairNodes>(tree, ray, hit, counters);
 }
 
 template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
@@ -401,21 +401,25 @@ bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
                     return trace_wide_avx512<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
                 return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
             }
-            if (path == SimdPath::avx2)
-                return trace_wide_avx2<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+            if (path == SimdPath::avx2) {
+                if (!kAnyHit && pair_rays_ != PairRays::none &&
+                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                    return trace_wide_avx2<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
+                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
+            }
             return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
         }
         if (blocks) {
             if (path == SimdPath::avx512)
                 return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
             if (path == SimdPath::avx2)
-                return trace_wide_avx2<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
             return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
         }
         if (path == SimdPath::avx512)
             return trace_wide_avx512<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
         if (path == SimdPath::avx2)
-            return trace_wide_avx2<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+            return trace_wide_avx2<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
         return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
     }
     return trace_pairs<kAnyHit, kCutouts>(ray, hit, counters);

@@ -56,8 +56,8 @@ const char* bvh_layout_name(BvhLayout layout);
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 
-/// When closest-hit rays on the AVX-512 path test the inner node on top of the stack
-/// together with the one they visit (traverse_wide, intersect_bvh8_pair_avx512).
+/// When closest-hit rays on a wide8 tree (AVX-512 and AVX2 paths) test the inner node on
+/// top of the stack together with the one they visit (traverse_wide).
 enum class NodePairing : uint8_t {
     automatic,  ///< wide8 trees larger than the L2 cache, for rays from inside the scene's bounds
     always,     ///< every closest-hit ray on a wide8 tree (tests)
@@ -99,11 +99,12 @@ struct AcceleratorOptions {
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
     /// Node pairing pays where node fetches miss the L2 cache: against none (`sahara bench
-    /// --threads 1 --size 512`, five alternating runs, 2026-11-27, AVX-512 Xeon with 2 MiB
+    /// --threads 1 --size 512`, 3-5 alternating runs, 2026-11-27, AVX-512 Xeon with 2 MiB
     /// of L2), diffuse rays on the bunny (3.7 MB of tree and blocks) and the ogre (6.8 MB)
-    /// 4-6% faster; on the five meshes of 0.3 MB or less, -1.5 to +2%. Camera rays from
-    /// outside the bounds usually hit in the first subtree they enter, so the pending node
-    /// would never be visited: with pairing, 4-7% slower on the bunny and spot.
+    /// 3-6% faster on the AVX-512 path and 6-8% on the AVX2 path; on the five meshes of
+    /// 0.3 MB or less, -1.5 to +2%. Camera rays from outside the bounds usually hit in the
+    /// first subtree they enter, so the pending node would never be visited: with pairing,
+    /// 4-7% slower on the bunny and spot.
     NodePairing node_pairing = NodePairing::automatic;
     /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.
@@ -154,8 +155,8 @@ class Accelerator {
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
-    /// Whether closest-hit rays pair nodes (NodePairing; only on the AVX-512 path, and with
-    /// NodePairing::automatic only for rays from inside bounds()).
+    /// Whether closest-hit rays pair nodes (NodePairing; on the AVX-512 and AVX2 paths, and
+    /// with NodePairing::automatic only for rays from inside bounds()).
     bool pairs_nodes() const { return pair_rays_ != PairRays::none; }
     BvhLayout layout() const { return layout_; }
     /// The 4-wide tree (empty unless the layout is wide4 or wide4-slots; with the
@@ -191,7 +192,7 @@ class Accelerator {
     bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
     bool trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
+    template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
     __attribute__((target("avx2"))) bool trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
                                                          Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>

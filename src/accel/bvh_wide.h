@@ -295,8 +295,8 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
 }
 
 /// The words v[0..8) of the lanes in k, moved to the front (zeros after them).
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i compress_words(
-    __mmask8 k, const uint32_t* v) {
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i
+compress_words(__mmask8 k, const uint32_t* v) {
     return _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(v)));
 }
 
@@ -313,9 +313,9 @@ struct Bvh8HitPair {
 /// (slot order), are compressed to child/count/t[0..16); the first of them also comes back
 /// in registers. The two box tests depend on nothing of each other, so the out-of-order
 /// core overlaps them, where visiting b later would wait for a chain of its own.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitPair intersect_bvh8_pair_avx512(
-    const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAvx& r, float tmin, float tmax_far, uint32_t* child,
-    uint32_t* count, float* t) {
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitPair
+intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAvx& r, float tmin,
+                           float tmax_far, uint32_t* child, uint32_t* count, float* t) {
     __m256i entry_a, entry_b;
     const __mmask8 ka = bvh8_hits_avx512(a, r, tmin, tmax_far, entry_a);
     const __mmask8 kb = bvh8_hits_avx512(b, r, tmin, tmax_far, entry_b);
@@ -331,9 +331,8 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8Hi
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(count + hits_a), nb);
     _mm256_storeu_ps(t + hits_a, tb);
     const bool from_a = ka != 0;
-    return {hits_a + __builtin_popcount(unsigned(kb)),
-            uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)), uint32_t(_mm256_cvtsi256_si32(from_a ? na : nb)),
-            _mm256_cvtss_f32(from_a ? ta : tb)};
+    return {hits_a + __builtin_popcount(unsigned(kb)), uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)),
+            uint32_t(_mm256_cvtsi256_si32(from_a ? na : nb)), _mm256_cvtss_f32(from_a ? ta : tb)};
 }
 
 /// The AVX-512 node step of an any-hit ray: the first hit child (lowest slot) comes back
@@ -412,6 +411,9 @@ enum class LeafResult : uint8_t {
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
 /// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2);
 /// kAvx512: 8-wide nodes take the AVX-512 step (intersect_bvh8_compress_avx512).
+/// kPairNodes (closest hit, 8-wide, AVX2 or AVX-512): until the first hit, the inner
+/// node on top of the stack is tested in the same step as `cur`, and the hit children
+/// of both are sorted into the stack together (AcceleratorOptions::node_pairing).
 ///
 /// Leaves go first to `fast_leaf`, which must call no function: the inner loop
 /// then holds no call, and GCC keeps what of the ray's box constants fits in
@@ -425,8 +427,8 @@ enum class LeafResult : uint8_t {
 /// stack entry that would be visited next (next_count 0: none, or an inner node);
 /// when it tests that leaf in the same step it sets `paired`, and the entry is
 /// dropped from the stack.
-template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false, int N, class Counters,
-          class FastLeaf, class SlowLeaf>
+template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false, int N,
+          class Counters, class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
                                                          Counters& counters) {
@@ -573,6 +575,44 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     }
                     if (!pop()) return found;
                     continue;
+                }
+                if constexpr (kPairNodes && kAvx && !kAvx512 && N == 8 && !kAnyHit) {
+                    // The AVX2 form of the AVX-512 step's node pairing: both nodes' tests,
+                    // then their hit children sorted into the stack as one batch.
+                    if (!found && top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0 &&
+                        stack[top - 1].t_entry <= tmax_far) {
+                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
+                        alignas(32) float ta[N], tb[N];
+                        int ma = rw.test(n, ray.tmin, tmax_far, ta);
+                        int mb = rw.test(b, ray.tmin, tmax_far, tb);
+                        if (!(ma | mb)) {
+                            if (!pop()) return found;
+                            continue;
+                        }
+                        if (ma) {
+                            const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
+                            ma &= ma - 1;
+                            cur = Entry{n.child[c], n.count[c], ta[c]};
+                        } else {
+                            const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
+                            mb &= mb - 1;
+                            cur = Entry{b.child[c], b.count[c], tb[c]};
+                        }
+                        const int base = top;
+                        for (; ma; ma &= ma - 1) {
+                            const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
+                            Entry in{n.child[c], n.count[c], ta[c]};
+                            nearer_first(cur, in);
+                            push_sorted(base, in);
+                        }
+                        for (; mb; mb &= mb - 1) {
+                            const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
+                            Entry in{b.child[c], b.count[c], tb[c]};
+                            nearer_first(cur, in);
+                            push_sorted(base, in);
+                        }
+                        continue;
+                    }
                 }
                 alignas(32) float t[N];
                 int mask = rw.test(n, ray.tmin, tmax_far, t);

@@ -198,7 +198,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
         {"simd", simd_path_name(active_simd_path())},
-        {"node_pairing", accel.pairs_nodes() && active_simd_path() == SimdPath::avx512},
+        {"node_pairing", accel.pairs_nodes() && active_simd_path() != SimdPath::sse2},
         {"tree_bytes_per_primitive",
          double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
         {"build_ms", accel.build_ms()},
