@@ -395,14 +395,14 @@ bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
         if (layout_ == BvhLayout::wide8) {
             if (path == SimdPath::avx512) {
                 // Closest-hit rays pair nodes until their first hit (traverse_wide) where
-                // AcceleratorOptions::node_pairing says so.
+                // AcceleratorOptions::node_pairing says so; occlusion rays only on AVX2.
                 if (!kAnyHit && pair_rays_ != PairRays::none &&
                     (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
                     return trace_wide_avx512<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
                 return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
             }
             if (path == SimdPath::avx2) {
-                if (!kAnyHit && pair_rays_ != PairRays::none &&
+                if (pair_rays_ != PairRays::none &&
                     (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
                     return trace_wide_avx2<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
                 return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);

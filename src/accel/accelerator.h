@@ -56,8 +56,9 @@ const char* bvh_layout_name(BvhLayout layout);
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 
-/// When closest-hit rays on a wide8 tree (AVX-512 and AVX2 paths) test the inner node on
-/// top of the stack together with the one they visit (traverse_wide).
+/// When rays on a wide8 tree test the inner node on top of the stack together with the
+/// one they visit (traverse_wide): closest-hit rays on the AVX-512 and AVX2 paths,
+/// occlusion rays on the AVX2 path.
 enum class NodePairing : uint8_t {
     automatic,  ///< wide8 trees larger than the L2 cache, for rays from inside the scene's bounds
     always,     ///< every closest-hit ray on a wide8 tree (tests)
@@ -101,10 +102,10 @@ struct AcceleratorOptions {
     /// Node pairing pays where node fetches miss the L2 cache: against none (`sahara bench
     /// --threads 1 --size 512`, 3-5 alternating runs, 2026-11-27, AVX-512 Xeon with 2 MiB
     /// of L2), diffuse rays on the bunny (3.7 MB of tree and blocks) and the ogre (6.8 MB)
-    /// 3-6% faster on the AVX-512 path and 6-8% on the AVX2 path; on the five meshes of
-    /// 0.3 MB or less, -1.5 to +2%. Camera rays from outside the bounds usually hit in the
-    /// first subtree they enter, so the pending node would never be visited: with pairing,
-    /// 4-7% slower on the bunny and spot.
+    /// 3-6% faster on the AVX-512 path and 6-8% on the AVX2 path (occlusion rays there
+    /// 2-3%); on the five meshes of 0.3 MB or less, -1.5 to +2%. Camera rays from outside
+    /// the bounds usually hit in the first subtree they enter, so the pending node would
+    /// never be visited: with pairing, 4-7% slower on the bunny and spot.
     NodePairing node_pairing = NodePairing::automatic;
     /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.
@@ -155,8 +156,8 @@ class Accelerator {
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
-    /// Whether closest-hit rays pair nodes (NodePairing; on the AVX-512 and AVX2 paths, and
-    /// with NodePairing::automatic only for rays from inside bounds()).
+    /// Whether rays pair nodes (NodePairing; with NodePairing::automatic only rays from
+    /// inside bounds()). The SSE2 path never does.
     bool pairs_nodes() const { return pair_rays_ != PairRays::none; }
     BvhLayout layout() const { return layout_; }
     /// The 4-wide tree (empty unless the layout is wide4 or wide4-slots; with the
