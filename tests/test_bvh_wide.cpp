@@ -210,6 +210,46 @@ TEST_CASE("BVH4 is valid and agrees with brute force on the shared OBJ meshes, o
     for (const auto& f : obj_files()) check_mesh(read_obj_triangles(f), seed++, false);
 }
 
+TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
+    // Triangles at geometrically growing distances along x, each also scaled up: the SAH
+    // splits off one or a few at a time, so the tree runs as deep as the builder lets it,
+    // and rays along the axis pass through every level with pending siblings on the stack.
+    TriangleMesh m;
+    m.name = "comb";
+    for (int i = 0; i < 3000; ++i) {
+        const float x = std::pow(1.01f, float(i)), s = 0.3f * x;
+        const auto base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), {Vec3(x, -s, -s), Vec3(x, s, -s), Vec3(x, 0.0f, s)});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    const Scene scene = scene_from_mesh(m);
+    AcceleratorOptions opt;
+    opt.node_pairing = NodePairing::always;
+    const Accelerator acc(scene, opt);
+    CHECK(acc.pairs_nodes());
+    int depth = 0;  // of the wide tree
+    for (std::vector<std::pair<uint32_t, int>> todo{{0u, 1}}; !todo.empty();) {
+        const auto [offset, d] = todo.back();
+        todo.pop_back();
+        depth = std::max(depth, d);
+        const Bvh8Node& n = acc.bvh8().node_at(offset);
+        for (int c = 0; c < 8; ++c)
+            if (n.has_child(c) && n.count[c] == 0) todo.push_back({n.child[c], d + 1});
+    }
+    CHECK(depth >= 8);
+    MESSAGE("wide tree depth " << depth);
+    std::vector<Ray> rays = make_random_rays(acc.bounds(), 4000 / kSanitizerDivisor, 71);
+    for (int i = 0; i < 2000 / kSanitizerDivisor; ++i)  // along the comb, from both ends
+        rays.push_back(Ray{Vec3(i % 2 ? -1.0f : 1e13f, 0.01f * float(i % 7), 0.01f * float(i % 5)),
+                           Vec3(i % 2 ? 1.0f : -1.0f, 1e-3f * float(i % 3), 0.0f)});
+    SimdPathGuard guard;
+    for (SimdPath path : runnable_paths()) {
+        force_simd_path(path);
+        INFO(std::string(simd_path_name(path)));
+        CHECK(disagreements(acc, rays) == 0);
+    }
+}
+
 TEST_CASE("BVH4 and pair layouts give the same hits") {
     const TriangleMesh m = make_icosphere(4);  // random rays hit it often, even the few under ASan
     const Scene scene = scene_from_mesh(m);

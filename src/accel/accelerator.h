@@ -61,7 +61,7 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 /// occlusion rays on the AVX2 path.
 enum class NodePairing : uint8_t {
     automatic,  ///< wide8 trees larger than the L2 cache, for rays from inside the scene's bounds
-    always,     ///< every closest-hit ray on a wide8 tree (tests)
+    always,     ///< every ray that can pair, from anywhere, whatever the tree's size (tests)
     never,
 };
 
