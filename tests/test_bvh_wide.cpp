@@ -228,13 +228,13 @@ TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
     const Accelerator acc(scene, opt);
     CHECK(acc.pairs_nodes());
     int depth = 0;  // of the wide tree
-    for (std::vector<std::pair<uint32_t, int>> todo{{0u, 1}}; !todo.empty();) {
-        const auto [offset, d] = todo.back();
-        todo.pop_back();
+    for (std::vector<std::pair<uint32_t, int>> pending{{0u, 1}}; !pending.empty();) {
+        const auto [offset, d] = pending.back();
+        pending.pop_back();
         depth = std::max(depth, d);
         const Bvh8Node& n = acc.bvh8().node_at(offset);
         for (int c = 0; c < 8; ++c)
-            if (n.has_child(c) && n.count[c] == 0) todo.push_back({n.child[c], d + 1});
+            if (n.has_child(c) && n.count[c] == 0) pending.push_back({n.child[c], d + 1});
     }
     CHECK(depth >= 8);
     MESSAGE("wide tree depth " << depth);

@@ -581,7 +581,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     // Occlusion rays on the AVX2 step pair nodes too (nothing culls a pushed
                     // entry): the hit children of both pushed in slot order, b's beneath, the
                     // last of a's visited next. (On the AVX-512 step, whose first-hit-first
-                    // order this cannot keep, shadow rays were 16-18% slower with it.)
+                    // order this cannot keep, shadow rays were 14-18% slower with it.)
                     if (top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0) {
                         const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
                         alignas(32) float ta[N], tb[N];
