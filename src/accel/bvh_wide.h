@@ -445,8 +445,8 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         float t_entry;
     };
     const char* const nodes = reinterpret_cast<const char*>(bvh.nodes.data());
-    // Each node pushes at most N - 1 entries per level, plus slack. A paired step (AVX-512,
-    // closest hit) pops one entry and pushes up to 2 N - 1, and pairs only while
+    // Each node pushes at most N - 1 entries per level, plus slack. A paired step (any
+    // kPairNodes form) pops one entry and pushes up to 2 N - 1, and pairs only while
     // top <= kPairMaxTop; above that the steps push N - 1 per level of one path down the
     // tree, so the stack stays below kPairMaxTop + 2 N + (N - 1) * kBvhMaxDepth.
     constexpr int kPairMaxTop = (N - 1) * kBvhMaxDepth;
