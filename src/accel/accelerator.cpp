@@ -284,102 +284,6 @@ bool Accelerator::intersect_other(const Ray& ray, uint32_t id, float tmax, float
     }
 }
 
-/// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in
-/// `hit`.
-template <bool kAnyHit, bool kCutouts>
-__attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr,
-                                                                   uint32_t first, uint32_t count,
-                                                                   float& tmax, Hit& hit) const {
-    bool found = false;
-    for (uint32_t s = first; s < first + count; ++s) {
-        const uint32_t id = slots_[s].id;
-        float t = 0.0f, u = 0.0f, v = 0.0f;
-        switch (prim_kind(id)) {
-            case PrimKind::triangle: {
-                TriangleHit th;
-                if (!intersect_triangle(tr, slots_[s].tri, ray.tmin, tmax, th)) continue;
-                if constexpr (kCutouts)
-                    if (!keep_triangle_hit(ray, id, th.u, th.v)) continue;
-                t = th.t, u = th.u, v = th.v;
-                break;
-            }
-            default:
-                if (!intersect_other(ray, id, tmax, t, u)) continue;
-                break;
-        }
-        if constexpr (kAnyHit) return true;
-        tmax = t;
-        hit = Hit{t, id, u, v};
-        found = true;
-    }
-    return found;
-}
-
-/// The wide-BVH traversal; trace_wide_avx2 is the same code compiled for AVX2
-/// (both inline this body, so each gets its own instruction selection; an
-/// 8-wide node is tested in one AVX step there, as two SSE halves otherwise), and
-/// trace_wide_avx512 for AVX-512 (kAvx512: its node step compresses the hit children).
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
-          class Counters>
-__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
-                                                                        Hit& hit, Counters& counters) const {
-    // The triangle constants (axes and shear) are made at the first leaf: many rays
-    // (most diffuse bounces leaving a convex part) never reach one.
-    BvhRay br(ray);
-    TriangleRay tr;
-    bool tr_ready = false;
-    auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
-        if (!tr_ready) {
-            // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
-            // Only the AVX-512 body takes 1 / d[kz] from the box test's inverse direction:
-            // in the AVX2 body that cost diffuse rays 2-4% against dividing (AVX-512 Xeon).
-            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray, kAvx512 ? br.inv_dir : nullptr);
-            tr_ready = true;
-        }
-        return tr;
-    };
-    Hit best;
-    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512, kPairNodes>(
-        tree, br,
-        [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
-            float& tmax) __attribute__((always_inline)) {
-            if constexpr (kBlocks)
-                return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count,
-                                                                 next_first, next_count, paired, tmax, best);
-            else
-                return LeafResult::slow;  // slots: every kind through the full test
-        },
-        [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
-            if constexpr (kBlocks)
-                return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
-            else
-                return test_slots<kAnyHit, kCutouts>(ray, triangle_ray(), first, count, tmax, best);
-        },
-        counters);
-    if (found && !kAnyHit) {
-        hit = best;
-        ray.tmax = best.t;
-    }
-    return found;
-}
-
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
-bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false, false>(tree, ray, hit, counters);
-}
-
-template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
-__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
-                                                                  Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false, kPairNodes>(tree, ray, hit, counters);
-}
-
-template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
-    const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, true, kPairNodes>(tree, ray, hit, counters);
-}
-
 template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
     return alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
@@ -389,7 +293,8 @@ bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
 template <bool kAnyHit, bool kCutouts, class Counters>
 bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
     if (layout_ != BvhLayout::pairs) {
-        // The wide layouts: one traversal body compiled three times (SSE2, AVX2, AVX-512).
+        // The wide layouts: one traversal body compiled three times (SSE2, AVX2, AVX-512),
+        // each in its own file (trace_wide.inl).
         const SimdPath path = active_simd_path();
         const bool blocks = layout_ != BvhLayout::wide4_slots;
         if (layout_ == BvhLayout::wide8) {

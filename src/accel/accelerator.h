@@ -188,6 +188,8 @@ class Accelerator {
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_pairs(Ray& ray, Hit& hit, Counters& counters) const;
+    /// The wide-tree traversal (trace_wide.inl) and its entry point per instruction set
+    /// (trace_wide_sse2.cpp, trace_wide_avx2.cpp, trace_wide_avx512.cpp).
     template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
               class Counters>
     bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;

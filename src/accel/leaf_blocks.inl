@@ -1,6 +1,7 @@
 #pragma once
-// The leaf-block tests of Accelerator (definitions of its always-inline member
-// templates), shared by the single-ray traversal (accelerator.cpp) and the
+// The leaf tests of Accelerator (definitions of its always-inline member templates:
+// triangle blocks and leaf slots), shared by the single-ray traversal
+// (trace_wide.inl), the brute-force and pair-layout paths (accelerator.cpp) and the
 // wide8 packet traversal (packet_wide8.cpp). Include only from those.
 #include <immintrin.h>
 
@@ -126,6 +127,37 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             found = true;
         }
         b += pair ? 2 : 1;
+    }
+    return found;
+}
+
+/// Tests the primitives in slots [first, first + count); the closest hit lowers `tmax` and is stored in
+/// `hit`.
+template <bool kAnyHit, bool kCutouts>
+__attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ray, const TriangleRay& tr,
+                                                                   uint32_t first, uint32_t count,
+                                                                   float& tmax, Hit& hit) const {
+    bool found = false;
+    for (uint32_t s = first; s < first + count; ++s) {
+        const uint32_t id = slots_[s].id;
+        float t = 0.0f, u = 0.0f, v = 0.0f;
+        switch (prim_kind(id)) {
+            case PrimKind::triangle: {
+                TriangleHit th;
+                if (!intersect_triangle(tr, slots_[s].tri, ray.tmin, tmax, th)) continue;
+                if constexpr (kCutouts)
+                    if (!keep_triangle_hit(ray, id, th.u, th.v)) continue;
+                t = th.t, u = th.u, v = th.v;
+                break;
+            }
+            default:
+                if (!intersect_other(ray, id, tmax, t, u)) continue;
+                break;
+        }
+        if constexpr (kAnyHit) return true;
+        tmax = t;
+        hit = Hit{t, id, u, v};
+        found = true;
     }
     return found;
 }
