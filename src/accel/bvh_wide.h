@@ -486,9 +486,11 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     // Asks for the child boxes of the node at `p` (its first three cache lines; the fourth,
     // child links, is read only on a hit). The paired forms run on trees larger than the L2
     // cache (AcceleratorOptions::node_pairing), where a pushed node is often still in L3 or
-    // memory when it is popped, so they prefetch every child they push (a leaf's `child` is
-    // a block index, not a node offset: a wasted request, but no fault and no branch).
-    auto prefetch_planes = [](const char* p) __attribute__((always_inline)) {
+    // memory when it is popped, so they prefetch every child they push. A leaf's `child` is
+    // a block index, not a node offset: that request is wasted, but it costs no branch (the
+    // address is made in integers, as it may lie past the node array; a prefetch never faults).
+    auto prefetch_planes = [nodes](uint32_t child) __attribute__((always_inline)) {
+        const auto p = reinterpret_cast<const char*>(reinterpret_cast<uintptr_t>(nodes) + child);
         _mm_prefetch(p, _MM_HINT_T0);
         _mm_prefetch(p + 64, _MM_HINT_T0);
         _mm_prefetch(p + 128, _MM_HINT_T0);
@@ -559,7 +561,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                             cur = Entry{h.child0, h.count0, h.t0};
                             const int base = top;
                             for (int i = 1; i < h.hits; ++i) {
-                                prefetch_planes(nodes + child[i]);
+                                prefetch_planes(child[i]);
                                 Entry in{child[i], count[i], t[i]};
                                 nearer_first(cur, in);
                                 push_sorted(base, in);
@@ -580,7 +582,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         const int base = top;
                         for (int i = 1; i < hits; ++i) {
                             if constexpr (kPairNodes) {
-                                prefetch_planes(nodes + child[i]);
+                                prefetch_planes(child[i]);
                             }
                             Entry in{child[i], count[i], t[i]};
                             nearer_first(cur, in);
@@ -642,14 +644,14 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         const int base = top;
                         for (; ma; ma &= ma - 1) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
-                            prefetch_planes(nodes + n.child[c]);
+                            prefetch_planes(n.child[c]);
                             Entry in{n.child[c], n.count[c], ta[c]};
                             nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         for (; mb; mb &= mb - 1) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
-                            prefetch_planes(nodes + b.child[c]);
+                            prefetch_planes(b.child[c]);
                             Entry in{b.child[c], b.count[c], tb[c]};
                             nearer_first(cur, in);
                             push_sorted(base, in);
