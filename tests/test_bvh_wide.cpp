@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -100,8 +101,10 @@ void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
                 }
                 ++children;
                 CHECK(inside(child_box(n, c), box));
+                // A reference tells a leaf and its count by itself (wide_leaf_ref).
+                CHECK(ref_count(n.child[c]) == n.count[c]);
                 if (n.count[c]) {
-                    use_leaf(acc, n.child[c], n.count[c], slot_uses);
+                    use_leaf(acc, ref_first(n.child[c]), n.count[c], slot_uses);
                 } else {
                     // Inner children hold node byte offsets (BvhWide::node_at).
                     CHECK(n.child[c] % sizeof(BvhWideNode<N>) == 0);
@@ -401,53 +404,44 @@ TEST_CASE(
             if ((mask & (1 << c)) && t_avx[c] != entry[c]) ++bad;
         if (!avx512) continue;
         alignas(32) float t[8];
-        alignas(32) uint32_t child[8], count[8];
-        const Bvh8HitChildren h =
-            intersect_bvh8_compress_avx512(n, rw.avx, r.tmin, tmax_far, child, count, t);
+        alignas(32) uint32_t child[8];
+        const Bvh8HitChildren h = intersect_bvh8_compress_avx512(n, rw.avx, r.tmin, tmax_far, child, t);
         if (int(h.mask) != mask) ++bad;
-        // The any-hit form: the first hit in registers, the others as 12-byte stack entries
-        // (reference, count, unused).
-        struct StackEntry {
-            uint32_t index, count;
-            float unused;
-        } entries[8];
+        // The any-hit form: the first hit in registers, the others as stack entries (the
+        // reference in the low word; the high word is garbage).
+        uint64_t entries[8];
         const Bvh8HitChildren ha = intersect_bvh8_entries_avx512(n, rw.avx, r.tmin, tmax_far, entries);
-        if (ha.mask != h.mask || ha.child0 != h.child0 || ha.count0 != h.count0) ++bad;
+        if (ha.mask != h.mask || ha.ref0 != h.ref0) ++bad;
         for (int i = 1; i < __builtin_popcount(h.mask); ++i)
-            if (entries[i - 1].index != child[i] || entries[i - 1].count != count[i]) ++bad;
+            if (uint32_t(entries[i - 1]) != child[i]) ++bad;
         int i_hit = 0;
-        std::vector<std::array<uint32_t, 3>> hits;  // child, count, entry bits (slot order)
+        std::vector<std::array<uint32_t, 2>> hits;  // child, entry bits (slot order)
         for (int c = 0; c < 8; ++c) {
             if (!(mask & (1 << c))) continue;
-            if (child[i_hit] != n.child[c] || count[i_hit] != n.count[c] || t[i_hit] != entry[c]) ++bad;
-            if (i_hit == 0 && (h.child0 != n.child[c] || h.count0 != n.count[c] || h.t0 != entry[c])) ++bad;
-            hits.push_back({n.child[c], n.count[c], std::bit_cast<uint32_t>(entry[c])});
+            if (child[i_hit] != n.child[c] || t[i_hit] != entry[c]) ++bad;
+            if (i_hit == 0 && (h.ref0 != n.child[c] || h.t0 != entry[c])) ++bad;
+            hits.push_back({n.child[c], std::bit_cast<uint32_t>(entry[c])});
             ++i_hit;
         }
         // The paired step over the previous node (tested with this ray) and this one: the
-        // hit children of both, the previous node's first, all of them with their distances.
+        // hit children of both, the previous node's first, all of them with their distances
+        // as stack entries (reference low, distance high).
         if (i > 0) {
-            std::vector<std::array<uint32_t, 3>> expected;
+            std::vector<std::array<uint32_t, 2>> expected;
             alignas(32) float tp[8];
             const int mask_prev = rw.test(prev, r.tmin, tmax_far, tp);
             for (int c = 0; c < 8; ++c)
-                if (mask_prev & (1 << c))
-                    expected.push_back({prev.child[c], prev.count[c], std::bit_cast<uint32_t>(tp[c])});
+                if (mask_prev & (1 << c)) expected.push_back({prev.child[c], std::bit_cast<uint32_t>(tp[c])});
             paired_both += !expected.empty() && !hits.empty();
             expected.insert(expected.end(), hits.begin(), hits.end());
-            alignas(32) uint32_t pc[16], pn[16];
-            alignas(32) float pt[16];
-            const Bvh8HitPair hp = intersect_bvh8_pair_avx512(prev, n, rw.avx, r.tmin, tmax_far, pc, pn, pt);
-            if (hp.hits != int(expected.size())) {
+            alignas(32) uint64_t pe[16];
+            const Bvh8HitChildren hp = intersect_bvh8_pair_avx512(prev, n, rw.avx, r.tmin, tmax_far, pe);
+            if (hp.mask != expected.size()) {
                 ++bad;
-            } else if (hp.hits > 0) {
-                if (hp.child0 != expected[0][0] || hp.count0 != expected[0][1] ||
-                    std::bit_cast<uint32_t>(hp.t0) != expected[0][2])
-                    ++bad;
-                for (int k = 0; k < hp.hits; ++k)
-                    if (pc[k] != expected[size_t(k)][0] || pn[k] != expected[size_t(k)][1] ||
-                        std::bit_cast<uint32_t>(pt[k]) != expected[size_t(k)][2])
-                        ++bad;
+            } else if (hp.mask > 0) {
+                if (hp.ref0 != expected[0][0] || std::bit_cast<uint32_t>(hp.t0) != expected[0][1]) ++bad;
+                for (size_t k = 0; k < hp.mask; ++k)
+                    if (pe[k] != (uint64_t(expected[k][1]) << 32 | expected[k][0])) ++bad;
             }
         }
         prev = n;
@@ -566,8 +560,8 @@ TEST_CASE("wide tree statistics follow Embree's definitions") {
         n.lo_x[c] = 2.0f * float(c), n.hi_x[c] = 2.0f * float(c) + 1.0f;
         n.lo_y[c] = n.lo_z[c] = 0.0f;
         n.hi_y[c] = n.hi_z[c] = 1.0f;
-        n.child[c] = uint32_t(9 * c);
         n.count[c] = c == 0 ? 5 : 4;
+        n.child[c] = wide_leaf_ref(uint32_t(2 * c), n.count[c]);  // first blocks 0 and 2
     }
     tree.nodes.push_back(n);
     const WideBvhStats s = compute_wide_bvh_stats(tree, 4);
@@ -691,4 +685,55 @@ TEST_CASE("wide collapse: least SAH cost, as an exhaustive search finds it") {
             }
     }
     CHECK(merged);
+}
+
+TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused oversize leaves") {
+    // Primitives cost far more than nodes, so the builder keeps leaves as large as it may:
+    // a max_leaf_size of 1000 is clamped to the largest count a leaf reference holds.
+    const TriangleMesh m = make_icosphere(3);
+    const Scene scene = scene_from_mesh(m);
+    const std::vector<Ray> rays = make_random_rays(mesh_bounds(m), 4000 / kSanitizerDivisor, 91);
+    SimdPathGuard guard;
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::wide4, BvhLayout::wide4_slots}) {
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        opt.params.max_leaf_size = 1000;
+        opt.params.intersection_cost = 1e-4f;
+        opt.collapse.merge_leaves_up_to = kMaxWideLeafCount;
+        opt.flat_loop_max_prims = 0;
+        CHECK(opt.build_params().max_leaf_size == kMaxWideLeafCount);
+        const Accelerator acc(scene, opt);
+        check_bvh4_valid(acc);
+        uint32_t largest = 0;
+        auto largest_leaf = [&](const auto& tree) {
+            for (const auto& n : tree.nodes)
+                for (int c = 0; c < std::decay_t<decltype(n)>::kWidth; ++c)
+                    largest = std::max(largest, n.count[c]);
+        };
+        if (layout == BvhLayout::wide8)
+            largest_leaf(acc.bvh8());
+        else
+            largest_leaf(acc.bvh4());
+        INFO("layout ", std::string(bvh_layout_name(layout)), " largest leaf ", largest);
+        CHECK(largest > 32);  // the count's top bit is used
+        CHECK(largest <= kMaxWideLeafCount);
+        for (SimdPath path : runnable_paths()) {
+            force_simd_path(path);
+            INFO(std::string(simd_path_name(path)));
+            CHECK(disagreements(acc, rays) == 0);
+        }
+    }
+    // The collapse itself refuses leaves its references cannot hold.
+    AcceleratorOptions big;
+    big.layout = BvhLayout::pairs;  // keeps max_leaf_size unclamped
+    big.params.max_leaf_size = 1000;
+    big.params.intersection_cost = 1e-4f;
+    big.flat_loop_max_prims = 0;
+    const Accelerator pairs(scene, big);
+    const Bvh& bvh = pairs.bvh();
+    REQUIRE(!bvh.nodes.empty());
+    CHECK(std::any_of(bvh.nodes.begin(), bvh.nodes.end(),
+                      [](const BvhNode& n) { return n.is_leaf() && n.count > kMaxWideLeafCount; }));
+    CHECK_THROWS_AS(make_bvh_wide<8>(bvh), std::invalid_argument);
+    CHECK_THROWS_AS(make_bvh_wide<8>(bvh, WideCollapse{kMaxWideLeafCount + 1, 1.0}), std::invalid_argument);
 }

@@ -237,8 +237,8 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
         uint32_t block = first_block[size_t(i)];
         for (int c = 0; c < N; ++c)
             if (n.count[c]) {
-                fill_leaf(n.child[c], n.count[c], block);
-                n.child[c] = block;
+                fill_leaf(ref_first(n.child[c]), n.count[c], block);
+                n.child[c] = wide_leaf_ref(block, n.count[c]);
                 block += blocks_of(n.count[c]);
             }
     }

@@ -8,6 +8,7 @@
 /// Scenes with cut-out triangles (accel/alpha_filter.h) run a second
 /// instantiation of the traversal whose triangle hits pass the alpha test
 /// before they count; the others run the traversal without it.
+#include <algorithm>
 #include <string_view>
 #include <vector>
 
@@ -115,6 +116,8 @@ struct AcceleratorOptions {
     /// intersection cost and count leaves in blocks of four.
     BvhBuildParams build_params() const {
         BvhBuildParams p = params;
+        // A wide BVH's leaf reference holds its count in kLeafCountBits.
+        if (layout != BvhLayout::pairs) p.max_leaf_size = std::min(p.max_leaf_size, kMaxWideLeafCount);
         if (layout_has_blocks(layout)) {
             p.intersection_cost *= layout == BvhLayout::wide8 ? wide8_leaf_cost_scale : wide4_leaf_cost_scale;
             p.leaf_block_size = 4;  // a leaf block tests four triangles at once

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "base/error.h"
@@ -107,6 +108,10 @@ class CollapsePlan {
     void emit(uint32_t x, int k, Child out[N], int& n) const {
         const BvhNode& node = bvh_.nodes[x];
         if (node.is_leaf()) {
+            if (node.count > kMaxWideLeafCount)
+                throw std::invalid_argument("wide BVH leaves hold at most " +
+                                            std::to_string(kMaxWideLeafCount) +
+                                            " primitives (BvhBuildParams::max_leaf_size)");
             out[n++] = {x, node.index, node.count};
         } else if (plan_[x].open[k]) {
             const int j = plan_[x].left_slots[k];
@@ -133,7 +138,7 @@ void set_child(BvhWideNode<N>& p, int c, const BvhNode& box, uint32_t first, uin
     p.lo_z[c] = box.bounds[4];
     p.hi_z[c] = box.bounds[5];
     p.count[c] = count;
-    p.child[c] = count ? first : kNoNode;
+    p.child[c] = count ? wide_leaf_ref(first, count) : kNoNode;
 }
 
 template <int N>
@@ -158,6 +163,14 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     out.empty = false;
     out.root = bvh.nodes[0];
     if (out.root.is_leaf()) return out;
+    // Leaf references hold the first slot and the count in one word (wide_leaf_ref).
+    if (bvh.prim_indices.size() > size_t(kMaxWideLeafFirst) + 1)
+        throw InputError("scene too large: " + std::to_string(bvh.prim_indices.size()) +
+                         " primitives, more than the " + std::to_string(size_t(kMaxWideLeafFirst) + 1) +
+                         " that a wide BVH's leaf references reach");
+    if (opt.merge_leaves_up_to > kMaxWideLeafCount)
+        throw std::invalid_argument("wide BVH leaves hold at most " + std::to_string(kMaxWideLeafCount) +
+                                    " primitives (WideCollapse::merge_leaves_up_to)");
     out.nodes.reserve(bvh.nodes.size() / (N - 1) + 1);
     // Depth-first: (canonical inner node, wide node that must point at it, child slot).
     struct Pending {

@@ -12,6 +12,7 @@
 /// Traversal", 2013). Unused child slots hold an empty box (lo = +inf,
 /// hi = -inf), which no ray with a finite origin can hit.
 #include <atomic>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -26,9 +27,26 @@
 
 namespace sahara {
 
+/// A child reference (BvhWideNode::child, and the traversal's stack entries): an inner
+/// node's byte offset in BvhWide::nodes (a multiple of the node size, so its low
+/// kLeafCountBits are 0), or a leaf, first << kLeafCountBits | count with count in
+/// [1, kMaxWideLeafCount] (first: its first slot, or its first TriangleBlock4 in the block
+/// layouts). The traversal's stack entries are then 8 bytes, one reference and one
+/// distance, and one test of the low bits tells a leaf.
+constexpr uint32_t kLeafCountBits = 6;
+constexpr uint32_t kMaxWideLeafCount = (1u << kLeafCountBits) - 1;
+/// Slots (and blocks) a leaf reference can start at: [0, kMaxWideLeafFirst].
+constexpr uint32_t kMaxWideLeafFirst = 0xFFFFFFFFu >> kLeafCountBits;
+inline uint32_t wide_leaf_ref(uint32_t first, uint32_t count) { return first << kLeafCountBits | count; }
+/// A reference's leaf count; 0: an inner node.
+inline uint32_t ref_count(uint32_t ref) { return ref & kMaxWideLeafCount; }
+/// A leaf reference's first slot (or block).
+inline uint32_t ref_first(uint32_t ref) { return ref >> kLeafCountBits; }
+
 /// One N-wide node; child c is empty (child[c] == kNoNode, count 0), inner
-/// (count 0, child = the node's byte offset in BvhWide::nodes, see node_at) or a
-/// leaf (count > 0, child = first slot).
+/// (count 0, child = the node's byte offset) or a leaf (count > 0, child =
+/// wide_leaf_ref(first, count)). `count` repeats the leaf counts for the code that
+/// reads a node's children by slot (packets, statistics, the block fill).
 template <int N>
 struct alignas(64) BvhWideNode {
     float lo_x[N], hi_x[N], lo_y[N], hi_y[N], lo_z[N], hi_z[N];  ///< 24 N bytes of child bounds
@@ -42,6 +60,8 @@ using Bvh4Node = BvhWideNode<4>;
 using Bvh8Node = BvhWideNode<8>;
 static_assert(sizeof(Bvh4Node) == 128, "two cache lines per node");
 static_assert(sizeof(Bvh8Node) == 256, "four cache lines per node");
+static_assert(sizeof(Bvh4Node) % (kMaxWideLeafCount + 1) == 0,
+              "node offsets keep the low bits of a reference 0");
 
 /// An N-wide BVH. `root` keeps the root box; a leaf root has no nodes.
 template <int N>
@@ -247,10 +267,11 @@ __attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(con
     return ~_mm256_movemask_ps(_mm256_castsi256_ps(miss)) & 0xFF;
 }
 
-/// What the AVX-512 node step found: the hit mask and the first hit child (lowest slot).
+/// What an AVX-512 node step found: the hit mask (or, for a pair of nodes, the number of
+/// hit children) and the first hit child (lowest slot) with its entry distance.
 struct Bvh8HitChildren {
     unsigned mask;
-    uint32_t child0, count0;
+    uint32_t ref0;
     float t0;
 };
 
@@ -271,100 +292,93 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmas
     return k;
 }
 
-/// The AVX-512 node step of a closest-hit ray: the hit children's references, counts
-/// and entry distances compressed to the front of child/count/t (slot order). The first
-/// hit child also comes back in registers, so the next node's address waits for neither
-/// a bit scan nor a load (against the AVX2 step on an AVX-512 Xeon: diffuse rays 4-7%,
-/// occlusion rays 3-5% faster).
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
-intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
-                               uint32_t* child, uint32_t* count, float* t) {
-    __m256i entry;
-    const __mmask8 k = bvh8_hits_avx512(n, r, tmin, tmax_far, entry);
-    const __m256 t0 = _mm256_castsi256_ps(entry);
-    const __m256i ch =
-        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
-    const __m256i cn =
-        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.count)));
-    const __m256 tc = _mm256_maskz_compress_ps(k, t0);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(child), ch);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(count), cn);
-    _mm256_store_ps(t, tc);
-    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), uint32_t(_mm256_cvtsi256_si32(cn)),
-            _mm256_cvtss_f32(tc)};
-}
-
 /// The words v[0..8) of the lanes in k, moved to the front (zeros after them).
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i
 compress_words(__mmask8 k, const uint32_t* v) {
     return _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(v)));
 }
 
-/// What the paired AVX-512 node step found: the number of hit children of both nodes and
-/// the first of them.
-struct Bvh8HitPair {
-    int hits;
-    uint32_t child0, count0;
-    float t0;
-};
+/// Writes eight stack entries (see traverse_wide) to out[0..8): lane i of `ref` in the low
+/// word of entry i, lane i of `t` in its high word. kAligned: `out` is 32-byte aligned.
+template <bool kAligned>
+__attribute__((target("avx2"), always_inline)) inline void store_stack_entries(uint64_t* out, __m256i ref,
+                                                                               __m256i t) {
+    const __m256i lo = _mm256_unpacklo_epi32(ref, t);  // entries 0, 1 | 4, 5
+    const __m256i hi = _mm256_unpackhi_epi32(ref, t);  // entries 2, 3 | 6, 7
+    const __m256i e0 = _mm256_permute2x128_si256(lo, hi, 0x20), e1 = _mm256_permute2x128_si256(lo, hi, 0x31);
+    if constexpr (kAligned) {
+        _mm256_store_si256(reinterpret_cast<__m256i*>(out), e0);
+        _mm256_store_si256(reinterpret_cast<__m256i*>(out + 4), e1);
+    } else {
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), e0);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 4), e1);
+    }
+}
+
+/// The AVX-512 node step of a closest-hit ray: the hit children's references and entry
+/// distances compressed to the front of ref/t[0..8) (slot order, zeros after them). The
+/// first hit child also comes back in registers, so the next node's address waits for
+/// neither a bit scan nor a load (against the AVX2 step on an AVX-512 Xeon: diffuse rays
+/// 4-7%, occlusion rays 3-5% faster).
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
+                               uint32_t* ref, float* t) {
+    __m256i entry;
+    const __mmask8 k = bvh8_hits_avx512(n, r, tmin, tmax_far, entry);
+    const __m256i ch = compress_words(k, n.child);
+    const __m256 tc = _mm256_maskz_compress_ps(k, _mm256_castsi256_ps(entry));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ref), ch);
+    _mm256_store_ps(t, tc);
+    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), _mm256_cvtss_f32(tc)};
+}
 
 /// The AVX-512 node step of a closest-hit ray over two nodes: `a`, the node visited now,
-/// and `b`, the inner node on top of the stack. The hit children of a, then those of b
-/// (slot order), are compressed to child/count/t[0..16); the first of them also comes back
-/// in registers. The two box tests depend on nothing of each other, so the out-of-order
-/// core overlaps them, where visiting b later would wait for a chain of its own.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitPair
+/// and `b`, the inner node on top of the stack. The stack entries of the hit children of
+/// a, then those of b (slot order), are compressed to entries[0..16); `mask` of the result
+/// is their number, and the first of them also comes back in registers. The two box tests
+/// depend on nothing of each other, so the out-of-order core overlaps them, where visiting
+/// b later would wait for a chain of its own.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAvx& r, float tmin,
-                           float tmax_far, uint32_t* child, uint32_t* count, float* t) {
+                           float tmax_far, uint64_t* entries) {
     __m256i entry_a, entry_b;
     const __mmask8 ka = bvh8_hits_avx512(a, r, tmin, tmax_far, entry_a);
     const __mmask8 kb = bvh8_hits_avx512(b, r, tmin, tmax_far, entry_b);
-    const __m256i ca = compress_words(ka, a.child), na = compress_words(ka, a.count);
-    const __m256i cb = compress_words(kb, b.child), nb = compress_words(kb, b.count);
-    const __m256 ta = _mm256_maskz_compress_ps(ka, _mm256_castsi256_ps(entry_a));
-    const __m256 tb = _mm256_maskz_compress_ps(kb, _mm256_castsi256_ps(entry_b));
+    const __m256i ca = compress_words(ka, a.child), cb = compress_words(kb, b.child);
+    const __m256i ta = _mm256_maskz_compress_epi32(ka, entry_a);
+    const __m256i tb = _mm256_maskz_compress_epi32(kb, entry_b);
     const int hits_a = __builtin_popcount(unsigned(ka));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(child), ca);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count), na);
-    _mm256_storeu_ps(t, ta);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(child + hits_a), cb);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(count + hits_a), nb);
-    _mm256_storeu_ps(t + hits_a, tb);
+    store_stack_entries<true>(entries, ca, ta);
+    store_stack_entries<false>(entries + hits_a, cb, tb);
     const bool from_a = ka != 0;
-    return {hits_a + __builtin_popcount(unsigned(kb)), uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)),
-            uint32_t(_mm256_cvtsi256_si32(from_a ? na : nb)), _mm256_cvtss_f32(from_a ? ta : tb)};
+    return {unsigned(hits_a + __builtin_popcount(unsigned(kb))),
+            uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)),
+            std::bit_cast<float>(uint32_t(_mm256_cvtsi256_si32(from_a ? ta : tb)))};
 }
 
 /// The AVX-512 node step of an any-hit ray: the first hit child (lowest slot) comes back
-/// in registers, the other hit children as 12-byte stack entries (reference, count, an
-/// unused third word: any hit needs no distance) in slot order, all eight entries written
-/// to entries[0..8) (96 bytes; those past the hits are garbage), so that pushing them takes
-/// no loop over the hits (occlusion rays 0-5% faster than that loop). The next node's
-/// address then waits for neither the stack nor a bit count: against visiting the last
-/// hit child first (read back from the stack, Embree's order), shadow rays on the AVX-512
-/// Xeon gained 4-18% on the bunny, teapot, spot and ogre and lost 8-10% on suzanne and
-/// 17-19% on the Cornell box. Much of that is the visit order, not the latency: on the
-/// AVX2 step the order alone moves the same meshes by -12 to +13%, so the AVX2 step keeps
-/// Embree's.
+/// in registers, the other hit children as stack entries (reference; any hit needs no
+/// distance) in slot order, all eight entries written to entries[0..8) (those past the
+/// hits are garbage), so that pushing them takes no loop over the hits (occlusion rays
+/// 0-5% faster than that loop). The next node's address then waits for neither the stack
+/// nor a bit count: against visiting the last hit child first (read back from the stack,
+/// Embree's order), shadow rays on the AVX-512 Xeon gained 4-18% on the bunny, teapot, spot
+/// and ogre and lost 8-10% on suzanne and 17-19% on the Cornell box. Much of that is the
+/// visit order, not the latency: on the AVX2 step the order alone moves the same meshes by
+/// -12 to +13%, so the AVX2 step keeps Embree's.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
-                              void* entries) {
+                              uint64_t* entries) {
     __m256i entry;
     const __mmask8 k = bvh8_hits_avx512(n, r, tmin, tmax_far, entry);
-    const __m256i ch =
-        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
-    const __m256i cn =
-        _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.count)));
-    // Interleave from the second hit on: word 3 i is child i + 1, word 3 i + 1 its count
-    // (index 8 + j picks cn lane j); entry 7 would be a ninth hit and is never read.
-    char* out = static_cast<char*>(entries);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
-                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(1, 9, 1, 2, 10, 2, 3, 11), cn));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 32),
-                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(3, 4, 12, 4, 5, 13, 5, 6), cn));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 64),
-                        _mm256_permutex2var_epi32(ch, _mm256_setr_epi32(14, 6, 7, 15, 7, 0, 0, 0), cn));
-    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), uint32_t(_mm256_cvtsi256_si32(cn)), 0.0f};
+    const __m256i ch = compress_words(k, n.child);
+    // From the second hit on, each reference in the low word of an entry (the high word,
+    // the distance, is garbage: an any-hit ray reads none).
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(entries),
+                        _mm256_permutexvar_epi32(_mm256_setr_epi32(1, 1, 2, 2, 3, 3, 4, 4), ch));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(entries + 4),
+                        _mm256_permutexvar_epi32(_mm256_setr_epi32(5, 5, 6, 6, 7, 7, 7, 7), ch));
+    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), 0.0f};
 }
 
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
@@ -439,11 +453,13 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         counters.on_prims(bvh.root.count);
         return slow_leaf(bvh.root.index, bvh.root.count, ray.tmax);
     }
+    // A stack entry: a child reference and its entry distance, 8 bytes (the AVX-512 steps
+    // write them as words: reference low, distance high).
     struct Entry {
-        uint32_t index;  ///< node offset (see BvhWide::node_at), or first leaf item
-        uint32_t count;  ///< 0: inner node
-        float t_entry;
+        uint32_t ref;
+        float t;
     };
+    static_assert(sizeof(Entry) == 8);
     const char* const nodes = reinterpret_cast<const char*>(bvh.nodes.data());
     // Each node pushes at most N - 1 entries per level, plus slack. A paired step (any
     // kPairNodes form) pops one entry and pushes up to 2 N - 1, and pairs only while
@@ -453,13 +469,13 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     Entry stack[2 * (N - 1) * kBvhMaxDepth + 2 * N + 8];  // + 8: the AVX-512 any-hit step writes 8 entries
     int top = 0;
     bool found = false;
-    Entry cur{0, 0, ray.tmin};
+    Entry cur{0, ray.tmin};
     // tmax scaled for the far planes; changes only when a leaf lowers tmax.
     float tmax_far = ray.tmax * kRobustFarScale;
     // Inserts `in` among the entries pushed since `base`, which are sorted farthest deepest.
-    auto push_sorted = [&](int base, const Entry& in) __attribute__((always_inline)) {
+    auto push_sorted = [&](int base, Entry in) __attribute__((always_inline)) {
         int k = top++;
-        while (k > base && stack[k - 1].t_entry < in.t_entry) {
+        while (k > base && stack[k - 1].t < in.t) {
             stack[k] = stack[k - 1];
             --k;
         }
@@ -471,24 +487,18 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     // like the floats (were one negative, only the order of visits would suffer, not the
     // answer); on a tie, a stays.
     auto nearer_first = [](Entry & a, Entry & b) __attribute__((always_inline)) {
-        static_assert(sizeof(Entry) == 12 && offsetof(Entry, t_entry) == 8);
-        uint64_t ka, kb;
-        uint32_t ta, tb;
-        std::memcpy(&ka, &a, 8), std::memcpy(&kb, &b, 8);
-        std::memcpy(&ta, &a.t_entry, 4), std::memcpy(&tb, &b.t_entry, 4);
-        const uint64_t swap = uint64_t(0) - uint64_t(tb < ta);
-        const uint64_t dk = (ka ^ kb) & swap;
-        const uint32_t dt = (ta ^ tb) & uint32_t(swap);
-        ka ^= dk, kb ^= dk, ta ^= dt, tb ^= dt;
-        std::memcpy(&a, &ka, 8), std::memcpy(&b, &kb, 8);
-        std::memcpy(&a.t_entry, &ta, 4), std::memcpy(&b.t_entry, &tb, 4);
+        const uint32_t ta = std::bit_cast<uint32_t>(a.t), tb = std::bit_cast<uint32_t>(b.t);
+        const uint32_t swap = uint32_t(0) - uint32_t(tb < ta);
+        const uint32_t dr = (a.ref ^ b.ref) & swap, dt = (ta ^ tb) & swap;
+        a.ref ^= dr, b.ref ^= dr;
+        a.t = std::bit_cast<float>(ta ^ dt), b.t = std::bit_cast<float>(tb ^ dt);
     };
     // Asks for the child boxes of the node at `p` (its first three cache lines; the fourth,
     // child links, is read only on a hit). The paired forms run on trees larger than the L2
     // cache (AcceleratorOptions::node_pairing), where a pushed node is often still in L3 or
-    // memory when it is popped, so they prefetch every child they push. A leaf's `child` is
-    // a block index, not a node offset: that request is wasted, but it costs no branch (the
-    // address is made in integers, as it may lie past the node array; a prefetch never faults).
+    // memory when it is popped, so they prefetch every child they push. A leaf's reference
+    // is not a node offset: that request is wasted, but it costs no branch (the address is
+    // made in integers, as it may lie past the node array; a prefetch never faults).
     auto prefetch_planes = [nodes](uint32_t child) __attribute__((always_inline)) {
         const auto p = reinterpret_cast<const char*>(reinterpret_cast<uintptr_t>(nodes) + child);
         _mm_prefetch(p, _MM_HINT_T0);
@@ -501,28 +511,25 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
             if (top == 0) return false;
             cur = stack[--top];
             // An occlusion ray's tmax never shrinks: every pushed entry is still in reach.
-            if (kAnyHit || cur.t_entry <= tmax_far) return true;
+            if (kAnyHit || cur.t <= tmax_far) return true;
         }
     };
     for (;;) {
         // Made here, not before the loop: their registers then never live across a call.
         const WideRay<N, kAvx && N == 8> rw(ray);
         for (;;) {  // the inner loop: no calls
-            if (cur.count) {
-                counters.on_prims(cur.count);
+            if (const uint32_t count = ref_count(cur.ref)) {
+                counters.on_prims(count);
                 // The entry visited next, when it is a leaf, may be tested in the same step.
-                uint32_t next_first = 0, next_count = 0;
-                if (top > 0 && (kAnyHit || stack[top - 1].t_entry <= tmax_far)) {
-                    next_first = stack[top - 1].index;
-                    next_count = stack[top - 1].count;
-                }
+                uint32_t next = 0;
+                if (top > 0 && (kAnyHit || stack[top - 1].t <= tmax_far)) next = stack[top - 1].ref;
                 bool paired = false;
                 const LeafResult r =
-                    fast_leaf(cur.index, cur.count, next_first, next_count, paired, ray.tmax);
+                    fast_leaf(ref_first(cur.ref), count, ref_first(next), ref_count(next), paired, ray.tmax);
                 if (r == LeafResult::slow) break;
                 if (paired) {
                     --top;
-                    counters.on_prims(next_count);
+                    counters.on_prims(ref_count(next));
                 }
                 if (r == LeafResult::hit) {
                     if constexpr (kAnyHit) return true;
@@ -530,17 +537,16 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     tmax_far = ray.tmax * kRobustFarScale;
                 }
             } else {
-                const auto& n = *reinterpret_cast<const BvhWideNode<N>*>(nodes + cur.index);  // node_at
+                const auto& n = *reinterpret_cast<const BvhWideNode<N>*>(nodes + cur.ref);  // node_at
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
                 if constexpr (kAvx512 && N == 8 && kAnyHit) {
-                    static_assert(sizeof(Entry) == 12);
-                    const Bvh8HitChildren h =
-                        intersect_bvh8_entries_avx512(n, rw.avx, ray.tmin, tmax_far, &stack[top]);
+                    const Bvh8HitChildren h = intersect_bvh8_entries_avx512(
+                        n, rw.avx, ray.tmin, tmax_far, reinterpret_cast<uint64_t*>(&stack[top]));
                     if (h.mask) {
                         // The first hit child is visited next, the others stay pushed (the
                         // last one on top); no branch on the number of hits.
-                        cur = Entry{h.child0, h.count0, 0.0f};
+                        cur = Entry{h.ref0, 0.0f};
                         top += __builtin_popcount(h.mask) - 1;
                         continue;
                     }
@@ -550,19 +556,18 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     // Until the first hit, an inner node on top of the stack is tested in the
                     // same step (intersect_bvh8_pair_avx512): before a hit nothing culls it,
                     // so it is visited anyway, unless a hit below `cur` comes first.
-                    if (kPairNodes && !found && top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0 &&
-                        stack[top - 1].t_entry <= tmax_far) {
-                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
-                        alignas(32) uint32_t child[2 * N], count[2 * N];
-                        alignas(32) float t[2 * N];
-                        const Bvh8HitPair h =
-                            intersect_bvh8_pair_avx512(n, b, rw.avx, ray.tmin, tmax_far, child, count, t);
-                        if (h.hits) {
-                            cur = Entry{h.child0, h.count0, h.t0};
+                    if (kPairNodes && !found && top > 0 && top <= kPairMaxTop &&
+                        ref_count(stack[top - 1].ref) == 0 && stack[top - 1].t <= tmax_far) {
+                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].ref);
+                        alignas(32) uint64_t hit[2 * N];
+                        const Bvh8HitChildren h =
+                            intersect_bvh8_pair_avx512(n, b, rw.avx, ray.tmin, tmax_far, hit);
+                        if (h.mask) {
+                            cur = Entry{h.ref0, h.t0};
                             const int base = top;
-                            for (int i = 1; i < h.hits; ++i) {
-                                prefetch_planes(child[i]);
-                                Entry in{child[i], count[i], t[i]};
+                            for (int i = 1; i < int(h.mask); ++i) {
+                                prefetch_planes(uint32_t(hit[i]));
+                                Entry in = std::bit_cast<Entry>(hit[i]);
                                 nearer_first(cur, in);
                                 push_sorted(base, in);
                             }
@@ -571,20 +576,20 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         if (!pop()) return found;
                         continue;
                     }
-                    alignas(32) uint32_t child[8], count[8];
-                    alignas(32) float t[8];
+                    alignas(32) uint32_t ref[N];
+                    alignas(32) float t[N];
                     const Bvh8HitChildren h =
-                        intersect_bvh8_compress_avx512(n, rw.avx, ray.tmin, tmax_far, child, count, t);
+                        intersect_bvh8_compress_avx512(n, rw.avx, ray.tmin, tmax_far, ref, t);
                     if (h.mask) {
-                        cur = Entry{h.child0, h.count0, h.t0};
+                        cur = Entry{h.ref0, h.t0};
                         if (!(h.mask & (h.mask - 1))) continue;  // one child hit
                         const int hits = __builtin_popcount(h.mask);
                         const int base = top;
                         for (int i = 1; i < hits; ++i) {
                             if constexpr (kPairNodes) {
-                                prefetch_planes(child[i]);
+                                prefetch_planes(ref[i]);
                             }
-                            Entry in{child[i], count[i], t[i]};
+                            Entry in{ref[i], t[i]};
                             nearer_first(cur, in);
                             push_sorted(base, in);
                         }
@@ -598,8 +603,8 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     // entry): the hit children of both pushed in slot order, b's beneath, the
                     // last of a's visited next. (On the AVX-512 step, whose first-hit-first
                     // order this cannot keep, shadow rays were 14-18% slower with it.)
-                    if (top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0) {
-                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
+                    if (top > 0 && top <= kPairMaxTop && ref_count(stack[top - 1].ref) == 0) {
+                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].ref);
                         alignas(32) float ta[N], tb[N];
                         int ma = rw.test(n, ray.tmin, tmax_far, ta);
                         int mb = rw.test(b, ray.tmin, tmax_far, tb);
@@ -607,14 +612,10 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                             if (!pop()) return found;
                             continue;
                         }
-                        for (; mb; mb &= mb - 1) {
-                            const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
-                            stack[top++] = Entry{b.child[c], b.count[c], 0.0f};
-                        }
-                        for (; ma; ma &= ma - 1) {
-                            const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
-                            stack[top++] = Entry{n.child[c], n.count[c], 0.0f};
-                        }
+                        for (; mb; mb &= mb - 1)
+                            stack[top++] = Entry{b.child[__builtin_ctz(unsigned(mb))], 0.0f};
+                        for (; ma; ma &= ma - 1)
+                            stack[top++] = Entry{n.child[__builtin_ctz(unsigned(ma))], 0.0f};
                         cur = stack[--top];
                         continue;
                     }
@@ -622,9 +623,9 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 if constexpr (kPairNodes && kAvx && !kAvx512 && N == 8 && !kAnyHit) {
                     // The AVX2 form of the AVX-512 step's node pairing: both nodes' tests,
                     // then their hit children sorted into the stack as one batch.
-                    if (!found && top > 0 && top <= kPairMaxTop && stack[top - 1].count == 0 &&
-                        stack[top - 1].t_entry <= tmax_far) {
-                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].index);
+                    if (!found && top > 0 && top <= kPairMaxTop && ref_count(stack[top - 1].ref) == 0 &&
+                        stack[top - 1].t <= tmax_far) {
+                        const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].ref);
                         alignas(32) float ta[N], tb[N];
                         int ma = rw.test(n, ray.tmin, tmax_far, ta);
                         int mb = rw.test(b, ray.tmin, tmax_far, tb);
@@ -635,24 +636,24 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         if (ma) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
                             ma &= ma - 1;
-                            cur = Entry{n.child[c], n.count[c], ta[c]};
+                            cur = Entry{n.child[c], ta[c]};
                         } else {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
                             mb &= mb - 1;
-                            cur = Entry{b.child[c], b.count[c], tb[c]};
+                            cur = Entry{b.child[c], tb[c]};
                         }
                         const int base = top;
                         for (; ma; ma &= ma - 1) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
                             prefetch_planes(n.child[c]);
-                            Entry in{n.child[c], n.count[c], ta[c]};
+                            Entry in{n.child[c], ta[c]};
                             nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         for (; mb; mb &= mb - 1) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
                             prefetch_planes(b.child[c]);
-                            Entry in{b.child[c], b.count[c], tb[c]};
+                            Entry in{b.child[c], tb[c]};
                             nearer_first(cur, in);
                             push_sorted(base, in);
                         }
@@ -665,7 +666,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     // Unsigned: the child's address then needs no sign extension.
                     unsigned c = unsigned(__builtin_ctz(unsigned(mask)));
                     mask &= mask - 1;
-                    cur = Entry{n.child[c], n.count[c], t[c]};
+                    cur = Entry{n.child[c], t[c]};
                     if (!mask) continue;  // one child hit: no ordering, no stack
                     if constexpr (kAnyHit) {
                         // Any hit ends the search, so order buys little: push in child order
@@ -674,7 +675,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                             stack[top++] = cur;
                             c = unsigned(__builtin_ctz(unsigned(mask)));
                             mask &= mask - 1;
-                            cur = Entry{n.child[c], n.count[c], t[c]};
+                            cur = Entry{n.child[c], 0.0f};
                         } while (mask);
                         continue;
                     }
@@ -685,7 +686,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     do {
                         c = unsigned(__builtin_ctz(unsigned(mask)));
                         mask &= mask - 1;
-                        Entry in{n.child[c], n.count[c], t[c]};
+                        Entry in{n.child[c], t[c]};
                         nearer_first(cur, in);
                         push_sorted(base, in);
                     } while (mask);
@@ -694,7 +695,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
             }
             if (!pop()) return found;
         }
-        if (slow_leaf(cur.index, cur.count, ray.tmax)) {
+        if (slow_leaf(ref_first(cur.ref), ref_count(cur.ref), ray.tmax)) {
             if constexpr (kAnyHit) return true;
             found = true;
             tmax_far = ray.tmax * kRobustFarScale;
