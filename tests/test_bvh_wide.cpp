@@ -95,16 +95,15 @@ void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
             int children = 0;
             for (int c = 0; c < N; ++c) {
                 if (!n.has_child(c)) {
-                    CHECK(n.count[c] == 0);
+                    CHECK(n.leaf_count(c) == 0);
                     CHECK(child_box(n, c).lo.x > child_box(n, c).hi.x);
                     continue;
                 }
                 ++children;
                 CHECK(inside(child_box(n, c), box));
                 // A reference tells a leaf and its count by itself (wide_leaf_ref).
-                CHECK(ref_count(n.child[c]) == n.count[c]);
-                if (n.count[c]) {
-                    use_leaf(acc, ref_first(n.child[c]), n.count[c], slot_uses);
+                if (const uint32_t count = n.leaf_count(c)) {
+                    use_leaf(acc, ref_first(n.child[c]), count, slot_uses);
                 } else {
                     // Inner children hold node byte offsets (BvhWide::node_at).
                     CHECK(n.child[c] % sizeof(BvhWideNode<N>) == 0);
@@ -237,7 +236,7 @@ TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
         depth = std::max(depth, d);
         const Bvh8Node& n = acc.bvh8().node_at(offset);
         for (int c = 0; c < 8; ++c)
-            if (n.has_child(c) && n.count[c] == 0) pending.push_back({n.child[c], d + 1});
+            if (n.has_child(c) && n.leaf_count(c) == 0) pending.push_back({n.child[c], d + 1});
     }
     CHECK(depth >= 8);
     MESSAGE("wide tree depth " << depth);
@@ -363,7 +362,6 @@ TEST_CASE(
             n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
             n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
             n.child[c] = b.empty() ? kNoNode : uint32_t(rng());
-            n.count[c] = b.empty() ? 0 : uint32_t(rng() % 3);
         }
         const BvhRay r(random_slab_test_ray(rng, coord, u));
         const float tmax_far = r.tmax * kRobustFarScale;
@@ -554,14 +552,12 @@ TEST_CASE("wide tree statistics follow Embree's definitions") {
         n.lo_x[c] = n.lo_y[c] = n.lo_z[c] = kInfinity;
         n.hi_x[c] = n.hi_y[c] = n.hi_z[c] = -kInfinity;
         n.child[c] = kNoNode;
-        n.count[c] = 0;
     }
     for (int c = 0; c < 2; ++c) {
         n.lo_x[c] = 2.0f * float(c), n.hi_x[c] = 2.0f * float(c) + 1.0f;
         n.lo_y[c] = n.lo_z[c] = 0.0f;
         n.hi_y[c] = n.hi_z[c] = 1.0f;
-        n.count[c] = c == 0 ? 5 : 4;
-        n.child[c] = wide_leaf_ref(uint32_t(2 * c), n.count[c]);  // first blocks 0 and 2
+        n.child[c] = wide_leaf_ref(uint32_t(2 * c), c == 0 ? 5 : 4);  // first blocks 0 and 2
     }
     tree.nodes.push_back(n);
     const WideBvhStats s = compute_wide_bvh_stats(tree, 4);
@@ -708,7 +704,7 @@ TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused
         auto largest_leaf = [&](const auto& tree) {
             for (const auto& n : tree.nodes)
                 for (int c = 0; c < std::decay_t<decltype(n)>::kWidth; ++c)
-                    largest = std::max(largest, n.count[c]);
+                    largest = std::max(largest, n.leaf_count(c));
         };
         if (layout == BvhLayout::wide8)
             largest_leaf(acc.bvh8());

@@ -228,7 +228,7 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
     auto total = uint32_t(blocks_.size());
     for (int64_t i = 0; i < nodes; ++i) {
         first_block[size_t(i)] = total;
-        for (int c = 0; c < N; ++c) total += blocks_of(tree.nodes[size_t(i)].count[c]);
+        for (int c = 0; c < N; ++c) total += blocks_of(tree.nodes[size_t(i)].leaf_count(c));
     }
     blocks_.resize(total);
 #pragma omp parallel for schedule(static) if (nodes > kParallelLoopMin / N)
@@ -236,10 +236,10 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
         BvhWideNode<N>& n = tree.nodes[size_t(i)];
         uint32_t block = first_block[size_t(i)];
         for (int c = 0; c < N; ++c)
-            if (n.count[c]) {
-                fill_leaf(ref_first(n.child[c]), n.count[c], block);
-                n.child[c] = wide_leaf_ref(block, n.count[c]);
-                block += blocks_of(n.count[c]);
+            if (const uint32_t count = n.leaf_count(c)) {
+                fill_leaf(ref_first(n.child[c]), count, block);
+                n.child[c] = wide_leaf_ref(block, count);
+                block += blocks_of(count);
             }
     }
 }

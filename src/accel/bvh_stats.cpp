@@ -28,10 +28,11 @@ WideBvhStats wide_stats(const BvhWide<N>& bvh, uint32_t block_size) {
             const Bounds3 b = child_box(n, c);
             node_box.extend(b);
             ++s.children;
-            if (!n.count[c]) continue;
-            const size_t blocks = (n.count[c] + block_size - 1) / block_size;
+            const uint32_t count = n.leaf_count(c);
+            if (!count) continue;
+            const size_t blocks = (count + block_size - 1) / block_size;
             ++s.leaves;
-            s.leaf_primitives += n.count[c];
+            s.leaf_primitives += count;
             s.leaf_blocks += blocks;
             s.sah_leaves += double(b.surface_area()) * double(blocks) * inv_root;
         }

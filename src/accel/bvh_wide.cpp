@@ -137,7 +137,6 @@ void set_child(BvhWideNode<N>& p, int c, const BvhNode& box, uint32_t first, uin
     p.hi_y[c] = box.bounds[3];
     p.lo_z[c] = box.bounds[4];
     p.hi_z[c] = box.bounds[5];
-    p.count[c] = count;
     p.child[c] = count ? wide_leaf_ref(first, count) : kNoNode;
 }
 
@@ -149,7 +148,6 @@ BvhWideNode<N> empty_node() {
         p.lo_x[c] = p.lo_y[c] = p.lo_z[c] = inf;
         p.hi_x[c] = p.hi_y[c] = p.hi_z[c] = -inf;
         p.child[c] = kNoNode;
-        p.count[c] = 0;
     }
     return p;
 }

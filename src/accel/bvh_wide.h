@@ -43,18 +43,18 @@ inline uint32_t ref_count(uint32_t ref) { return ref & kMaxWideLeafCount; }
 /// A leaf reference's first slot (or block).
 inline uint32_t ref_first(uint32_t ref) { return ref >> kLeafCountBits; }
 
-/// One N-wide node; child c is empty (child[c] == kNoNode, count 0), inner
-/// (count 0, child = the node's byte offset) or a leaf (count > 0, child =
-/// wide_leaf_ref(first, count)). `count` repeats the leaf counts for the code that
-/// reads a node's children by slot (packets, statistics, the block fill).
+/// One N-wide node; child c is empty (child[c] == kNoNode), inner (child = the node's
+/// byte offset) or a leaf (child = wide_leaf_ref(first, count)). The alignment pads it
+/// to whole cache lines (the last one half used).
 template <int N>
 struct alignas(64) BvhWideNode {
     float lo_x[N], hi_x[N], lo_y[N], hi_y[N], lo_z[N], hi_z[N];  ///< 24 N bytes of child bounds
     uint32_t child[N];
-    uint32_t count[N];
 
     static constexpr int kWidth = N;
     bool has_child(int c) const { return child[c] != kNoNode; }
+    /// Child c's leaf primitive count; 0 for an inner or empty child.
+    uint32_t leaf_count(int c) const { return has_child(c) ? ref_count(child[c]) : 0; }
 };
 using Bvh4Node = BvhWideNode<4>;
 using Bvh8Node = BvhWideNode<8>;
