@@ -55,6 +55,9 @@ struct alignas(64) BvhWideNode {
     bool has_child(int c) const { return child[c] != kNoNode; }
     /// Child c's leaf primitive count; 0 for an inner or empty child.
     uint32_t leaf_count(int c) const { return has_child(c) ? ref_count(child[c]) : 0; }
+    /// Child c decoded for traversals that keep the count beside it (packets): a leaf's
+    /// first slot (or block), an inner child's node offset.
+    uint32_t child_index(int c) const { return leaf_count(c) ? ref_first(child[c]) : child[c]; }
 };
 using Bvh4Node = BvhWideNode<4>;
 using Bvh8Node = BvhWideNode<8>;
@@ -299,20 +302,13 @@ compress_words(__mmask8 k, const uint32_t* v) {
 }
 
 /// Writes eight stack entries (see traverse_wide) to out[0..8): lane i of `ref` in the low
-/// word of entry i, lane i of `t` in its high word. kAligned: `out` is 32-byte aligned.
-template <bool kAligned>
+/// word of entry i, lane i of `t` in its high word.
 __attribute__((target("avx2"), always_inline)) inline void store_stack_entries(uint64_t* out, __m256i ref,
                                                                                __m256i t) {
     const __m256i lo = _mm256_unpacklo_epi32(ref, t);  // entries 0, 1 | 4, 5
     const __m256i hi = _mm256_unpackhi_epi32(ref, t);  // entries 2, 3 | 6, 7
-    const __m256i e0 = _mm256_permute2x128_si256(lo, hi, 0x20), e1 = _mm256_permute2x128_si256(lo, hi, 0x31);
-    if constexpr (kAligned) {
-        _mm256_store_si256(reinterpret_cast<__m256i*>(out), e0);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(out + 4), e1);
-    } else {
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), e0);
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 4), e1);
-    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 4), _mm256_permute2x128_si256(lo, hi, 0x31));
 }
 
 /// The AVX-512 node step of a closest-hit ray: the hit children's references and entry
@@ -348,8 +344,8 @@ intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAv
     const __m256i ta = _mm256_maskz_compress_epi32(ka, entry_a);
     const __m256i tb = _mm256_maskz_compress_epi32(kb, entry_b);
     const int hits_a = __builtin_popcount(unsigned(ka));
-    store_stack_entries<true>(entries, ca, ta);
-    store_stack_entries<false>(entries + hits_a, cb, tb);
+    store_stack_entries(entries, ca, ta);
+    store_stack_entries(entries + hits_a, cb, tb);
     const bool from_a = ka != 0;
     return {unsigned(hits_a + __builtin_popcount(unsigned(kb))),
             uint32_t(_mm256_cvtsi256_si32(from_a ? ca : cb)),

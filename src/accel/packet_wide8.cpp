@@ -214,16 +214,14 @@ __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPa
                     const uint32_t parent = cur.index;  // a node offset: its low 8 bits are 0
                     int c = std::countr_zero(unsigned(any));
                     any &= any - 1;
-                    cur = Entry{n.leaf_count(c) ? ref_first(n.child[c]) : n.child[c], n.leaf_count(c),
-                                parent + uint32_t(c), order[c]};
+                    cur = Entry{n.child_index(c), n.leaf_count(c), parent + uint32_t(c), order[c]};
                     if (!any) continue;
                     // The others into the stack top, farthest deepest; the nearest becomes `cur`.
                     const int base_top = top;
                     do {
                         c = std::countr_zero(unsigned(any));
                         any &= any - 1;
-                        Entry in{n.leaf_count(c) ? ref_first(n.child[c]) : n.child[c], n.leaf_count(c),
-                                 parent + uint32_t(c), order[c]};
+                        Entry in{n.child_index(c), n.leaf_count(c), parent + uint32_t(c), order[c]};
                         if (in.t_entry < cur.t_entry) std::swap(in, cur);
                         int k = top++;
                         while (k > base_top && stack[k - 1].t_entry < in.t_entry) {
