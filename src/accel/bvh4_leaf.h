@@ -86,9 +86,10 @@ __attribute__((always_inline)) inline int intersect_triangle_block4_simd(const T
     // answers just as exactly; NaN (padding) lanes compare unequal.
     exact_zero = _mm_movemask_ps(_mm_cmpeq_ps(_mm_mul_ps(_mm_mul_ps(u, v), w), zero));
     // With no zero among them, u, v, w of a hit share one sign: differing sign bits miss.
-    const __m128 mixed = _mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w));
+    const int mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w)));
+    int mask = ~(mixed | exact_zero) & 0xF;
     // No branch on the sign test: whether any lane passes it is a coin toss for the
-    // predictor (diffuse and shadow rays 1-3% faster, AVX2 up to 7%, without the branch).
+    // predictor (diffuse rays 1.5-3% faster on the AVX-512 step, up to 7% on the AVX2 step).
     const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
     const __m128 t_scaled =
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, rz[0])), _mm_mul_ps(v, _mm_mul_ps(sz, rz[1]))),
@@ -100,17 +101,19 @@ __attribute__((always_inline)) inline int intersect_triangle_block4_simd(const T
     __m128 ok = _mm_cmpneq_ps(det, zero);
     ok = _mm_and_ps(ok, _mm_cmpgt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmin), abs_det)));
     ok = _mm_and_ps(ok, _mm_cmplt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmax), abs_det)));
-    // The sign bit of `mixed` clears the lanes whose signs differ.
-    const int mask = _mm_movemask_ps(_mm_andnot_ps(mixed, ok)) & ~exact_zero;
-    if (!mask) return 0;
-    const __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.0f), det);
-    const __m128 t = _mm_mul_ps(t_scaled, inv_det);
-    // Rounding of the division can push t onto the interval's boundary.
-    const __m128 in = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax)));
-    _mm_storeu_ps(t_out, t);
-    _mm_storeu_ps(u_out, _mm_mul_ps(v, inv_det));
-    _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
-    return mask & _mm_movemask_ps(in);
+    mask &= _mm_movemask_ps(ok);
+    int result = 0;
+    if (mask) {
+        const __m128 inv_det = _mm_div_ps(_mm_set1_ps(1.0f), det);
+        const __m128 t = _mm_mul_ps(t_scaled, inv_det);
+        // Rounding of the division can push t onto the interval's boundary.
+        const __m128 in = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax)));
+        result = mask & _mm_movemask_ps(in);
+        _mm_storeu_ps(t_out, t);
+        _mm_storeu_ps(u_out, _mm_mul_ps(v, inv_det));
+        _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
+    }
+    return result;
 }
 
 /// Tests the four lanes of `b`; returns the mask of lanes hit in (tmin, tmax)
@@ -157,7 +160,8 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
     const __m256 w = _mm256_sub_ps(_mm256_mul_ps(x[1], y[0]), _mm256_mul_ps(y[1], x[0]));
     const __m256 zero = _mm256_setzero_ps();
     exact_zero = _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(_mm256_mul_ps(u, v), w), zero, _CMP_EQ_OQ));
-    const __m256 mixed = _mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w));
+    const int mixed = _mm256_movemask_ps(_mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w)));
+    int mask = ~(mixed | exact_zero) & 0xFF;
     const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
     const __m256 t_scaled = _mm256_add_ps(
         _mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, rz[0])), _mm256_mul_ps(v, _mm256_mul_ps(sz, rz[1]))),
@@ -168,16 +172,19 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
     __m256 ok = _mm256_cmp_ps(det, zero, _CMP_NEQ_UQ);
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ));
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
-    const int mask = _mm256_movemask_ps(_mm256_andnot_ps(mixed, ok)) & ~exact_zero;
-    if (!mask) return 0;
-    const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
-    const __m256 t = _mm256_mul_ps(t_scaled, inv_det);
-    const __m256 in = _mm256_and_ps(_mm256_cmp_ps(t, _mm256_set1_ps(tmin), _CMP_GT_OQ),
-                                    _mm256_cmp_ps(t, _mm256_set1_ps(tmax), _CMP_LT_OQ));
-    _mm256_storeu_ps(t_out, t);
-    _mm256_storeu_ps(u_out, _mm256_mul_ps(v, inv_det));
-    _mm256_storeu_ps(v_out, _mm256_mul_ps(w, inv_det));
-    return mask & _mm256_movemask_ps(in);
+    mask &= _mm256_movemask_ps(ok);
+    int result = 0;
+    if (mask) {
+        const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+        const __m256 t = _mm256_mul_ps(t_scaled, inv_det);
+        const __m256 in = _mm256_and_ps(_mm256_cmp_ps(t, _mm256_set1_ps(tmin), _CMP_GT_OQ),
+                                        _mm256_cmp_ps(t, _mm256_set1_ps(tmax), _CMP_LT_OQ));
+        result = mask & _mm256_movemask_ps(in);
+        _mm256_storeu_ps(t_out, t);
+        _mm256_storeu_ps(u_out, _mm256_mul_ps(v, inv_det));
+        _mm256_storeu_ps(v_out, _mm256_mul_ps(w, inv_det));
+    }
+    return result;
 }
 
 /// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step (lanes as
