@@ -16,9 +16,12 @@
 #include <vector>
 
 #include "app/cmd_info.h"
+#include "accel/accelerator.h"
 #include "app/render_args.h"
 #include "geometry/sphere.h"
 #include "io/image_io.h"
+#include "scene/scene.h"
+#include "scene/scene_parser.h"
 
 extern char** environ;
 
@@ -358,4 +361,21 @@ TEST_CASE("render --builder overrides the scene's render.bvh_builder") {
     parse_render_args({}).overrides.apply(untouched);
     CHECK(untouched.bvh_builder == BvhBuilder::sweep);
     CHECK_THROWS_AS(parse_render_args({"--builder", "lbvh"}), UsageError);
+}
+
+TEST_CASE("render --layout picks the traversal structure the scene's tree is built in") {
+    const RenderArgs a = parse_render_args({"--layout", "pairs"});
+    REQUIRE(a.overrides.bvh_layout.has_value());
+    SceneDesc d = default_scene();
+    CHECK(d.render.bvh_layout == BvhLayout::wide8);
+    a.overrides.apply(d.render);
+    CHECK(d.render.bvh_layout == BvhLayout::pairs);
+    const Scene pairs = build_scene(d);
+    REQUIRE(pairs.accelerator() != nullptr);
+    CHECK(pairs.accelerator()->layout() == BvhLayout::pairs);
+    parse_render_args({"--layout", "wide4-slots"}).overrides.apply(d.render);
+    CHECK(build_scene(d).accelerator()->layout() == BvhLayout::wide4_slots);
+    CHECK(build_scene(default_scene()).accelerator()->layout() == BvhLayout::wide8);
+    CHECK_THROWS_AS(parse_render_args({"--layout", "wide16"}), UsageError);
+    CHECK_THROWS_AS(parse_render_args({"--layout"}), UsageError);
 }

@@ -39,24 +39,6 @@ struct HitPacket;
 /// 32 triangles: 124.7 vs 53.7 ns). So no separate flat path: 0.
 inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
-/// Traversal structure built from the binary SAH tree.
-enum class BvhLayout : uint8_t {
-    wide4,        ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
-    wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
-    pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
-    wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
-};
-
-/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
-inline bool layout_has_blocks(BvhLayout layout) {
-    return layout == BvhLayout::wide4 || layout == BvhLayout::wide8;
-}
-
-/// "wide4", "wide4-slots", "pairs" or "wide8".
-const char* bvh_layout_name(BvhLayout layout);
-/// Parses a bvh_layout_name(); returns false for anything else.
-bool parse_bvh_layout(std::string_view text, BvhLayout& out);
-
 /// When rays on a wide8 tree test the inner node on top of the stack together with the
 /// one they visit (traverse_wide): closest-hit rays on the AVX-512 and AVX2 paths,
 /// occlusion rays on the AVX2 path.

@@ -24,6 +24,8 @@ const char* const kRenderUsage =
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
+    "  --layout L           traversal structure: wide8 (default) | wide4 | wide4-slots | pairs\n"
+    "                       (see sahara bench --help; pairs: a plain binary BVH, one ray at a time)\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
     "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
@@ -147,6 +149,12 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
         if (!parse_bvh_builder(v, b))
             throw UsageError(a + ": expected binned|sweep|reinsert, got '" + v + "'");
         o.bvh_builder = b;
+    } else if (a == "--layout") {
+        const std::string& v = flag_value(args, i);
+        BvhLayout l{};
+        if (!parse_bvh_layout(v, l))
+            throw UsageError(a + ": expected wide8|wide4|wide4-slots|pairs, got '" + v + "'");
+        o.bvh_layout = l;
     } else if (a == "--sampler")
         o.sampler = parse_sampler_name(a, flag_value(args, i));
     else if (a == "--exposure")
@@ -174,6 +182,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (tonemap) r.tonemap = *tonemap;
     if (sampler) r.sampler = *sampler;
     if (bvh_builder) r.bvh_builder = *bvh_builder;
+    if (bvh_layout) r.bvh_layout = *bvh_layout;
 }
 
 RenderArgs parse_render_args(const std::vector<std::string>& args) {

@@ -26,6 +26,7 @@ struct RenderOverrides {
     std::optional<Tonemap> tonemap;
     std::optional<SamplerType> sampler;
     std::optional<BvhBuilder> bvh_builder;
+    std::optional<BvhLayout> bvh_layout;
 
     void apply(RenderSettings& r) const;
 };
