@@ -53,7 +53,7 @@ struct AcceleratorOptions {
     /// wide8 by default: against wide4 it cut CPU time per ray by 10-25% on every
     /// ray set (`sahara bench --layout wide4|wide8 --threads 1 --size 512`, bunny,
     /// 2026-11-22: primary 0.65 -> 0.72, diffuse 0.51 -> 0.62, shadow 0.61 -> 0.80 of Embree).
-    BvhLayout layout = BvhLayout::wide8;
+    BvhLayout layout = kDefaultBvhLayout;
     BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
     /// The wide4 layout builds with params.intersection_cost times this and counts

@@ -168,6 +168,9 @@ enum class BvhLayout : uint8_t {
     wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
 };
 
+/// The layout used unless --layout says otherwise (render, view, bench, bvh).
+inline constexpr BvhLayout kDefaultBvhLayout = BvhLayout::wide8;
+
 /// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
 inline bool layout_has_blocks(BvhLayout layout) {
     return layout == BvhLayout::wide4 || layout == BvhLayout::wide8;

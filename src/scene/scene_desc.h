@@ -187,7 +187,7 @@ struct RenderSettings {
     Tonemap tonemap = Tonemap::clamp;
     SamplerType sampler = SamplerType::sobol;     ///< command line only (--sampler)
     BvhBuilder bvh_builder = kDefaultBvhBuilder;  ///< "bvh_builder" / --builder
-    BvhLayout bvh_layout = BvhLayout::wide8;      ///< command line only (--layout)
+    BvhLayout bvh_layout = kDefaultBvhLayout;     ///< command line only (--layout)
 };
 
 struct SceneDesc {
