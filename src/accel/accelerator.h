@@ -31,12 +31,9 @@ struct RayPacket;
 struct HitPacket;
 
 /// Largest primitive count for which the accelerator skips the SAH build and
-/// tests everything in one root leaf (a flat loop). Decided by measurement,
-/// `sahara bench --small-scenes` (CPU ns per random ray, one thread, median of 5,
-/// 2026-11-22, this 2-core VM): for 1-4 spheres or triangles flat and tree are
-/// equal within 5% (the SAH already makes a root leaf when no split pays off);
-/// from 6 primitives on the tree wins (8 triangles: flat 46.6 ns, tree 40.2 ns;
-/// 32 triangles: 124.7 vs 53.7 ns). So no separate flat path: 0.
+/// tests everything in one root leaf (a flat loop). 0, no separate flat path: the
+/// SAH already makes a root leaf when no split pays off, and from about 6 primitives
+/// the tree is faster (`sahara bench --small-scenes` compares the two).
 inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 
 /// When rays on a wide8 tree test the inner node on top of the stack together with the
@@ -50,45 +47,34 @@ enum class NodePairing : uint8_t {
 
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
-    /// wide8 by default: against wide4 it cut CPU time per ray by 10-25% on every
-    /// ray set (`sahara bench --layout wide4|wide8 --threads 1 --size 512`, bunny,
-    /// 2026-11-22: primary 0.65 -> 0.72, diffuse 0.51 -> 0.62, shadow 0.61 -> 0.80 of Embree).
+    /// wide8 by default: one AVX step tests eight children, and on every ray set it
+    /// takes less time per ray than wide4.
     BvhLayout layout = kDefaultBvhLayout;
     BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
     /// The wide4 layout builds with params.intersection_cost times this and counts
     /// leaves in whole blocks of four (BvhBuildParams::leaf_block_size): a block
-    /// tests four triangles per SSE step. 0.25 measured equal to 0.35-0.5 in speed
-    /// (`sahara bench --size 512 --threads 1`, bunny, 2026-11-22, within the shared
-    /// machine's noise of +-0.05 in the Embree ratio) and smallest in memory
-    /// (bunny: 53.6 bytes/triangle of nodes + blocks vs 58.0 at 0.5; without the
-    /// block rounding 0.5 gave 79.9, mostly padding lanes of 2- and 3-triangle leaves).
+    /// tests four triangles per SSE step, and counting whole blocks keeps the build from
+    /// making 2- and 3-triangle leaves that are mostly padding lanes. 0.25: as fast as
+    /// 0.35-0.5, with the smallest tree and blocks (8% less memory than 0.5).
     float wide4_leaf_cost_scale = 0.25f;
-    /// The same for the wide8 layout, whose node visits cost less per binary level:
-    /// instructions per diffuse ray (callgrind, `sahara bench --rays diffuse --size 256`,
-    /// 2026-11-22) at 0.25 / 0.5 / 1.0: suzanne 1141 / 1072 / 1070, bunny 1194 / 1139 /
-    /// 1138, ogre 1310 / 1253 / 1252; 0.5 is the smaller tree of the two best. Blocks of
-    /// eight (two blocks per AVX step) measured worse: bunny 1214 at 0.5.
+    /// The same for the wide8 layout, whose node visits cost less per binary level.
+    /// 0.5: instructions per diffuse ray within 0.2% of 1.0 and 5-6% below 0.25, with
+    /// the smaller tree of the two best. Blocks of eight (two per AVX step) took 7% more.
     float wide8_leaf_cost_scale = 0.5f;
     /// How the block layouts collapse the binary tree into the wide one: subtrees of up
     /// to 8 primitives (two blocks, the fast leaf test's limit) may become one leaf, and
     /// a block test costs as much as a node visit (Embree's weights in its SAH report).
-    /// Against keeping the binary leaves (`sahara bench --threads 1 --size 512`, medians
-    /// of 3-4 runs, 2026-11-25), the Embree ratios of bunny, suzanne, ogre, spot and
-    /// teapot moved by +0.00 to +0.07 (camera rays), -0.02 to +0.02 (diffuse) and -0.01
-    /// to +0.03 (occlusion); a block cost of 0.7 or 0.5 (larger leaves) measured the same
-    /// within the machine's noise.
+    /// Merging helps camera rays and costs the other ray sets nothing; block costs of 0.5
+    /// or 0.7 (larger leaves) are no better.
     WideCollapse collapse{8, 1.0};
     /// Scenes with at most this many primitives skip the SAH build and test
     /// every primitive in one root leaf (see kFlatLoopMaxPrims); 0: always build.
     uint32_t flat_loop_max_prims = kFlatLoopMaxPrims;
-    /// Node pairing pays where node fetches miss the L2 cache: against none (`sahara bench
-    /// --threads 1 --size 512`, 3-5 alternating runs, 2026-11-27, AVX-512 Xeon with 2 MiB
-    /// of L2), diffuse rays on the bunny (3.7 MB of tree and blocks) and the ogre (6.8 MB)
-    /// 3-6% faster on the AVX-512 path and 6-8% on the AVX2 path (occlusion rays there
-    /// 2-3%); on the five meshes of 0.3 MB or less, -1.5 to +2%. Camera rays from outside
-    /// the bounds usually hit in the first subtree they enter, so the pending node would
-    /// never be visited: with pairing, 4-7% slower on the bunny and spot.
+    /// Node pairing pays only where node fetches miss the L2 cache, whose latency it
+    /// overlaps; on trees that fit in L2 it gains nothing. Camera rays from outside the
+    /// bounds usually hit in the first subtree they enter, so the paired node would never
+    /// have been visited: automatic pairing leaves them out.
     NodePairing node_pairing = NodePairing::automatic;
     /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.

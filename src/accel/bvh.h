@@ -90,24 +90,9 @@ enum class BvhBuilder : uint8_t {
 };
 
 /// The builder used unless a scene ("render": {"bvh_builder"}) or --builder says otherwise.
-/// Chosen to minimise build + trace time of a typical render (640x480, 64 spp, ~3 rays per
-/// sample: ~60M rays). Measured 2026-11-22 on this shared 2-core VM, one thread, CPU times
-/// (wall times were 3-5x the CPU times, the cores being shared): `sahara bvh --size 512
-/// --threads 1` (SAH cost; nodes + primitives per diffuse ray, deterministic) and `sahara bench
-/// --threads 1 --size 512 --repeat 7` (diffuse / shadow MRays/s per CPU second, +-10% noise):
-///   bunny  binned   SAH 28.89, build  94 ms, 43.74 + 5.86, 2.33 / 2.54
-///          sweep    SAH 28.61, build 397 ms, 43.20 + 5.85, 2.50 / 2.82
-///          reinsert SAH 28.75, build 218 ms, 43.88 + 5.86, 2.65 / 2.98
-///   ogre   binned   SAH 25.10, build 138 ms, 44.39 + 6.73, 2.18 / 2.41
-///          sweep    SAH 24.88, build 759 ms, 44.33 + 6.71, 2.28 / 2.27
-///          reinsert SAH 23.56, build 605 ms, 43.51 + 6.58, 2.19 / 2.54
-/// (binned builds have since become ~30% faster: all axes binned in one pass.) 60M rays at
-/// ~2.4 MRays/s are ~25 s of CPU time. The ray work differences (the steady measure; the MRays/s
-/// differences are within noise) are 0.3% worse (bunny) and 2.0% better (ogre) for reinsert,
-/// i.e. -0.1 s and +0.5 s of tracing, against +0.12 s and +0.47 s of build; sweep saves 1.1% and
-/// 0.1% (0.3 s, 0.03 s) for +0.3 s and +0.62 s. Nothing beats binned by more than the noise on
-/// a typical render, and binned wins on short ones: binned is the default; reinsert is worth
-/// choosing for long renders of meshes like the ogre (uneven triangle sizes).
+/// Binned: on a typical render (some 60M rays) the better trees of sweep and reinsert
+/// save no more tracing time than their slower builds cost, and on shorter renders the
+/// build dominates. Reinsert pays off on long renders of meshes with uneven triangle sizes.
 inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::binned;
 
 /// SAH cost model and build limits. The costs are relative: visiting an inner
@@ -124,8 +109,8 @@ struct BvhBuildParams {
     /// Subtrees with more primitives than this are built as OpenMP tasks.
     uint32_t parallel_threshold = 4096;
     /// Reinsertion: inner nodes removed and reinserted per round (the most inefficient ones), as a
-    /// fraction of all inner nodes. 0.1 gets most of the gain of 1.0 at a tenth of the time
-    /// (ogre, `sahara bvh`: SAH 25.10 binned, 23.56 at 0.1 in 0.64 s, 23.33 at 1.0 in 5.3 s).
+    /// fraction of all inner nodes. 0.1: nearly 90% of the SAH reduction of 1.0 in an eighth
+    /// of the build time.
     float reinsert_batch_fraction = 0.1f;
     /// Reinsertion: at most this many rounds ...
     uint32_t reinsert_max_rounds = 100;

@@ -192,8 +192,7 @@ class BinnedBuild {
         if (n > params_.parallel_threshold) {
             // No taskwait: nothing here needs the subtree, and libgomp's taskwait blocks
             // the thread until that very child ends (it runs no other queued subtree), which
-            // left one of two threads idle for a third of the ogre build. The end of the
-            // parallel region waits for every task.
+            // would leave threads idle. The end of the parallel region waits for every task.
 #pragma omp task default(shared) firstprivate(region, left, depth)
             build(region, region + 2, left, depth + 1);
             build(region + 1, right_region, right, depth + 1);

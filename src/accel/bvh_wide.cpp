@@ -27,7 +27,7 @@ float half_area(const BvhNode& n) {
 /// programme over the binary tree minimises it exactly (the collapse step of
 /// Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through
 /// Compressed Wide BVHs", 2017). The usual greedy rule, opening the largest
-/// inner child until N are gathered, left 4-11% more node area (`sahara bvh`).
+/// inner child until N are gathered, leaves more node area.
 template <int N>
 class CollapsePlan {
    public:

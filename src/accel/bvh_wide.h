@@ -76,8 +76,8 @@ struct BvhWide {
 
     /// An inner child holds its node's byte offset (index * sizeof(node)), not its
     /// index: the traversal's next node address is then one addition. The address
-    /// depends on the node test just made, so a multiplication there lengthens every
-    /// step of the chain (without it: diffuse rays 1-5%, occlusion rays 0-4% faster).
+    /// depends on the node test just made, so a multiplication there would lengthen
+    /// every step of the chain.
     static uint32_t offset_of(size_t index) { return uint32_t(index * sizeof(BvhWideNode<N>)); }
     static size_t index_of(uint32_t offset) { return offset / sizeof(BvhWideNode<N>); }
     const BvhWideNode<N>& node_at(uint32_t offset) const {
@@ -218,9 +218,8 @@ struct Bvh8RayAvx {
 };
 
 /// The slab distances of an 8-wide node's children in one AVX step, reduced as
-/// integers: one cycle where a float max or min takes four (AVX-512 Xeon: diffuse and
-/// occlusion rays 2-4% faster on the AVX-512 step, 0-9% on the AVX2 step). That needs
-/// tmin >= 0:
+/// integers: one cycle where a float max or min takes four, on the chain every node
+/// step waits for. That needs tmin >= 0:
 ///  - entry: the signed-integer max of the near distances and tmin. Non-negative
 ///    floats order like their bit patterns, and every negative float, the NaN of
 ///    0 * inf (sign bit set on x86: a ray in a slab plane) included, is a negative
@@ -314,8 +313,7 @@ __attribute__((target("avx2"), always_inline)) inline void store_stack_entries(u
 /// The AVX-512 node step of a closest-hit ray: the hit children's references and entry
 /// distances compressed to the front of ref/t[0..8) (slot order, zeros after them). The
 /// first hit child also comes back in registers, so the next node's address waits for
-/// neither a bit scan nor a load (against the AVX2 step on an AVX-512 Xeon: diffuse rays
-/// 4-7%, occlusion rays 3-5% faster).
+/// neither a bit scan nor a load.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                                uint32_t* ref, float* t) {
@@ -355,13 +353,11 @@ intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAv
 /// The AVX-512 node step of an any-hit ray: the first hit child (lowest slot) comes back
 /// in registers, the other hit children as stack entries (reference; any hit needs no
 /// distance) in slot order, all eight entries written to entries[0..8) (those past the
-/// hits are garbage), so that pushing them takes no loop over the hits (occlusion rays
-/// 0-5% faster than that loop). The next node's address then waits for neither the stack
-/// nor a bit count: against visiting the last hit child first (read back from the stack,
-/// Embree's order), shadow rays on the AVX-512 Xeon gained 4-18% on the bunny, teapot, spot
-/// and ogre and lost 8-10% on suzanne and 17-19% on the Cornell box. Much of that is the
-/// visit order, not the latency: on the AVX2 step the order alone moves the same meshes by
-/// -12 to +13%, so the AVX2 step keeps Embree's.
+/// hits are garbage), so that pushing them takes no loop over the hits, and the next
+/// node's address waits for neither the stack nor a bit count. Visiting the first hit child
+/// first, not the last (Embree's order, read back from the stack), wins on most meshes here;
+/// the order alone, without the shorter chain, wins on some meshes and loses on others, so
+/// the AVX2 step keeps Embree's.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                               uint64_t* entries) {
@@ -478,10 +474,9 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         stack[k] = in;
     };
     // Puts the nearer of a and b into a without a branch: which of two hit children is
-    // nearer is a coin toss for the predictor (AVX-512 step, diffuse rays: 2-3% faster
-    // than a branch). Entry distances are at least tmin >= 0, so their bit patterns order
-    // like the floats (were one negative, only the order of visits would suffer, not the
-    // answer); on a tie, a stays.
+    // nearer is a coin toss for the predictor. Entry distances are at least tmin >= 0, so
+    // their bit patterns order like the floats (were one negative, only the order of
+    // visits would suffer, not the answer); on a tie, a stays.
     auto nearer_first = [](Entry & a, Entry & b) __attribute__((always_inline)) {
         const uint32_t ta = std::bit_cast<uint32_t>(a.t), tb = std::bit_cast<uint32_t>(b.t);
         const uint32_t swap = uint32_t(0) - uint32_t(tb < ta);
@@ -597,8 +592,8 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 if constexpr (kPairNodes && kAvx && !kAvx512 && N == 8 && kAnyHit) {
                     // Occlusion rays on the AVX2 step pair nodes too (nothing culls a pushed
                     // entry): the hit children of both pushed in slot order, b's beneath, the
-                    // last of a's visited next. (On the AVX-512 step, whose first-hit-first
-                    // order this cannot keep, shadow rays were 14-18% slower with it.)
+                    // last of a's visited next. (Not on the AVX-512 step: pairing cannot keep
+                    // that step's first-hit-first order, without which its shadow rays are slower.)
                     if (top > 0 && top <= kPairMaxTop && ref_count(stack[top - 1].ref) == 0) {
                         const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].ref);
                         alignas(32) float ta[N], tb[N];
@@ -677,7 +672,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     }
                     // Insert the others into the stack top sorted by distance (farthest
                     // deepest); the nearest of all becomes `cur`, without a branch as in
-                    // the AVX-512 step (AVX2 step, diffuse rays: -2 to +3% by mesh).
+                    // the AVX-512 step (here a branch would be no faster).
                     const int base = top;
                     do {
                         c = unsigned(__builtin_ctz(unsigned(mask)));

@@ -48,8 +48,7 @@ inline int other_lanes(const TriangleBlock4& block) {
 /// next (`next_first`, `next_count`; count 0: none or an inner node) when that is a
 /// one-block leaf of triangles too; `paired` then says so, and the traversal drops
 /// that entry. Two blocks take one AVX step (kAvx) where one block takes an SSE
-/// step, and the next leaf is usually visited anyway (diffuse rays on the bunny:
-/// 29% of the leaf tests cover two leaves).
+/// step, and the next leaf is often visited anyway.
 template <bool kAnyHit, bool kCutouts, bool kAvx>
 __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(
     const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, uint32_t next_first,

@@ -2,9 +2,9 @@
 // The wide-BVH traversal body of Accelerator (trace_wide_body), compiled once per
 // instruction set in a translation unit of its own: trace_wide_sse2.cpp,
 // trace_wide_avx2.cpp and trace_wide_avx512.cpp. Each of those holds only its entry
-// point and explicit instantiations, so an edit elsewhere in the accelerator does not
-// change the code GCC makes for the hot loop (it did, by up to 4% in speed, while all
-// three lived in accelerator.cpp). Include only from those files.
+// point and explicit instantiations, so an edit elsewhere in the accelerator cannot
+// change the code GCC makes for the hot loop, and with it the loop's speed. Include only
+// from those files.
 #include "accel/accelerator.h"
 #include "accel/bvh_wide.h"
 #include "accel/leaf_blocks.inl"
@@ -21,9 +21,9 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
                                                                         Hit& hit, Counters& counters) const {
     // The triangle constants (axes and shear): a closest-hit ray that starts inside the
     // scene's bounds (a bounce) makes them before the first node, where the out-of-order
-    // core overlaps them with the box tests (diffuse rays 0-4% faster than making them at
-    // the first leaf). Other rays make them at their first leaf, as many never reach one:
-    // shadow rays were 2-5% and camera rays from outside 5-13% slower when made first.
+    // core overlaps them with the box tests. Other rays make them at their first leaf, as
+    // many never reach one (shadow rays that are not blocked, camera rays from outside that
+    // miss).
     BvhRay br(ray);
     TriangleRay tr;
     bool tr_ready = false;
@@ -31,7 +31,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
         if (!tr_ready) {
             // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
             // Only the AVX-512 body takes 1 / d[kz] from the box test's inverse direction:
-            // in the AVX2 body that cost diffuse rays 2-4% against dividing (AVX-512 Xeon).
+            // the AVX2 body divides, which is faster there.
             tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray, kAvx512 ? br.inv_dir : nullptr);
             tr_ready = true;
         }

@@ -56,9 +56,9 @@ struct TriangleRay {
     }
 
     /// The same constants without branches, for rays in scattered directions (bounces),
-    /// whose dominant axis is a coin toss for the branch predictor. AVX-512 Xeon, against
-    /// the constructor: diffuse rays 2-3% faster (0.9 mispredictions fewer per ray on the
-    /// bunny), shadow rays 1-3% slower (the axes come later: no speculation).
+    /// whose dominant axis is a coin toss for the branch predictor. Coherent rays (shadow
+    /// rays towards a light) keep the constructor, whose branches predict well and let the
+    /// core speculate past them.
     /// `inv_dir` is 1 / ray.dir per axis (BvhRay::inv_dir), or null: then it divides.
     __attribute__((always_inline)) static TriangleRay scattered(const Ray& ray, const float inv_dir[3]) {
         TriangleRay tr;

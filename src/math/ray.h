@@ -12,8 +12,7 @@ inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
 /// neighbours. Traversal reads a ray right after its caller wrote it (a struct
 /// copy as two 16-byte stores, or field by field); a wider load that spans two
 /// of those stores cannot take its data from the store buffer and waits until
-/// both reach the cache. `sahara bench`, rays that miss everything: 45 MRays/s
-/// with such a load (8 bytes across a 16-byte boundary), 51-74 without.
+/// both reach the cache.
 __attribute__((always_inline)) inline float load_scalar(const float& x) {
     float v = x;
     asm("" : "+x"(v));

@@ -38,12 +38,9 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 /// Whether camera rays are traced as packets: the path integrator (which can
 /// take a first hit) over a block layout (wide4, wide8) without cut-outs, unless
 /// SAHARA_PACKETS=0, with the AVX-512 kernel or the AVX2 wide8 kernel
-/// (packet_wide8.cpp). The AVX2 kernel on wide4 and the SSE2 kernel trace
-/// primary rays slower than single rays (`sahara bench` on the bunny, 1 thread,
-/// 2026-11-22: AVX2 wide4 packets 6.5 MRays/s CPU against about 10 for single
-/// rays), so they stay for tests and bench. On wide8 with AVX2 (2026-11-25,
-/// AMD EPYC, `sahara bench stanford-bunny.obj --threads 1 --size 512`): packets
-/// 9.8 MRays/s against 9.3 for single rays.
+/// (packet_wide8.cpp), which trace camera rays faster than single rays. The
+/// AVX2 kernel on wide4 and the SSE2 kernel are slower than single rays, so
+/// they stay for tests and bench.
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
     if (!packets_enabled() || scene.render.integrator != IntegratorType::path || !accel ||
