@@ -26,6 +26,19 @@ fs::path executable_dir() {
     return fs::path(buf).parent_path();
 }
 
+/// Where the plugin may be, in the order tried (see kImageCodecLibrary).
+std::vector<fs::path> candidate_files() {
+    if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) return {forced};
+    const fs::path dir = executable_dir();
+    if (dir.empty()) return {};
+    std::vector<fs::path> files{dir / kImageCodecLibrary};
+#ifdef SAHARA_CODEC_RELATIVE_DIR
+    // The installed layout's bin -> plugin directory, computed by CMake.
+    files.push_back((dir / SAHARA_CODEC_RELATIVE_DIR / kImageCodecLibrary).lexically_normal());
+#endif
+    return files;
+}
+
 struct Loaded {
     const ImageCodecApi* api = nullptr;
     std::string error;
@@ -33,38 +46,38 @@ struct Loaded {
 
 Loaded load() {
     if (sahara_image_codec_api) return {sahara_image_codec_api(), ""};
-    std::vector<fs::path> candidates;
-    if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) {
-        candidates.emplace_back(forced);
-    } else {
-        if (const fs::path dir = executable_dir(); !dir.empty())
-            candidates.push_back(dir / kImageCodecLibrary);
-#ifdef SAHARA_CODEC_DIR
-        candidates.push_back(fs::path(SAHARA_CODEC_DIR) / kImageCodecLibrary);
-#endif
+    const ImageCodecSearch search = find_image_codec();
+    if (search.found.empty()) {
+        std::string tried;
+        for (const std::string& file : search.tried) tried += (tried.empty() ? "" : ", ") + file;
+        return {nullptr, "the image codec plugin is missing (looked for " + tried +
+                             "; build the target sahara_image_codec)"};
     }
-    std::string tried;
-    for (const fs::path& file : candidates) {
-        std::error_code ec;
-        if (!fs::exists(file, ec)) {
-            tried += (tried.empty() ? "" : ", ") + file.string();
-            continue;
-        }
-        void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
-        if (!handle) return {nullptr, "cannot load the image codec " + file.string() + ": " + ::dlerror()};
-        using Entry = const ImageCodecApi* (*)();
-        const auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecSymbol));
-        const ImageCodecApi* api = entry ? entry() : nullptr;
-        if (!api || api->version != kImageCodecVersion)
-            return {nullptr,
-                    "the image codec " + file.string() + " is from another build of sahara (rebuild it)"};
-        return {api, ""};
-    }
-    return {nullptr, "the image codec plugin is missing (looked for " + tried +
-                         "; build the target sahara_image_codec)"};
+    const std::string& file = search.found;
+    void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) return {nullptr, "cannot load the image codec " + file + ": " + ::dlerror()};
+    using Entry = const ImageCodecApi* (*)();
+    const auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecSymbol));
+    const ImageCodecApi* api = entry ? entry() : nullptr;
+    if (!api || api->version != kImageCodecVersion)
+        return {nullptr, "the image codec " + file + " is from another build of sahara (rebuild it)"};
+    return {api, ""};
 }
 
 }  // namespace
+
+ImageCodecSearch find_image_codec() {
+    ImageCodecSearch search;
+    for (const fs::path& file : candidate_files()) {
+        search.tried.push_back(file.string());
+        std::error_code ec;
+        if (fs::exists(file, ec)) {
+            search.found = file.string();
+            break;
+        }
+    }
+    return search;
+}
 
 const ImageCodecApi& image_codec(const std::string& file_for_errors) {
     static const Loaded loaded = load();  // once, thread-safe

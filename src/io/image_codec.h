@@ -1,6 +1,6 @@
 #pragma once
 /// The image codec: the only code that talks to OpenImageIO. It is built as a
-/// plugin (build/libsahara_image_codec.so) and loaded on first use, because
+/// plugin (libsahara_image_codec.so) and loaded on first use, because
 /// OpenImageIO and the ~260 libraries it pulls in take about half a second to
 /// load: `sahara --help`, `sahara bench` or a scene error should not pay that.
 /// Callers use image_io.h and image_bytes.h; this header is their back end.
@@ -57,10 +57,20 @@ struct ImageCodecApi {
 inline constexpr int kImageCodecVersion = 1;
 /// The plugin's one exported symbol: `extern "C" const ImageCodecApi* sahara_image_codec_api()`.
 inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
-/// The plugin's file name; it is looked for next to the executable, then in the
-/// build directory (the environment variable SAHARA_IMAGE_CODEC, when set, names
-/// the file to load instead).
+/// The plugin's file name. It is looked for relative to the executable, never at
+/// a path fixed at build time, so an installed or moved sahara finds its own copy:
+/// beside the executable (the build tree), then in the plugin directory of the
+/// installed layout (bin/../lib/sahara). SAHARA_IMAGE_CODEC, when set, names the
+/// file to load instead.
 inline constexpr const char* kImageCodecLibrary = "libsahara_image_codec.so";
+
+/// The outcome of looking for the plugin file (nothing is loaded).
+struct ImageCodecSearch {
+    std::string found;               ///< the file that would be loaded; empty: none exists
+    std::vector<std::string> tried;  ///< every place looked at, in order
+};
+/// Looks for the plugin as image_codec() does, without loading it (sahara --version).
+ImageCodecSearch find_image_codec();
 
 /// The codec, loaded on the first call (thread-safe). Throws InputError naming
 /// `file_for_errors` if the plugin cannot be found or loaded.

@@ -1,0 +1,70 @@
+# ctest install_tree: installs the build into a temporary prefix, copies the
+# installed tree elsewhere (so neither the build tree nor the install prefix can
+# be what it uses), and renders PNG and EXR with the copied bin/sahara.
+#   cmake -DBUILD_DIR=<build tree> -P check_install.cmake
+if(NOT BUILD_DIR)
+  message(FATAL_ERROR "usage: cmake -DBUILD_DIR=<build tree> -P check_install.cmake")
+endif()
+
+set(tmp "$ENV{TMPDIR}")
+if(NOT tmp)
+  set(tmp /tmp)
+endif()
+string(RANDOM LENGTH 8 tag)
+set(root "${tmp}/sahara_install_test_${tag}")
+set(prefix "${root}/prefix")
+set(moved "${root}/moved")
+
+function(fail message)
+  file(REMOVE_RECURSE "${root}")
+  message(FATAL_ERROR "${message}")
+endfunction()
+
+execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${prefix}"
+                RESULT_VARIABLE code OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  fail("cmake --install failed: ${err}")
+endif()
+if(NOT EXISTS "${prefix}/bin/sahara")
+  fail("the install has no bin/sahara")
+endif()
+
+# No path of the build tree may be compiled into the installed binary or plugin.
+string(REGEX REPLACE "([][+.*()^$?|\\])" "\\\\\\1" build_dir_regex "${BUILD_DIR}")
+file(GLOB_RECURSE installed LIST_DIRECTORIES false "${prefix}/*")
+foreach(file IN LISTS installed)
+  file(STRINGS "${file}" hits REGEX "${build_dir_regex}")
+  if(hits)
+    fail("${file} names the build tree: ${hits}")
+  endif()
+endforeach()
+
+file(COPY "${prefix}/" DESTINATION "${moved}")
+file(REMOVE_RECURSE "${prefix}")
+set(sahara "${moved}/bin/sahara")
+
+foreach(format png exr)
+  set(out "${root}/out.${format}")
+  execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=SAHARA_IMAGE_CODEC
+                          "${sahara}" render --width 8 --height 6 --spp 1 --quiet -o "${out}"
+                  RESULT_VARIABLE code ERROR_VARIABLE err)
+  if(NOT code EQUAL 0 OR NOT EXISTS "${out}")
+    fail("the installed sahara did not write ${format} (exit ${code}): ${err}")
+  endif()
+  file(READ "${out}" magic LIMIT 4 HEX)
+  if(format STREQUAL "png" AND NOT magic STREQUAL "89504e47")
+    fail("out.png is not a PNG (starts with ${magic})")
+  endif()
+  if(format STREQUAL "exr" AND NOT magic STREQUAL "762f3101")
+    fail("out.exr is not an OpenEXR file (starts with ${magic})")
+  endif()
+endforeach()
+
+execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=SAHARA_IMAGE_CODEC "${sahara}" --version
+                RESULT_VARIABLE code OUTPUT_VARIABLE version)
+string(FIND "${version}" "plugin ${moved}/" where)
+if(NOT code EQUAL 0 OR where EQUAL -1)
+  fail("sahara --version does not report the plugin under ${moved}:\n${version}")
+endif()
+
+file(REMOVE_RECURSE "${root}")
