@@ -6,7 +6,9 @@
 
 #include "app/cmd_converge.h"
 #include "app/cmd_info.h"
+#include "app/cmd_version.h"
 #include "app/commands.h"
+#include "app/tool_args.h"
 #include "base/error.h"
 
 namespace sahara {
@@ -28,7 +30,7 @@ const char* const kUsage =
     "  trace MESH            trace rays from a file and write the hits\n"
     "\n"
     "  sahara COMMAND --help   options of a command\n"
-    "  sahara --version        print the version\n";
+    "  sahara --version        the version and the optional parts built in\n";
 
 }  // namespace
 
@@ -43,10 +45,7 @@ int run_cli(int argc, char** argv) {
         std::fputs(kUsage, stdout);
         return 0;
     }
-    if (cmd == "--version" || cmd == "-V") {
-        std::printf("sahara %s\n", SAHARA_VERSION);
-        return 0;
-    }
+    if (cmd == "--version" || cmd == "-V" || cmd == "version") return run_version_command();
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     if (cmd == "render") return run_render_command(rest);
     if (cmd == "info") return run_info_command(rest);
@@ -55,8 +54,7 @@ int run_cli(int argc, char** argv) {
     if (cmd == "bvh") return run_bvh_command(argc - 1, argv + 1);
     if (cmd == "bench") return run_bench_command(argc - 1, argv + 1);
     if (cmd == "trace") return run_trace_command(argc - 1, argv + 1);
-    std::fprintf(stderr, "sahara: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
-    return 2;
+    return usage_error("", std::string(cmd[0] == '-' ? "unknown option '" : "unknown command '") + cmd + "'");
 }
 
 }  // namespace sahara

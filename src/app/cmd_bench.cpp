@@ -362,7 +362,7 @@ int run_bench_command(int argc, char** argv) {
     std::string err = parse_tool_args(
         argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat", "--embree-isa"},
         {"--json", "--no-embree", "--embree-robust", "--small-scenes"}, args);
-    if (!err.empty()) return usage_error("bench", err, kBenchUsage);
+    if (!err.empty()) return usage_error("bench", err);
     if (args.help) {
         std::fputs(kBenchUsage, stdout);
         return 0;
@@ -370,7 +370,7 @@ int run_bench_command(int argc, char** argv) {
     if (args.switches.count("--small-scenes")) return run_small_scenes();
     BenchOptions opt;
     err = bench_options(args, opt);
-    if (!err.empty()) return usage_error("bench", err, kBenchUsage);
+    if (!err.empty()) return usage_error("bench", err);
     try {
         const nlohmann::ordered_json j = run_bench(opt);
         if (opt.json)

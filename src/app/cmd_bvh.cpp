@@ -190,28 +190,28 @@ int run_bvh_command(int argc, char** argv) {
     ToolArgs args;
     const std::string err =
         parse_tool_args(argc, argv, {"--builder", "--layout", "--size", "--threads"}, {"--json"}, args);
-    if (!err.empty()) return usage_error("bvh", err, kBvhUsage);
+    if (!err.empty()) return usage_error("bvh", err);
     if (args.help) {
         std::fputs(kBvhUsage, stdout);
         return 0;
     }
-    if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh or scene file", kBvhUsage);
+    if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh or scene file");
     std::optional<BvhBuilder> builder;  // none: the scene's render.bvh_builder (for a mesh, the default)
     if (args.has("--builder")) {
         BvhBuilder b{};
         if (!parse_bvh_builder(args.values["--builder"], b))
-            return usage_error("bvh", "--builder must be binned, sweep or reinsert", kBvhUsage);
+            return usage_error("bvh", "--builder must be binned, sweep or reinsert");
         builder = b;
     }
     BvhLayout layout = AcceleratorOptions{}.layout;
     if (args.has("--layout") && !parse_bvh_layout(args.values["--layout"], layout))
-        return usage_error("bvh", "--layout must be wide8, wide4, wide4-slots or pairs", kBvhUsage);
+        return usage_error("bvh", "--layout must be wide8, wide4, wide4-slots or pairs");
     int size = 1024;
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
-        return usage_error("bvh", "--size must be a positive integer", kBvhUsage);
+        return usage_error("bvh", "--size must be a positive integer");
     int threads = omp_get_num_procs();
     if (args.has("--threads") && !parse_positive_int(args.values["--threads"], threads))
-        return usage_error("bvh", "--threads must be a positive integer", kBvhUsage);
+        return usage_error("bvh", "--threads must be a positive integer");
     try {
         const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, layout, size, threads);
         if (args.switches.count("--json"))

@@ -10,6 +10,7 @@
 
 #include <omp.h>
 
+#include "app/tool_args.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_io.h"
@@ -393,8 +394,7 @@ int run_converge_command(const std::vector<std::string>& args) {
     try {
         a = parse_converge_args(args);
     } catch (const UsageError& e) {
-        std::fprintf(stderr, "sahara converge: %s\n\n%s", e.what(), kConvergeUsage);
-        return 2;
+        return usage_error("converge", e.what());
     }
     if (a.help) {
         std::fputs(kConvergeUsage, stdout);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "app/tool_args.h"
 #include "base/error.h"
 #include "io/model_loader.h"
 #include "render/features.h"
@@ -157,13 +158,11 @@ int run_info_command(const std::vector<std::string>& args) {
         }
         if (a == "--json")
             json = true;
-        else if (!a.empty() && a[0] == '-') {
-            std::fprintf(stderr, "sahara info: unknown option '%s'\n\n%s", a.c_str(), kInfoUsage);
-            return 2;
-        } else if (input) {
-            std::fprintf(stderr, "sahara info: more than one input given\n\n%s", kInfoUsage);
-            return 2;
-        } else
+        else if (!a.empty() && a[0] == '-')
+            return usage_error("info", "unknown option '" + a + "'");
+        else if (input)
+            return usage_error("info", "more than one input given ('" + *input + "' and '" + a + "')");
+        else
             input = a;
     }
     try {

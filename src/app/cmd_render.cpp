@@ -12,6 +12,7 @@
 #include "app/render_args.h"
 #include "app/render_file.h"
 #include "app/signals.h"
+#include "app/tool_args.h"
 #include "base/counters.h"
 #include "base/error.h"
 #include "base/log.h"
@@ -283,8 +284,7 @@ int run_render_command(const std::vector<std::string>& args) {
     try {
         a = parse_render_args(args);
     } catch (const UsageError& e) {
-        std::fprintf(stderr, "sahara render: %s\n\n%s", e.what(), kRenderUsage);
-        return 2;
+        return usage_error("render", e.what());
     }
     if (a.help) {
         std::fputs(kRenderUsage, stdout);

@@ -110,14 +110,14 @@ int trace(const ToolArgs& args) {
 int run_trace_command(int argc, char** argv) {
     ToolArgs args;
     const std::string err = parse_tool_args(argc, argv, {"--rays", "--hits", "--occlusion"}, {}, args);
-    if (!err.empty()) return usage_error("trace", err, kTraceUsage);
+    if (!err.empty()) return usage_error("trace", err);
     if (args.help) {
         std::fputs(kTraceUsage, stdout);
         return 0;
     }
-    if (args.positional.size() != 1) return usage_error("trace", "expected one mesh file", kTraceUsage);
+    if (args.positional.size() != 1) return usage_error("trace", "expected one mesh file");
     if (!args.values.count("--rays") || !args.values.count("--hits"))
-        return usage_error("trace", "--rays and --hits are required", kTraceUsage);
+        return usage_error("trace", "--rays and --hits are required");
     try {
         return trace(args);
     } catch (const InputError& e) {

@@ -4,6 +4,7 @@
 
 #include "app/commands.h"
 #include "app/render_args.h"
+#include "app/tool_args.h"
 #include "io/model_loader.h"
 #include "scene/view_scene.h"
 
@@ -81,8 +82,7 @@ int run_view_command(const std::vector<std::string>& args) {
     try {
         v = parse_view_args(args);
     } catch (const UsageError& e) {
-        std::fprintf(stderr, "sahara view: %s\n\n%s", e.what(), kViewUsage);
-        return 2;
+        return usage_error("view", e.what());
     }
     if (v.render.help) {
         std::fputs(kViewUsage, stdout);

@@ -1,5 +1,6 @@
 #pragma once
-/// Minimal flag parsing shared by the BVH tool commands (bvh, bench, trace).
+/// Minimal flag parsing shared by the BVH tool commands (bvh, bench, trace), and
+/// the one-line usage error every command prints.
 #include <cstdio>
 #include <map>
 #include <set>
@@ -30,12 +31,12 @@ inline std::string parse_tool_args(int argc, char** argv, const std::set<std::st
         if (a == "--help" || a == "-h") {
             out.help = true;
         } else if (with_value.count(a)) {
-            if (i + 1 >= argc) return "flag " + a + " needs a value";
+            if (i + 1 >= argc) return a + ": missing value";
             out.values[a] = argv[++i];
         } else if (switches.count(a)) {
             out.switches.insert(a);
         } else if (a.size() > 1 && a[0] == '-') {
-            return "unknown flag " + a;
+            return "unknown option '" + a + "'";
         } else {
             out.positional.push_back(a);
         }
@@ -43,9 +44,12 @@ inline std::string parse_tool_args(int argc, char** argv, const std::set<std::st
     return "";
 }
 
-/// Prints "sahara CMD: MESSAGE" and the usage to stderr; returns exit code 2.
-inline int usage_error(const char* cmd, const std::string& message, const char* usage) {
-    std::fprintf(stderr, "sahara %s: %s\n%s", cmd, message.c_str(), usage);
+/// Prints "sahara COMMAND: MESSAGE (see 'sahara COMMAND --help')" as one line on
+/// stderr (COMMAND empty: the top level) and returns exit code 2. One line, not the
+/// whole help text, so the mistake stays on screen.
+inline int usage_error(const std::string& command, const std::string& message) {
+    const std::string program = command.empty() ? "sahara" : "sahara " + command;
+    std::fprintf(stderr, "%s: %s (see '%s --help')\n", program.c_str(), message.c_str(), program.c_str());
     return 2;
 }
 

@@ -1,0 +1,134 @@
+// Usage errors and `sahara --version`, through the real executable.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "accel/bvh_wide.h"
+#include "app/cmd_version.h"
+#include "io/image_codec.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A fresh directory per test case, removed afterwards.
+struct UsageDir {
+    fs::path path;
+    explicit UsageDir(const std::string& name)
+        : path(fs::temp_directory_path() / ("sahara_usage_" + std::to_string(::getpid()) + "_" + name)) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~UsageDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+};
+
+struct Run {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string read_text(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// Runs `[ENV] sahara ARGS` through the shell from `dir`, capturing stdout and stderr.
+Run run_sahara(const std::string& args, const UsageDir& dir, const std::string& env = "") {
+    const fs::path out = dir.path / "stdout.txt", err = dir.path / "stderr.txt";
+    const std::string cmd = "cd " + dir.path.string() + " && " + env + " " + SAHARA_EXE + " " + args + " >" +
+                            out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_text(out), read_text(err)};
+}
+
+/// Checks that `sahara ARGS` fails with exit code 2 and exactly one stderr line
+/// naming `culprit` and pointing at `sahara COMMAND --help`.
+void check_one_line_usage_error(const std::string& args, const std::string& command, const std::string& culprit) {
+    UsageDir dir("err");
+    const Run r = run_sahara(args, dir);
+    INFO("sahara " << args << "\nstderr:\n" << r.err);
+    CHECK(r.code == 2);
+    CHECK(r.out.empty());
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.back() == '\n');
+    const std::string program = command.empty() ? "sahara" : "sahara " + command;
+    CHECK(r.err.rfind(program + ": ", 0) == 0);
+    CHECK(r.err.find(culprit) != std::string::npos);
+    CHECK(r.err.find("(see '" + program + " --help')\n") != std::string::npos);
+}
+
+}  // namespace
+
+TEST_CASE("cli usage: an unknown option is one line with a help pointer, for every command") {
+    for (const char* command : {"render", "view", "info", "bvh", "bench", "trace", "converge"}) {
+        CAPTURE(command);
+        check_one_line_usage_error(std::string(command) + " --bogus", command, "unknown option '--bogus'");
+    }
+    check_one_line_usage_error("--bogus", "", "unknown option '--bogus'");
+    check_one_line_usage_error("frobnicate", "", "unknown command 'frobnicate'");
+}
+
+TEST_CASE("cli usage: missing and malformed values are one line too") {
+    check_one_line_usage_error("render --spp", "render", "--spp: missing value");
+    check_one_line_usage_error("render --spp lots", "render", "'lots'");
+    check_one_line_usage_error("render a.json b.json", "render", "more than one scene");
+    check_one_line_usage_error("view", "view", "no MODEL given");
+    check_one_line_usage_error("view m.obj --up x", "view", "--up");
+    check_one_line_usage_error("info a.json b.json", "info", "more than one input");
+    check_one_line_usage_error("converge --budget", "converge", "--budget: missing value");
+    check_one_line_usage_error("bvh", "bvh", "expected one mesh or scene file");
+    check_one_line_usage_error("bvh m.obj --size", "bvh", "--size: missing value");
+    check_one_line_usage_error("bench m.obj --rays sideways", "bench", "--rays");
+    check_one_line_usage_error("trace m.obj", "trace", "--rays and --hits are required");
+}
+
+TEST_CASE("cli usage: --help still prints the whole text on stdout") {
+    UsageDir dir("help");
+    for (const char* command : {"render", "view", "info", "bvh", "bench", "trace", "converge"}) {
+        CAPTURE(command);
+        const Run r = run_sahara(std::string(command) + " --help", dir);
+        CHECK(r.code == 0);
+        CHECK(r.out.find(std::string("usage: sahara ") + command) != std::string::npos);
+        CHECK(r.err.empty());
+    }
+}
+
+TEST_CASE("cli: --version names the version and every optional part") {
+    UsageDir dir("version");
+    const Run r = run_sahara("--version", dir);
+    CHECK(r.code == 0);
+    CHECK(r.out.rfind("sahara " SAHARA_VERSION "\n", 0) == 0);
+    for (const char* part : {"OpenMP:", "SIMD:", "Embree:", "MPI:", "SDL2:", "image codec:"})
+        CHECK(r.out.find(part) != std::string::npos);
+    CHECK(r.out.find("sse2 avx2 avx512 compiled in") != std::string::npos);
+    CHECK(r.out.find(std::string("this CPU runs ") + sahara::simd_path_name(sahara::best_simd_path())) !=
+          std::string::npos);
+    // The executable lives in the build tree, with the plugin beside it.
+    const fs::path plugin = fs::path(SAHARA_EXE).parent_path() / sahara::kImageCodecLibrary;
+    CHECK(r.out.find("OpenImageIO ") != std::string::npos);
+    CHECK(r.out.find("plugin " + plugin.string() + "\n") != std::string::npos);
+    CHECK(run_sahara("version", dir).out == r.out);
+    CHECK(sahara::version_report().rfind("sahara " SAHARA_VERSION "\n", 0) == 0);
+}
+
+TEST_CASE("cli: --version reports a missing plugin and a narrowed SIMD path") {
+    UsageDir dir("version_env");
+    const std::string missing = (dir.path / "no-codec.so").string();
+    const Run r = run_sahara("--version", dir, "SAHARA_IMAGE_CODEC=" + missing + " SAHARA_SIMD=sse2");
+    CHECK(r.code == 0);
+    CHECK(r.out.find("plugin not found (looked for " + missing + ")") != std::string::npos);
+    if (sahara::best_simd_path() != sahara::SimdPath::sse2)
+        CHECK(r.out.find("(SAHARA_SIMD selects sse2)") != std::string::npos);
+}
