@@ -51,7 +51,7 @@ Loaded load() {
         std::string tried;
         for (const std::string& file : search.tried) tried += (tried.empty() ? "" : ", ") + file;
         return {nullptr, "the image codec plugin is missing (looked for " + tried +
-                             "; build the target sahara_image_codec)"};
+                             "; build the target sahara_image_codec, or install sahara again)"};
     }
     const std::string& file = search.found;
     void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);

@@ -60,8 +60,8 @@ inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
 /// The plugin's file name. It is looked for relative to the executable, never at
 /// a path fixed at build time, so an installed or moved sahara finds its own copy:
 /// beside the executable (the build tree), then in the plugin directory of the
-/// installed layout (bin/../lib/sahara). SAHARA_IMAGE_CODEC, when set, names the
-/// file to load instead.
+/// installed layout (lib/sahara beside bin by default; CMake compiles in the
+/// relative path). SAHARA_IMAGE_CODEC, when set, names the file to load instead.
 inline constexpr const char* kImageCodecLibrary = "libsahara_image_codec.so";
 
 /// The outcome of looking for the plugin file (nothing is loaded).
