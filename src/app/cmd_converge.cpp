@@ -34,7 +34,10 @@ const char* const kConvergeUsage =
     "linear radiance; efficiency = 1 / (relMSE * seconds). Without --reference, a\n"
     "reference is rendered at 16x the largest spp (with another seed; capped at 8x\n"
     "the budget) and written to PREFIX-reference.exr for reuse.\n"
-    "Writes PREFIX.csv and PREFIX.png (log-log RMSE against seconds).\n"
+    "Writes PREFIX.csv (one row per measured image) and a log-log plot of RMSE against\n"
+    "render time, one line per configuration with the ideal Monte Carlo slope -1/2 as a\n"
+    "guide: PREFIX.svg (opens in any web browser) and PREFIX.png (needs a TrueType font\n"
+    "for its text, e.g. Debian's fonts-dejavu-core).\n"
     "\n"
     "  --reference FILE     reference image (.exr/.hdr/.pfm, same size as the render)\n"
     "  --budget S           render seconds per configuration (default 10)\n"
@@ -218,19 +221,22 @@ void write_csv(const std::string& file, const std::vector<Series>& all) {
     if (!out) throw input_error(file, "", "write failed");
 }
 
-void write_plot(const std::string& file, const std::vector<Series>& all, const std::string& scene_name) {
-    static const Rgb kColors[] = {{0.05f, 0.2f, 0.8f}, {0.8f, 0.08f, 0.05f}, {0.05f, 0.5f, 0.1f},
-                                  {0.9f, 0.45f, 0.0f}, {0.45f, 0.1f, 0.6f},  {0.0f, 0.55f, 0.6f}};
+/// The series as a log-log plot of RMSE against seconds, with the Monte Carlo
+/// rate as a guide.
+LogLogPlot convergence_plot(const std::vector<Series>& all, const std::string& scene_name) {
+    // Distinct hues that stay apart for the common forms of colour blindness.
+    static const PlotColor kColors[] = {{0.00f, 0.45f, 0.70f}, {0.84f, 0.37f, 0.00f}, {0.00f, 0.62f, 0.45f},
+                                        {0.80f, 0.47f, 0.65f}, {0.34f, 0.71f, 0.91f}, {0.90f, 0.62f, 0.00f}};
     LogLogPlot plot;
-    plot.title = "RMSE vs render time: " + scene_name;
-    plot.x_label = "render time (seconds)";
-    plot.y_label = "RMSE vs reference";
+    plot.title = "RMSE against render time: " + scene_name;
+    plot.x_label = "render time (s)";
+    plot.y_label = "RMSE against the reference";
     for (size_t i = 0; i < all.size(); ++i) {
         PlotSeries ps;
         char label[160];
         std::snprintf(label, sizeof label, "%s (slope %.2f)", all[i].label.c_str(), all[i].slope);
         ps.label = label;
-        ps.color = kColors[i % 6];
+        ps.color = kColors[i % std::size(kColors)];
         for (const Point& p : all[i].points) {
             ps.x.push_back(p.seconds);
             ps.y.push_back(p.error.rmse);
@@ -242,14 +248,30 @@ void write_plot(const std::string& file, const std::vector<Series>& all, const s
     for (const Series& s : all) t_max = std::max(t_max, s.points.back().seconds);
     const Point& p0 = all[0].points.front();
     PlotSeries ideal;
-    ideal.label = "ideal 1/sqrt(N) (slope -0.50)";
-    ideal.color = Rgb(0.45f);
+    ideal.label = "ideal Monte Carlo rate (slope -0.50)";
+    ideal.color = {0.45f, 0.45f, 0.45f};
     ideal.dashed = true;
     ideal.x = {p0.seconds, t_max};
     ideal.y = {p0.error.rmse, p0.error.rmse * std::sqrt(p0.seconds / t_max)};
     plot.series.push_back(ideal);
-    const Raster r = draw_loglog_plot(plot);
-    write_image(file, r.width, r.height, r.rgb);
+    return plot;
+}
+
+/// Writes PREFIX.svg and PREFIX.png from one layout; returns the files written.
+/// A PNG that cannot be drawn is reported, not fatal: the SVG holds the same plot.
+std::vector<std::string> write_plots(const std::string& prefix, const LogLogPlot& plot) {
+    const PlotDrawing drawing = layout_loglog_plot(plot);
+    std::vector<std::string> written;
+    write_plot_svg(prefix + ".svg", drawing);
+    written.push_back(prefix + ".svg");
+    try {
+        if (const std::string warning = write_plot_png(prefix + ".png", drawing); !warning.empty())
+            log_warning(prefix + ".png: " + warning);
+        written.push_back(prefix + ".png");
+    } catch (const InputError& e) {
+        log_warning(std::string("no PNG plot: ") + e.what());
+    }
+    return written;
 }
 
 void print_summary(const std::vector<Series>& all) {
@@ -309,9 +331,12 @@ int run(const ConvergeArgs& a) {
         s.slope = fit_loglog_slope(x, y);
     }
     write_csv(a.prefix + ".csv", all);
-    write_plot(a.prefix + ".png", all, a.scene ? *a.scene : std::string("default scene"));
+    const std::vector<std::string> plots =
+        write_plots(a.prefix, convergence_plot(all, a.scene ? *a.scene : std::string("default scene")));
     print_summary(all);
-    std::printf("wrote %s.csv and %s.png\n", a.prefix.c_str(), a.prefix.c_str());
+    std::printf("wrote %s.csv (the measurements)", a.prefix.c_str());
+    for (const std::string& file : plots) std::printf(", %s", file.c_str());
+    std::printf(" (log-log plot of RMSE against render time)\n");
     return 0;
 }
 

@@ -14,6 +14,8 @@
 
 namespace sahara {
 
+struct PlotDrawing;  // io/plot.h
+
 /// Decoded pixels: `channels` floats per pixel, row 0 at the top.
 struct DecodedPixels {
     int width = 0, height = 0, channels = 0;
@@ -52,9 +54,12 @@ struct ImageCodecApi {
     std::string (*read_u32_channels)(const std::string& file, const std::vector<std::string>& names,
                                      int& width, int& height, std::vector<std::vector<uint32_t>>& out,
                                      std::string& bad_channel);
+    /// Draws a laid-out plot into a PNG (lines, boxes, TrueType text). Without
+    /// a usable font the PNG is written without text and `warning` says why.
+    std::string (*draw_plot)(const std::string& file, const PlotDrawing& drawing, std::string& warning);
 };
 
-inline constexpr int kImageCodecVersion = 1;
+inline constexpr int kImageCodecVersion = 2;
 /// The plugin's one exported symbol: `extern "C" const ImageCodecApi* sahara_image_codec_api()`.
 inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
 /// The plugin's file name. It is looked for relative to the executable, never at

@@ -1,20 +1,87 @@
 #pragma once
-/// A small log-log line plot rasterised into an RGB image: axes with decade
-/// ticks and values, axis labels, a title, a legend, solid series with point
-/// markers and dashed guide lines. Text uses a built-in 5x7 bitmap font (upper
-/// case, digits and common punctuation; lower case is drawn as upper case).
+/// A log-log line plot, laid out once in pixels as a plain list of shapes and
+/// texts (PlotDrawing), then written as SVG (here) or drawn into a PNG by the
+/// image codec plugin (OpenImageIO's line, box and TrueType text renderers).
+/// The drawing types use the standard library only, so the plugin can read them.
+///
+/// Raster and its 5x7 bitmap font remain only for the bvh-cost heat map legend
+/// (render/bvh_cost.cpp); plots do not use them.
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "math/vec3.h"
 
 namespace sahara {
 
+/// A display colour: sRGB-encoded values in [0, 1], as stored in the PNG.
+struct PlotColor {
+    float r = 0, g = 0, b = 0;
+};
+
+/// A position in pixels: origin at the top-left corner, y pointing down.
+struct PlotPoint {
+    double x = 0, y = 0;
+};
+
+/// A polyline (two points: a segment). `role` names what it is ("grid",
+/// "axis", "tick", "series", "guide", "legend"); SVG keeps it as the class.
+struct PlotPath {
+    std::string role;
+    std::vector<PlotPoint> points;
+    PlotColor color;
+    double width = 1;
+    double dash = 0;    ///< > 0: dashes and gaps of this many pixels
+    std::string title;  ///< shown on hover in a browser (SVG only)
+};
+
+/// An axis-aligned rectangle, filled or outlined.
+struct PlotBox {
+    std::string role;
+    PlotPoint min, max;
+    PlotColor color;
+    bool filled = true;
+    std::string title;  ///< shown on hover in a browser (SVG only)
+};
+
+enum class TextAnchor { start, middle, end };             ///< which end of the text sits at `at.x`
+enum class TextBaseline { alphabetic, middle, hanging };  ///< what sits at `at.y`
+
+/// One line of UTF-8 text; vertical text reads bottom to top, turned about `at`.
+struct PlotText {
+    std::string role;
+    std::string text;
+    PlotPoint at;
+    double size = 14;  ///< font size in pixels
+    PlotColor color;
+    TextAnchor anchor = TextAnchor::start;
+    TextBaseline baseline = TextBaseline::alphabetic;
+    bool vertical = false;
+    std::string superscript;  ///< drawn right after `text`, smaller and raised (an exponent)
+};
+
+/// Font size and rise of a superscript on text of font size `size`.
+inline double superscript_size(double size) { return 0.7 * size; }
+inline double superscript_rise(double size) { return 0.4 * size; }
+
+using PlotItem = std::variant<PlotPath, PlotBox, PlotText>;
+
+/// Everything a plot shows, in drawing order (later items cover earlier ones).
+struct PlotDrawing {
+    int width = 0, height = 0;
+    PlotColor background{1, 1, 1};
+    /// TrueType fonts for the PNG, by name or path, the first one found is used.
+    std::vector<std::string> fonts;
+    /// The same faces for SVG viewers (CSS font-family list).
+    std::string font_family;
+    std::vector<PlotItem> items;
+};
+
 struct PlotSeries {
     std::string label;
-    std::vector<double> x, y;  ///< both > 0 (non-positive points are skipped)
-    Rgb color{0, 0, 0};
-    bool dashed = false;  ///< guides: no markers, dashed line
+    std::vector<double> x, y;  ///< both > 0 (other points are skipped)
+    PlotColor color;
+    bool dashed = false;  ///< a guide: dashed, no markers
 };
 
 struct LogLogPlot {
@@ -22,27 +89,41 @@ struct LogLogPlot {
     std::vector<PlotSeries> series;
 };
 
+/// Lays the plot out on a width x height canvas: decade and minor ticks with
+/// grid lines, tick labels, axis labels, title, series, and a legend.
+PlotDrawing layout_loglog_plot(const LogLogPlot& plot, int width = 900, int height = 600);
+
+/// The drawing as a standalone SVG document.
+std::string plot_svg(const PlotDrawing& drawing);
+
+/// Writes plot_svg(drawing) to `file`. Throws InputError.
+void write_plot_svg(const std::string& file, const PlotDrawing& drawing);
+
+/// Draws `drawing` into a PNG through the image codec. Returns a warning (empty:
+/// none), e.g. that no font was found and the PNG has no text. Throws InputError.
+std::string write_plot_png(const std::string& file, const PlotDrawing& drawing);
+
+/// A tick label: `text`, then `superscript` as an exponent ("10" "-5": 10^-5).
+struct TickLabel {
+    std::string text, superscript;
+};
+
+/// Tick label of 10^e: decimal for -3 <= e <= 3 ("0.01", "100"), else a power of ten.
+TickLabel decade_label(int e);
+
 /// A linear RGB raster, row 0 at the top (what write_image takes).
 struct Raster {
     int width = 0, height = 0;
     std::vector<float> rgb;
     Raster(int w, int h, Rgb fill);
     void set(int x, int y, Rgb c);
-    /// A line of the given thickness; dash > 0 draws dash-pixel on/off segments.
-    void line(double x0, double y0, double x1, double y1, Rgb c, int thickness = 1, int dash = 0);
     void fill_rect(int x0, int y0, int x1, int y1, Rgb c);
-    /// Draws text with its top-left corner at (x, y); `scale` pixels per font dot;
-    /// vertical text runs bottom to top with (x, y) its bottom-left corner.
-    void text(int x, int y, const std::string& s, Rgb c, int scale = 2, bool vertical = false);
+    /// Draws text in the 5x7 bitmap font with its top-left corner at (x, y);
+    /// `scale` pixels per font dot.
+    void text(int x, int y, const std::string& s, Rgb c, int scale = 2);
 };
 
-/// Width in pixels of `s` drawn at `scale`.
+/// Width in pixels of `s` drawn by Raster::text at `scale`.
 int text_width(const std::string& s, int scale = 2);
-
-/// Rasterises the plot into a width x height image.
-Raster draw_loglog_plot(const LogLogPlot& plot, int width = 900, int height = 650);
-
-/// Tick label for 10^e: plain for -3 <= e <= 3 ("0.01", "100"), else "1E-5".
-std::string decade_label(int e);
 
 }  // namespace sahara
