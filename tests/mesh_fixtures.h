@@ -1,5 +1,6 @@
 #pragma once
-// Procedural meshes and seeded ray sets shared by test_bvh.cpp and test_triangle.cpp.
+// Procedural meshes and seeded ray sets shared by the BVH, packet, triangle and loader tests.
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <random>
@@ -110,6 +111,85 @@ inline TriangleMesh make_degenerate_mesh() {
         m.indices.insert(m.indices.end(), {b, b + 1, b + 2});
     }
     return m;
+}
+
+/// A stand-in for a big real scan (the suite needs no downloaded meshes): a sphere of
+/// `rings` x `segments` quads, two triangles each, on an irregular grid (every inner
+/// vertex nudged), its radius displaced by smooth bumps and fine ripples. Like a scan
+/// it is big, has holes (`holes` caps cut out: boundary edges), long thin triangles
+/// (near the poles) and zero-area triangles: every pole row's vertices share one
+/// position, so one triangle of each quad there has two equal corners. Unused vertices
+/// are dropped, so the mesh's bounds are those of its triangles.
+inline TriangleMesh make_scan_mesh(int rings, int segments, int holes, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    struct Wave {
+        Vec3 dir;
+        float freq, amp, phase;
+    };
+    std::vector<Wave> waves;
+    for (int k = 0; k < 12; ++k)  // bumps (low frequency) to ripples (high frequency, small)
+        waves.push_back({normalize(Vec3(u(rng), u(rng), u(rng)) + Vec3(1e-3f)), 1.5f + 3.0f * float(k),
+                         0.08f / (1.0f + float(k)), 3.14159265f * u(rng)});
+    // The radius depends on the direction only, so the pole rows keep one position each.
+    auto surface = [&](Vec3 d) {
+        float r = 1.0f;
+        for (const Wave& w : waves) r += w.amp * std::sin(w.freq * dot(d, w.dir) + w.phase);
+        return d * r;
+    };
+    const float pi = 3.14159265f;
+    std::vector<Vec3> grid;
+    for (int r = 0; r <= rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            const bool pole = r == 0 || r == rings;
+            const float theta = pi * (float(r) + (pole ? 0.0f : 0.3f * u(rng))) / float(rings);
+            const float phi = 2.0f * pi * (float(s) + (pole ? 0.0f : 0.3f * u(rng))) / float(segments);
+            grid.push_back(surface(Vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                        std::sin(theta) * std::sin(phi))));
+        }
+    std::vector<Vec3> hole_dirs;
+    for (int h = 0; h < holes; ++h) hole_dirs.push_back(normalize(Vec3(u(rng), u(rng), u(rng)) + Vec3(1e-3f)));
+    auto in_hole = [&](uint32_t a) {
+        const Vec3 d = normalize(grid[a]);
+        for (const Vec3& h : hole_dirs)
+            if (dot(d, h) > 0.995f) return true;
+        return false;
+    };
+    auto at = [&](int r, int s) { return uint32_t(r * segments + (s % segments)); };
+    std::vector<uint32_t> tris;
+    for (int r = 0; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            const uint32_t a = at(r, s), b = at(r, s + 1), c = at(r + 1, s + 1), d = at(r + 1, s);
+            if (in_hole(a)) continue;
+            tris.insert(tris.end(), {a, c, d, a, b, c});  // counter-clockwise seen from outside
+        }
+    TriangleMesh m;
+    m.name = "scan-like mesh";
+    std::vector<uint32_t> remap(grid.size(), UINT32_MAX);
+    for (uint32_t v : tris) {
+        if (remap[v] == UINT32_MAX) {
+            remap[v] = uint32_t(m.positions.size());
+            m.positions.push_back(grid[v]);
+        }
+        m.indices.push_back(remap[v]);
+    }
+    return m;
+}
+
+/// The ~70k-triangle scan stand-in (in place of a Stanford-bunny-sized mesh) and a
+/// ~120k one (past 100k triangles, for the parallel build's larger trees).
+inline TriangleMesh make_scan_mesh_70k() { return make_scan_mesh(150, 240, 12, 1); }
+inline TriangleMesh make_scan_mesh_120k() { return make_scan_mesh(200, 310, 8, 2); }
+
+/// Number of triangles with two equal corners (zero area by construction).
+inline size_t count_repeated_corner_triangles(const TriangleMesh& m) {
+    size_t n = 0;
+    for (size_t t = 0; t < m.triangle_count(); ++t) {
+        const Vec3 &a = m.positions[m.indices[3 * t]], &b = m.positions[m.indices[3 * t + 1]],
+                   &c = m.positions[m.indices[3 * t + 2]];
+        n += a == b || b == c || a == c;
+    }
+    return n;
 }
 
 inline Bounds3 mesh_bounds(const TriangleMesh& m) {

@@ -14,19 +14,12 @@
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"
+#include "test_data.h"
 
 using namespace sahara;
 using namespace sahara::test;
 
 namespace {
-
-std::vector<std::filesystem::path> shared_obj_files() {
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(SAHARA_ASSETS_DIR "/obj"))
-        if (e.path().extension() == ".obj") files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    return files;
-}
 
 bool same_t(float a, float b, float rel) {
     return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b));
@@ -97,7 +90,7 @@ std::vector<TriangleMesh> procedural_meshes() {
 
 TEST_CASE("every builder produces valid trees") {
     std::vector<TriangleMesh> meshes = procedural_meshes();
-    for (const auto& f : shared_obj_files()) meshes.push_back(read_obj_triangles(f));
+    for (TriangleMesh& m : realistic_meshes()) meshes.push_back(std::move(m));
     for (const TriangleMesh& m : meshes)
         for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert}) {
             INFO(m.name, " ", std::string(bvh_builder_name(builder)));
@@ -179,27 +172,24 @@ TEST_CASE("BVH agrees with brute force on procedural meshes") {
             check_against_brute_force(m, builder, seed++, builder == BvhBuilder::binned ? 100000 : 25000);
 }
 
-TEST_CASE("BVH agrees with brute force on the shared OBJ meshes") {
+TEST_CASE("BVH agrees with brute force on real and scan-like meshes") {
     uint32_t seed = 100;
-    for (const auto& f : shared_obj_files())
+    for (const TriangleMesh& m : realistic_meshes())
         for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::reinsert})
-            check_against_brute_force(read_obj_triangles(f), builder, seed++,
-                                      builder == BvhBuilder::binned ? 100000 : 25000);
+            check_against_brute_force(m, builder, seed++, builder == BvhBuilder::binned ? 100000 : 25000);
 }
 
 TEST_CASE("reinsertion never raises the SAH cost of its input") {
     std::vector<TriangleMesh> meshes = procedural_meshes();
     meshes.push_back(make_icosphere(4));
     const size_t procedural = meshes.size();
-    // Under ASan only the shared meshes up to 20k triangles (the optimiser is sequential).
-    for (const auto& f : shared_obj_files()) {
-        TriangleMesh m = read_obj_triangles(f);
+    // Under ASan only the realistic meshes up to 20k triangles (the optimiser is sequential).
+    for (TriangleMesh& m : realistic_meshes())
         if (!kSanitized || m.triangle_count() <= 20000) meshes.push_back(std::move(m));
-    }
     for (size_t i = 0; i < meshes.size(); ++i) {
         const TriangleMesh& m = meshes[i];
         const std::vector<Bounds3> boxes = triangle_boxes(m);
-        // The sweep build is slow on the big shared meshes; they start from the binned tree only.
+        // The sweep build is slow on the big realistic meshes; they start from the binned tree only.
         const bool sweep_too = i < procedural;
         for (BvhBuilder input_builder : {BvhBuilder::binned, BvhBuilder::sweep}) {
             if (input_builder == BvhBuilder::sweep && !sweep_too) continue;
@@ -587,14 +577,10 @@ void write_file(const std::filesystem::path& p, const void* data, size_t bytes) 
 
 }  // namespace
 
-TEST_CASE("sahara agrees with Embree on the shared meshes (bench ray sets)") {
-    if (!EmbreeReference::available()) {
-        MESSAGE("built without Embree: skipped");
-        return;
-    }
+TEST_CASE("sahara agrees with Embree on real and scan-like meshes (bench ray sets) [needs Embree]" *
+          doctest::skip(!EmbreeReference::available())) {
     const int side = kSanitized ? 48 : 128;
-    for (const auto& f : shared_obj_files()) {
-        const TriangleMesh mesh = read_obj_triangles(f);
+    for (const TriangleMesh& mesh : realistic_meshes()) {
         Scene scene = scene_from_mesh(mesh);
         const Accelerator acc(scene);
         const EmbreeReference embree(mesh.positions, mesh.indices);
@@ -605,7 +591,7 @@ TEST_CASE("sahara agrees with Embree on the shared meshes (bench ray sets)") {
             trace_sahara(acc, rays, s == 2, 2, true, a);
             trace_embree(embree, rays, s == 2, 2, true, b);
             const Disagreements d = compare_answers(a, b, rays, mesh);
-            INFO(f.string(), " set ", s, " ties ", d.ties, " confirmed for sahara ", d.confirmed_for_a);
+            INFO(mesh.name, " set ", s, " ties ", d.ties, " confirmed for sahara ", d.confirmed_for_a);
             CHECK(d.total == 0);
             CHECK(a.hits() > 0);
         }
@@ -682,8 +668,15 @@ TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
     std::filesystem::remove_all(dir);
 }
 
+namespace {
+
+/// A small real mesh for the tool commands.
+const std::string kToolMesh = (kTestData / "obj/spot/spot.obj").string();
+
+}  // namespace
+
 TEST_CASE("bvh and bench commands: JSON output, usage errors") {
-    const std::string mesh = SAHARA_ASSETS_DIR "/obj/suzanne/suzanne.obj";
+    const std::string& mesh = kToolMesh;
     const auto bvh =
         run_captured(run_bvh_command, {"bvh", mesh, "--builder", "sweep", "--size", "32", "--json"});
     REQUIRE(bvh.first == 0);
@@ -712,27 +705,9 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     for (const char* key : {"\"mesh\"", "\"primitives\"", "\"threads\":2", "\"build_ms\"", "\"primary\"",
                             "\"diffuse\"", "\"shadow\"", "\"mrays_s\"", "\"hit_rate\""})
         CHECK(bench.second.find(key) != std::string::npos);
-    if (EmbreeReference::available()) {
-        CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
-        CHECK(bench.second.find("\"embree_build_ms\"") != std::string::npos);
-        CHECK(bench.second.find("\"embree_mtris_s\"") != std::string::npos);
-        CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
-        CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
-        // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.
-        const auto robust =
-            run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--rays",
-                                             "diffuse", "--embree-robust", "--json"});
-        REQUIRE(robust.first == 0);
-        CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
-        CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
-        CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
-        const auto capped =
-            run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays",
-                                             "shadow", "--embree-isa", "sse2", "--json"});
-        REQUIRE(capped.first == 0);
-        CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
-        CHECK(capped.second.find("\"disagreements\":0") != std::string::npos);
-    }
+    if (!EmbreeReference::available())
+        CHECK(bench.second.find("\"embree\":\"skipped: sahara was built without Embree 3\"") !=
+              std::string::npos);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-isa", "avx512skx"}).first == 2);
     const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1",
                                                        "--rays", "shadow", "--no-embree"});
@@ -742,4 +717,31 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--threads", "0"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--frobnicate"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", "--help"}).first == 0);
+}
+
+TEST_CASE("bench command compares with Embree: default, robust and ISA-capped modes [needs Embree]" *
+          doctest::skip(!EmbreeReference::available())) {
+    const std::string& mesh = kToolMesh;
+    const auto bench = run_captured(
+        run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--threads", "2", "--json"});
+    REQUIRE(bench.first == 0);
+    CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
+    CHECK(bench.second.find("\"embree_build_ms\"") != std::string::npos);
+    CHECK(bench.second.find("\"embree_mtris_s\"") != std::string::npos);
+    CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
+    CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
+    // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.
+    const auto robust =
+        run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--rays",
+                                         "diffuse", "--embree-robust", "--json"});
+    REQUIRE(robust.first == 0);
+    CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
+    CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
+    CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
+    const auto capped =
+        run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays",
+                                         "shadow", "--embree-isa", "sse2", "--json"});
+    REQUIRE(capped.first == 0);
+    CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
+    CHECK(capped.second.find("\"disagreements\":0") != std::string::npos);
 }

@@ -18,19 +18,12 @@
 #include "app/mesh_input.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"
+#include "test_data.h"
 
 using namespace sahara;
 using namespace sahara::test;
 
 namespace {
-
-std::vector<std::filesystem::path> obj_files() {
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(SAHARA_ASSETS_DIR "/obj"))
-        if (e.path().extension() == ".obj") files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    return files;
-}
 
 std::vector<TriangleMesh> procedural() {
     return {make_icosphere(3), make_tiny_grid(30), make_slivers(1000), make_degenerate_mesh()};
@@ -147,10 +140,11 @@ int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
     return bad;
 }
 
-/// The wide layouts on every runnable SIMD path: valid trees, brute-force answers;
-/// `reinsert` adds the wide8 layout over the reinsertion builder's tree. The wide8 tree
-/// is also traced with node pairing for every closest-hit ray (the AVX-512 path).
-void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
+/// The wide layouts on `paths`: valid trees, brute-force answers; `reinsert` adds the
+/// wide8 layout over the reinsertion builder's tree. The wide8 tree is also traced with
+/// node pairing for every closest-hit ray (the AVX-512 path).
+void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert,
+                const std::vector<SimdPath>& paths = runnable_paths()) {
     const Scene scene = scene_from_mesh(mesh);
     const double budget = 2.5e7 / double(std::max<size_t>(mesh.triangle_count(), 1));
     const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
@@ -176,7 +170,7 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert) {
         REQUIRE(acc.layout() == layout);
         if (pairing != NodePairing::automatic) CHECK(acc.pairs_nodes() == (pairing == NodePairing::always));
         check_bvh4_valid(acc);
-        for (SimdPath path : runnable_paths()) {
+        for (SimdPath path : paths) {
             force_simd_path(path);
             INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " builder ",
                  std::string(bvh_builder_name(builder)), " pairing ", int(pairing), " path ",
@@ -201,15 +195,29 @@ Ray random_slab_test_ray(std::mt19937& rng, std::uniform_int_distribution<int>& 
 
 }  // namespace
 
-TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on every SIMD path") {
+// One test case per SIMD path, so that a CPU without AVX2 or AVX-512 shows those paths as skipped.
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the SSE2 path") {
     uint32_t seed = 500;
-    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true);
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::sse2});
 }
 
-TEST_CASE("BVH4 is valid and agrees with brute force on the shared OBJ meshes, on every SIMD path") {
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
+          doctest::skip(!cpu_has_avx2())) {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx2});
+}
+
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
+          "[needs AVX-512]" *
+          doctest::skip(!cpu_has_avx512())) {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx512});
+}
+
+TEST_CASE("BVH4 is valid and agrees with brute force on real and scan-like meshes, on every SIMD path") {
     uint32_t seed = 600;
     // (The reinsertion tree on these meshes is checked against brute force in test_bvh.cpp.)
-    for (const auto& f : obj_files()) check_mesh(read_obj_triangles(f), seed++, false);
+    for (const TriangleMesh& m : realistic_meshes()) check_mesh(m, seed++, false);
 }
 
 TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
@@ -337,14 +345,11 @@ TEST_CASE("BVH8 box test in SSE halves matches the single-node test") {
     CHECK(hits > 0);
 }
 
-TEST_CASE(
-    "BVH8 AVX2 and AVX-512 node steps: the exact slab test's hits (AVX-512: compressed in slot order)") {
-    if (!cpu_has_avx2()) {
-        MESSAGE("this CPU has no AVX2: the AVX2 and AVX-512 node steps are not run here");
-        return;
-    }
-    const bool avx512 = cpu_has_avx512();
-    if (!avx512) MESSAGE("this CPU has no AVX-512: only the AVX2 node step is run here");
+namespace {
+
+/// The BVH8 AVX2 node step (and with `avx512` the AVX-512 ones, compressed in slot
+/// order, and the paired step) against the exact slab test, on random nodes and rays.
+void check_bvh8_node_steps(bool avx512) {
     std::mt19937 rng(33);
     std::uniform_int_distribution<int> coord(-2, 2);
     std::uniform_real_distribution<float> u(-2.0f, 2.0f);
@@ -453,7 +458,22 @@ TEST_CASE(
                                                         << "; hit by the scalar test only: " << tighter);
 }
 
-TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar watertight test") {
+}  // namespace
+
+TEST_CASE("BVH8 AVX2 node step: the exact slab test's hits [needs AVX2]" * doctest::skip(!cpu_has_avx2())) {
+    check_bvh8_node_steps(false);
+}
+
+TEST_CASE("BVH8 AVX-512 node steps: the exact slab test's hits, compressed in slot order [needs AVX-512]" *
+          doctest::skip(!cpu_has_avx512())) {
+    check_bvh8_node_steps(true);
+}
+
+namespace {
+
+/// The four-lane triangle test (and with `eight_lanes` the AVX pair test) against the
+/// scalar watertight test, bit for bit.
+void check_lane_triangle_tests(bool eight_lanes) {
     // A fine grid: rays through shared edges and vertices give exactly-zero edge functions.
     const TriangleMesh m = make_tiny_grid(12, 1.0f, 1.0f);
     std::mt19937 rng(5);
@@ -482,7 +502,7 @@ TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar w
             alignas(32) float t8[8], u8[8], v8[8];
             const TriangleBlock4 pair[2] = {b, b};
             const int mask8 =
-                cpu_has_avx2() ? intersect_triangle_blocks2_avx(tr, pair, ray.tmin, ray.tmax, t8, u8, v8) : 0;
+                eight_lanes ? intersect_triangle_blocks2_avx(tr, pair, ray.tmin, ray.tmax, t8, u8, v8) : 0;
             for (int l = 0; l < 4; ++l) {
                 TriangleHit h{};
                 const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
@@ -490,7 +510,7 @@ TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar w
                 hits += hit;
                 if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l])))
                     ++bad;
-                if (!cpu_has_avx2()) continue;
+                if (!eight_lanes) continue;
                 for (int half = 0; half < 2; ++half) {
                     const int k = 4 * half + l;
                     if (hit != bool(mask8 & (1 << k)) ||
@@ -503,6 +523,17 @@ TEST_CASE("four- and eight-lane triangle tests are bit-identical to the scalar w
     CHECK(bad == 0);
     CHECK(hits > 0);
     CHECK(checked > 0);
+}
+
+}  // namespace
+
+TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight test") {
+    check_lane_triangle_tests(false);
+}
+
+TEST_CASE("eight-lane (AVX pair) triangle test is bit-identical to the scalar watertight test [needs AVX2]" *
+          doctest::skip(!cpu_has_avx2())) {
+    check_lane_triangle_tests(true);
 }
 
 TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <iomanip>
+#include <limits>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -10,13 +13,16 @@
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "mesh_fixtures.h"
+#include "test_data.h"
 
 using namespace sahara;
+using sahara::test::count_repeated_corner_triangles;
+using sahara::test::kTestData;
+using sahara::test::make_scan_mesh_70k;
 namespace fs = std::filesystem;
 
 namespace {
-
-const fs::path kAssets = SAHARA_ASSETS_DIR;
 
 /// A fresh scratch folder per test.
 fs::path scratch(const std::string& name) {
@@ -87,49 +93,107 @@ std::string error_of(F&& f) {
     return "(no InputError)";
 }
 
+/// What load_model must give for an OBJ file: its triangles (counted from the file)
+/// minus the zero-area ones, and the materials and textures it names.
+struct ObjExpect {
+    size_t degenerate, materials, textures;
+};
+
+void check_obj_loads(const fs::path& file, size_t file_tris, const ObjExpect& e) {
+    CAPTURE(file.string());
+    const ObjFacts facts = count_obj(file);
+    REQUIRE(facts.triangles == file_tris);
+    set_log_quiet(true);
+    const LoadedModel m = load_model(file);
+    set_log_quiet(false);
+    CHECK(triangles(m) == file_tris - e.degenerate);
+    CHECK(m.dropped_degenerate == e.degenerate);
+    CHECK(m.materials.size() == e.materials);
+    CHECK(m.textures.size() == e.textures);
+    const Bounds3 b = bounds(m);
+    for (int k = 0; k < 3; ++k) {
+        CHECK(b.lo[k] == doctest::Approx(facts.box.lo[k]));
+        CHECK(b.hi[k] == doctest::Approx(facts.box.hi[k]));
+    }
+    for (const auto& mesh : m.meshes) {
+        CHECK((mesh.normals.empty() || mesh.normals.size() == mesh.positions.size()));
+        CHECK((mesh.uvs.empty() || mesh.uvs.size() == mesh.positions.size()));
+    }
+}
+
+/// Writes `m` as OBJ text: `v` lines that read back to the same floats, then one
+/// `f` line per triangle (1-based).
+void write_obj(const fs::path& file, const TriangleMesh& m) {
+    std::ofstream out(file);
+    out << std::setprecision(std::numeric_limits<float>::max_digits10);
+    for (const Vec3& p : m.positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    for (size_t t = 0; t < m.triangle_count(); ++t)
+        out << "f " << m.indices[3 * t] + 1 << ' ' << m.indices[3 * t + 1] + 1 << ' ' << m.indices[3 * t + 2] + 1
+            << '\n';
+}
+
 }  // namespace
 
-TEST_CASE("every shared OBJ asset loads with the published counts") {
-    struct Expect {
-        const char* path;
-        size_t published_tris, degenerate, materials, textures;
-    };
-    // Triangle counts from SOURCES.md; degenerate counts from its notes (ogre 4, spider 56).
+TEST_CASE("the OBJ files in tests/data load with their published counts") {
+    // Triangle counts from tests/data/SOURCES.md; spider has 56 zero-area triangles.
     // Materials: newmtl entries (cornell 8, spider 5) or the default one; textures: map_Kd files.
-    const Expect expect[] = {
-        {"obj/stanford-bunny/stanford-bunny.obj", 69451, 0, 1, 0},
-        {"obj/spot/spot.obj", 5856, 0, 1, 0},
-        {"obj/teapot/teapot.obj", 6320, 0, 1, 0},
-        {"obj/suzanne/suzanne.obj", 968, 0, 1, 0},
-        {"obj/ogre/ogre.obj", 124008, 4, 1, 0},
-        {"obj/cornell-box/CornellBox-Original.obj", 36, 0, 8, 0},
-        {"obj/spider/spider.obj", 1368, 56, 5, 5},
+    check_obj_loads(kTestData / "obj/spot/spot.obj", 5856, {0, 1, 0});
+    check_obj_loads(kTestData / "obj/cornell-box/CornellBox-Original.obj", 36, {0, 8, 0});
+    check_obj_loads(kTestData / "obj/spider/spider.obj", 1368, {56, 5, 5});
+}
+
+TEST_CASE("a 70k-triangle scan-like OBJ loads whole; its zero-area triangles, and only those, are dropped") {
+    // The big triangle-only file with holes, slivers and degenerate triangles that
+    // scanned models are; the expected counts come from the generated mesh itself.
+    const TriangleMesh scan = make_scan_mesh_70k();
+    const size_t degenerate = count_repeated_corner_triangles(scan);
+    REQUIRE(scan.triangle_count() > 60000);
+    REQUIRE(degenerate > 0);
+    const fs::path file = scratch("scan") / "scan.obj";
+    write_obj(file, scan);
+    check_obj_loads(file, scan.triangle_count(), {degenerate, 1, 0});
+}
+
+TEST_CASE("an OBJ of quads and triangles with per-vertex normals (f v//vn) is triangulated") {
+    // A closed sphere in quads, with triangle fans at the poles, and a `vn` for every vertex.
+    const int rings = 12, segments = 20;
+    std::ostringstream obj;
+    obj << "v 0 1 0\nvn 0 1 0\n";
+    for (int r = 1; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            const double th = std::numbers::pi * r / rings, ph = 2 * std::numbers::pi * s / segments;
+            const double x = std::sin(th) * std::cos(ph), y = std::cos(th), z = std::sin(th) * std::sin(ph);
+            obj << "v " << x << ' ' << y << ' ' << z << "\nvn " << x << ' ' << y << ' ' << z << '\n';
+        }
+    obj << "v 0 -1 0\nvn 0 -1 0\n";
+    const int south = 2 + (rings - 1) * segments;
+    auto at = [&](int r, int s) { return 2 + (r - 1) * segments + s % segments; };
+    // One face line; every corner's normal has the corner's own index (f v//vn).
+    auto face = [&](std::initializer_list<int> corners) {
+        obj << 'f';
+        for (int v : corners) obj << ' ' << v << "//" << v;
+        obj << '\n';
     };
-    set_log_quiet(true);
-    for (const Expect& e : expect) {
-        CAPTURE(e.path);
-        const ObjFacts facts = count_obj(kAssets / e.path);
-        REQUIRE(facts.triangles == e.published_tris);
-        const LoadedModel m = load_model(kAssets / e.path);
-        CHECK(triangles(m) == e.published_tris - e.degenerate);
-        CHECK(m.dropped_degenerate == e.degenerate);
-        CHECK(m.materials.size() == e.materials);
-        CHECK(m.textures.size() == e.textures);
-        const Bounds3 b = bounds(m);
-        for (int k = 0; k < 3; ++k) {
-            CHECK(b.lo[k] == doctest::Approx(facts.box.lo[k]));
-            CHECK(b.hi[k] == doctest::Approx(facts.box.hi[k]));
-        }
-        for (const auto& mesh : m.meshes) {
-            CHECK((mesh.normals.empty() || mesh.normals.size() == mesh.positions.size()));
-            CHECK((mesh.uvs.empty() || mesh.uvs.size() == mesh.positions.size()));
-        }
+    for (int s = 0; s < segments; ++s) face({1, at(1, s + 1), at(1, s)});
+    for (int r = 1; r + 1 < rings; ++r)
+        for (int s = 0; s < segments; ++s) face({at(r, s), at(r, s + 1), at(r + 1, s + 1), at(r + 1, s)});
+    for (int s = 0; s < segments; ++s) face({south, at(rings - 1, s), at(rings - 1, s + 1)});
+    const fs::path file = scratch("quads") / "quads.obj";
+    write(file, obj.str());
+    const size_t tris = size_t(2 * segments + 2 * (rings - 2) * segments);
+    check_obj_loads(file, tris, {0, 1, 0});
+    const LoadedModel m = load_model(file);
+    REQUIRE(!m.meshes.empty());
+    for (const TriangleMesh& mesh : m.meshes) {
+        REQUIRE(mesh.normals.size() == mesh.positions.size());
+        // The file's normals are the unit sphere's: each equals its own vertex position.
+        for (size_t v = 0; v < mesh.positions.size(); ++v)
+            CHECK(length(mesh.normals[v] - normalize(mesh.positions[v])) < 1e-4f);
     }
-    set_log_quiet(false);
 }
 
 TEST_CASE("OBJ materials: Kd, Ke emitters, map_Kd with Windows paths") {
-    const LoadedModel box = load_obj(kAssets / "obj/cornell-box/CornellBox-Original.obj");
+    const LoadedModel box = load_obj(kTestData / "obj/cornell-box/CornellBox-Original.obj");
     int emitters = 0;
     for (const MaterialDesc& m : box.materials) {
         if (m.name == "light") {
@@ -143,7 +207,7 @@ TEST_CASE("OBJ materials: Kd, Ke emitters, map_Kd with Windows paths") {
     }
     CHECK(emitters == 1);
 
-    const LoadedModel spider = load_obj(kAssets / "obj/spider/spider.obj");
+    const LoadedModel spider = load_obj(kTestData / "obj/spider/spider.obj");
     for (const MaterialDesc& m : spider.materials) {
         CAPTURE(m.name);
         REQUIRE(m.albedo.kind == ColorSource::Kind::texture);
