@@ -144,11 +144,12 @@ inline TriangleMesh make_scan_mesh(int rings, int segments, int holes, uint32_t 
             const bool pole = r == 0 || r == rings;
             const float theta = pi * (float(r) + (pole ? 0.0f : 0.3f * u(rng))) / float(rings);
             const float phi = 2.0f * pi * (float(s) + (pole ? 0.0f : 0.3f * u(rng))) / float(segments);
-            grid.push_back(surface(Vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                        std::sin(theta) * std::sin(phi))));
+            grid.push_back(surface(
+                Vec3(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi))));
         }
     std::vector<Vec3> hole_dirs;
-    for (int h = 0; h < holes; ++h) hole_dirs.push_back(normalize(Vec3(u(rng), u(rng), u(rng)) + Vec3(1e-3f)));
+    for (int h = 0; h < holes; ++h)
+        hole_dirs.push_back(normalize(Vec3(u(rng), u(rng), u(rng)) + Vec3(1e-3f)));
     auto in_hole = [&](uint32_t a) {
         const Vec3 d = normalize(grid[a]);
         for (const Vec3& h : hole_dirs)

@@ -207,9 +207,10 @@ TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on th
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx2});
 }
 
-TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
-          "[needs AVX-512]" *
-          doctest::skip(!cpu_has_avx512())) {
+TEST_CASE(
+    "BVH4 is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
+    "[needs AVX-512]" *
+    doctest::skip(!cpu_has_avx512())) {
     uint32_t seed = 500;
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx512});
 }

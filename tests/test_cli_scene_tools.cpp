@@ -153,7 +153,8 @@ SceneBench bench_triangle_only_scene() {
 TEST_CASE("bench on a triangle-only scene counts its triangles") {
     const SceneBench r = bench_triangle_only_scene();
     CHECK(r.bench["primitives"] == triangle_count(r.desc));
-    if (!EmbreeReference::available()) CHECK(r.bench["embree"] == "skipped: sahara was built without Embree 3");
+    if (!EmbreeReference::available())
+        CHECK(r.bench["embree"] == "skipped: sahara was built without Embree 3");
 }
 
 TEST_CASE("bench on a triangle-only scene compares with Embree [needs Embree]" *

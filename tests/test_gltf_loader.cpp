@@ -264,8 +264,9 @@ std::pair<fs::path, fs::path> write_duck_like(const fs::path& dir, const std::st
 
     // A camera at (400, 463, -431) looking at the origin, in the unscaled units of the mesh.
     const Vec3d eye(400.113, 463.264, -431.078);
-    const Vec3d back = normalize(eye), right = normalize(cross(Vec3d(0, 1, 0), back)), up = cross(back, right);
-    const json camera_matrix = {right.x, right.y, right.z, 0, up.x, up.y, up.z, 0,
+    const Vec3d back = normalize(eye), right = normalize(cross(Vec3d(0, 1, 0), back)),
+                up = cross(back, right);
+    const json camera_matrix = {right.x, right.y, right.z, 0, up.x,  up.y,  up.z,  0,
                                 back.x,  back.y,  back.z,  0, eye.x, eye.y, eye.z, 1};
     json j = {
         {"asset", {{"version", "2.0"}}},
@@ -299,7 +300,10 @@ std::pair<fs::path, fs::path> write_duck_like(const fs::path& dir, const std::st
            {"count", ico.positions.size()},
            {"min", {box.lo.x, box.lo.y, box.lo.z}},
            {"max", {box.hi.x, box.hi.y, box.hi.z}}},
-          {{"bufferView", 0}, {"byteOffset", 12}, {"componentType", 5126}, {"type", "VEC3"},
+          {{"bufferView", 0},
+           {"byteOffset", 12},
+           {"componentType", 5126},
+           {"type", "VEC3"},
            {"count", ico.positions.size()}},
           {{"bufferView", 1}, {"componentType", 5126}, {"type", "VEC2"}, {"count", ico.positions.size()}},
           {{"bufferView", 2}, {"componentType", 5123}, {"type", "SCALAR"}, {"count", idx.size()}}}}};
@@ -330,7 +334,8 @@ void check_gltf_loads(const fs::path& file, size_t scene_tris, bool exact_box) {
     for (int m : mats) {
         if (m < 0) continue;
         const json& mat = j["materials"][size_t(m)];
-        if (mat.contains("pbrMetallicRoughness") && mat["pbrMetallicRoughness"].contains("baseColorTexture")) {
+        if (mat.contains("pbrMetallicRoughness") &&
+            mat["pbrMetallicRoughness"].contains("baseColorTexture")) {
             const json& tex =
                 j["textures"][mat["pbrMetallicRoughness"]["baseColorTexture"]["index"].get<size_t>()];
             texs.insert({tex.value("source", -1), tex.value("sampler", -1)});
@@ -389,7 +394,7 @@ TEST_CASE("a Duck-like glTF (scaled root, camera child, interleaved strides) loa
     check_gltf_loads(glb, tris, true);
 }
 
-TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale; Cameras has both kinds") {
+TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale, and Cameras has both kinds") {
     const fs::path duck_file = write_duck_like(scratch("duck_camera"), "duck").first;
     const LoadedModel duck = load_gltf(duck_file);
     REQUIRE(duck.cameras.size() == 1);

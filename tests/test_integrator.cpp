@@ -56,7 +56,7 @@ TEST_CASE("max_depth D counts rays per path, camera ray included") {
     CHECK(radiance_stats(scene, ray, 8, 1).mean.x == doctest::Approx(1.0f));  // emission only, no variance
 }
 
-TEST_CASE("with a point light, D = 2 is direct light only; D = 3 adds one bounce") {
+TEST_CASE("with a point light, D = 2 is direct light only and D = 3 adds one bounce") {
     SceneDesc d = empty_scene(Rgb(0.0f));
     d.materials.push_back(lambertian(Rgb(0.5f)));
     d.planes.push_back({{0, 0, 0}, {0, 0, 1}, 1});
@@ -206,7 +206,7 @@ TEST_CASE("motion blur: the blurred image's mean equals the average of static re
           doctest::Approx(blurred).epsilon(0.02));
 }
 
-TEST_CASE("scene features pick the kernel; forcing turns everything on") {
+TEST_CASE("scene features pick the kernel, and forcing turns everything on") {
     const Scene plain = build_scene(default_scene());
     CHECK(!plain.features.has_lights);
     CHECK(!plain.features.has_emitters);

@@ -253,8 +253,9 @@ TEST_CASE("mpi: 2 and 3 ranks render bit-identical to one process (uniform and a
     CHECK(meta_value(dir / "a3.exr", "status") == "converged");
 }
 
-TEST_CASE("mpi: a rank killed mid-render ends the job; the checkpoint resumes to the one-go image [needs MPI]" *
-          doctest::skip(!kHaveMpi)) {
+TEST_CASE(
+    "mpi: a rank killed mid-render ends the job, and the checkpoint resumes to the one-go image [needs MPI]" *
+    doctest::skip(!kHaveMpi)) {
     TempDir dir("killed");
     const std::string args = "render " + kWorkshop + " --width 128 --height 96 --threads 1 --spp " +
                              std::to_string(512 / kSlow) + " ";

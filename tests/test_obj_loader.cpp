@@ -128,8 +128,8 @@ void write_obj(const fs::path& file, const TriangleMesh& m) {
     out << std::setprecision(std::numeric_limits<float>::max_digits10);
     for (const Vec3& p : m.positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     for (size_t t = 0; t < m.triangle_count(); ++t)
-        out << "f " << m.indices[3 * t] + 1 << ' ' << m.indices[3 * t + 1] + 1 << ' ' << m.indices[3 * t + 2] + 1
-            << '\n';
+        out << "f " << m.indices[3 * t] + 1 << ' ' << m.indices[3 * t + 1] + 1 << ' '
+            << m.indices[3 * t + 2] + 1 << '\n';
 }
 
 }  // namespace
@@ -142,7 +142,7 @@ TEST_CASE("the OBJ files in tests/data load with their published counts") {
     check_obj_loads(kTestData / "obj/spider/spider.obj", 1368, {56, 5, 5});
 }
 
-TEST_CASE("a 70k-triangle scan-like OBJ loads whole; its zero-area triangles, and only those, are dropped") {
+TEST_CASE("a 70k-triangle scan-like OBJ loads whole, its zero-area triangles, and only those, are dropped") {
     // The big triangle-only file with holes, slivers and degenerate triangles that
     // scanned models are; the expected counts come from the generated mesh itself.
     const TriangleMesh scan = make_scan_mesh_70k();
@@ -278,7 +278,7 @@ TEST_CASE("OBJ normals: given ones are kept, missing ones become flat") {
     CHECK(load_obj(dir / "plain.obj").meshes.at(0).normals.empty());
 }
 
-TEST_CASE("OBJ groups and per-face materials; missing .mtl and textures are warnings") {
+TEST_CASE("OBJ groups and per-face materials, missing .mtl and textures are warnings") {
     const fs::path dir = scratch("groups");
     write(dir / "a.mtl",
           "newmtl red\nKd 1 0 0\nnewmtl tex\nKd 0 1 0\nmap_Kd .\\missing.png\n"
@@ -359,7 +359,7 @@ TEST_CASE("ear clipping handles collinear and repeated vertices") {
     CHECK(a == doctest::Approx(4.0));
 }
 
-TEST_CASE("OBJ map_d grey masks become alpha; map_Ke textures emission") {
+TEST_CASE("OBJ map_d grey masks become alpha, map_Ke textures emission") {
     const fs::path dir = scratch("alpha");
     // A 2x1 single-channel mask: 0 (cut) and 255 (kept).
     const uint8_t px[2] = {0, 255};

@@ -241,8 +241,9 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
         }
 }
 
-TEST_CASE("packets on a 70k-triangle scan-like mesh and on the pairs layout (ray-by-ray fallback) agree "
-          "with single rays") {
+TEST_CASE(
+    "packets on a 70k-triangle scan-like mesh and on the pairs layout (ray-by-ray fallback) agree "
+    "with single rays") {
     PacketSimdGuard guard;
     // Big, bumpy, with holes and slivers: deep trees and ragged packet frusta, as on a real scan.
     const TriangleMesh mesh = make_scan_mesh_70k();
