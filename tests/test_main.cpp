@@ -56,9 +56,11 @@ bool lists_test_cases(int argc, char** argv) {
 
 /// The test cases the filters on the command line select, skipped ones included.
 std::vector<const doctest::TestCaseData*> selected_test_cases(int argc, char** argv) {
-    doctest::Context query(argc, argv);
+    std::vector<char*> args(argv, argv + argc);
+    char list_flag[] = "--list-test-cases";  // a flag: Context::setOption does not set it
+    args.push_back(list_flag);
+    doctest::Context query(int(args.size()), args.data());
     query.setOption("no-skip", true);
-    query.setOption("list-test-cases", true);
     std::ostringstream discard;  // the listing is for this function, not for the user
     query.setCout(&discard);
     query.run();
