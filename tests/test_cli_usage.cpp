@@ -71,7 +71,7 @@ void check_one_line_usage_error(const std::string& args, const std::string& comm
 
 }  // namespace
 
-TEST_CASE("cli usage: an unknown option is one line with a help pointer, for every command") {
+TEST_CASE("cli usage: an unknown option is one line with a help pointer in every command") {
     for (const char* command : {"render", "view", "info", "bvh", "bench", "trace", "converge"}) {
         CAPTURE(command);
         check_one_line_usage_error(std::string(command) + " --bogus", command, "unknown option '--bogus'");
