@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <variant>
 
@@ -202,13 +203,20 @@ IBA::TextAlignY align_y(TextBaseline b) {
                                        : IBA::TextAlignY::Baseline;
 }
 
+/// Whether text_size found glyphs with pixels: it leaves the bounds at INT_MIN
+/// for empty or blank text.
+bool has_ink(const OIIO::ROI& box) {
+    constexpr int unset = std::numeric_limits<int>::min();
+    return box.xbegin != unset && box.ybegin != unset && box.xend > box.xbegin && box.yend > box.ybegin;
+}
+
 /// Vertical text: OpenImageIO draws horizontal text only, so the text is drawn
 /// into an image of its own, turned a quarter anticlockwise and pasted.
 bool draw_vertical_text(OIIO::ImageBuf& canvas, const PlotText& t, const std::string& font,
                         PlotColor background) {
     const int size = canvas_px(t.size), pad = 2;
     const OIIO::ROI box = IBA::text_size(t.text, size, font);
-    if (!box.defined()) return false;
+    if (!has_ink(box)) return box.defined();  // blank text: nothing to draw
     OIIO::ImageBuf label(
         OIIO::ImageSpec(box.width() + 2 * pad, box.height() + 2 * pad, 3, OIIO::TypeDesc::FLOAT));
     IBA::fill(label, rgb(background));
@@ -229,7 +237,7 @@ bool draw_text_with_superscript(OIIO::ImageBuf& canvas, const PlotText& t, const
     const int size = canvas_px(t.size), sup_size = canvas_px(superscript_size(t.size));
     const OIIO::ROI base = IBA::text_size(t.text, size, font);
     const OIIO::ROI sup = IBA::text_size(t.superscript, sup_size, font);
-    if (!base.defined() || !sup.defined()) return false;
+    if (!has_ink(base) || !has_ink(sup)) return false;
     const int gap = kSupersample, width = base.xend + gap + sup.xend;
     const int x = canvas_px(t.at.x) - (t.anchor == TextAnchor::start    ? 0
                                        : t.anchor == TextAnchor::middle ? width / 2
