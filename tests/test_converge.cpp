@@ -246,6 +246,9 @@ TEST_CASE("plot: the PNG is drawn by the codec, with text when a font is found a
     else
         MESSAGE("no font: " << warning);
 
+    // Empty title and axis labels: nothing to draw, no undefined text box measured.
+    CHECK(write_plot_png(file, layout_loglog_plot({}, 300, 200)) == warning);
+
     d.fonts = {"no-such-font-anywhere"};
     CHECK(write_plot_png(file, d).find("no TrueType font") != std::string::npos);
     const auto without_font = read_image(file, false);
