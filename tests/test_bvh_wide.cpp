@@ -12,10 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/bvh_stats.h"
 #include "accel/bvh_wide.h"
-#include "app/mesh_input.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"
 #include "test_data.h"

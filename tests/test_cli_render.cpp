@@ -16,12 +16,12 @@
 #include <vector>
 
 #include "app/cmd_info.h"
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "app/render_args.h"
 #include "geometry/sphere.h"
 #include "io/image_io.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 extern char** environ;
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "accel/embree_reference.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;

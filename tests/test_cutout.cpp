@@ -1,4 +1,4 @@
-// Cut-out (alpha-tested) triangles: the any-hit filter of accel/alpha_filter.h
+// Cut-out (alpha-tested) triangles: the any-hit filter of scene/alpha_filter.h
 // as seen by shadow rays, camera rays, the loaders and the BVH layouts.
 #include <doctest/doctest.h>
 
@@ -8,12 +8,12 @@
 #include <random>
 #include <unistd.h>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "io/image_io.h"
 #include "mesh_fixtures.h"
 #include "render/features.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 using namespace sahara::test;

@@ -15,7 +15,7 @@
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
 #include "mesh_fixtures.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 #include "test_data.h"
 
 using namespace sahara;
@@ -693,7 +693,7 @@ TEST_CASE("KHR_texture_transform is rewritten for sahara's v-up uvs") {
         const float su = scl[0] * u, sv = scl[1] * vg;
         const float tu = off[0] + std::cos(rot) * su - std::sin(rot) * sv;
         const float tv = off[1] + std::sin(rot) * su + std::cos(rot) * sv;
-        // sahara (scene_desc.h, render/texture.cpp): uv = (u, 1 - vg);
+        // sahara (scene_desc.h, scene/texture.cpp): uv = (u, 1 - vg);
         // uv' = offset + [cos sin; -sin cos] * (scale * uv); row = (1 - uv'.y) * height.
         const float xu = t.uv_scale.x * u, xv = t.uv_scale.y * (1 - vg);
         const float pu = t.uv_offset.x + std::cos(t.uv_rotation) * xu + std::sin(t.uv_rotation) * xv;
@@ -860,7 +860,7 @@ TEST_CASE("bad glTF input throws InputError naming file and element") {
     }
 }
 
-TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through render/texture.h") {
+TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through scene/texture.h") {
     // tiny_png: top row red, (0,128,0); bottom row blue, white. uv 0.25/0.75 hit texel centres.
     const fs::path dir = scratch("texels");
     const std::vector<uint8_t> png = tiny_png(dir);

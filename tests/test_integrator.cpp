@@ -8,7 +8,7 @@
 #include "render/film.h"
 #include "render/renderer.h"
 #include "render_test_util.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 using namespace sahara::test;

@@ -27,7 +27,7 @@
 #include "io/image_io.h"
 #include "render/camera.h"
 #include "render/renderer.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 extern char** environ;
 

@@ -7,14 +7,15 @@
 #include <string>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/packet.h"
-#include "app/mesh_input.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
 #include "mesh_fixtures.h"
 #include "render/film.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 using namespace sahara::test;

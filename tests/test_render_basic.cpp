@@ -4,7 +4,7 @@
 
 #include "render/camera.h"
 #include "render/renderer.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 

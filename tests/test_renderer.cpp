@@ -6,7 +6,7 @@
 #include "base/counters.h"
 #include "render/renderer.h"
 #include "render/stats.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 

@@ -171,7 +171,7 @@ TEST_CASE("sobol sampler converges faster than independent on smooth integrands"
 
 #include "render/film.h"
 #include "render/renderer.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 TEST_CASE("sobol sampler: same image with any thread count and any split into passes") {
     SceneDesc d = default_scene();

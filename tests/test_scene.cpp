@@ -3,7 +3,7 @@
 #include "math/rng.h"
 #include "render/camera.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 

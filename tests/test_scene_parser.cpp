@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "base/error.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;

@@ -13,7 +13,7 @@
 #include "render/film.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 using namespace sahara;
 

@@ -4,9 +4,10 @@
 #include <cstring>
 #include <filesystem>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "base/error.h"
-#include "app/mesh_input.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
 #include "geometry/triangle.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"

@@ -5,9 +5,9 @@
 // point and explicit instantiations, so an edit elsewhere in the accelerator cannot
 // change the code GCC makes for the hot loop, and with it the loop's speed. Include only
 // from those files.
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/bvh_wide.h"
-#include "accel/leaf_blocks.inl"
+#include "scene/leaf_blocks.inl"
 
 namespace sahara {
 

@@ -1,11 +1,11 @@
-#include "accel/alpha_filter.h"
+#include "scene/alpha_filter.h"
 
 #include <bit>
 #include <string>
 
 #include "base/log.h"
 #include "geometry/hit.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 #include "scene/scene.h"
 
 namespace sahara {

@@ -19,8 +19,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "accel/accelerator.h"
-#include "accel/leaf_blocks.inl"
+#include "scene/accelerator.h"
+#include "scene/leaf_blocks.inl"
 #include "accel/packet.h"
 
 namespace sahara {

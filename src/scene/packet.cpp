@@ -9,7 +9,7 @@
 #include <cstring>
 #include <type_traits>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 
 namespace sahara {
 
@@ -68,7 +68,7 @@ bool packet_eligible(const RayPacket& p, PacketContext& c) {
 #pragma GCC optimize("fp-contract=off")
 namespace packet_sse2 {
 #define SAHARA_PACKET_ISA 128
-#include "accel/packet_kernel.inc"
+#include "scene/packet_kernel.inc"
 #undef SAHARA_PACKET_ISA
 }  // namespace packet_sse2
 #pragma GCC pop_options
@@ -78,7 +78,7 @@ namespace packet_sse2 {
 #pragma GCC optimize("fp-contract=off")
 namespace packet_avx2 {
 #define SAHARA_PACKET_ISA 256
-#include "accel/packet_kernel.inc"
+#include "scene/packet_kernel.inc"
 #undef SAHARA_PACKET_ISA
 }  // namespace packet_avx2
 #pragma GCC pop_options
@@ -88,7 +88,7 @@ namespace packet_avx2 {
 #pragma GCC optimize("fp-contract=off")
 namespace packet_avx512 {
 #define SAHARA_PACKET_ISA 512
-#include "accel/packet_kernel.inc"
+#include "scene/packet_kernel.inc"
 #undef SAHARA_PACKET_ISA
 }  // namespace packet_avx512
 #pragma GCC pop_options

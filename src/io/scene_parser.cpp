@@ -1,4 +1,4 @@
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 #include <cmath>
 #include <cstring>
@@ -7,7 +7,7 @@
 
 #include "base/error.h"
 #include "io/image_io.h"
-#include "scene/scene_parser_internal.h"
+#include "io/scene_parser_internal.h"
 
 namespace sahara {
 

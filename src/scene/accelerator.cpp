@@ -1,4 +1,4 @@
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 
 #include <time.h>
 #include <unistd.h>
@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "accel/box_intersect.h"
-#include "accel/leaf_blocks.inl"
+#include "scene/leaf_blocks.inl"
 #include "scene/scene.h"
 
 namespace sahara {

@@ -1,5 +1,5 @@
 // The wide-BVH traversal compiled for AVX-512 (see trace_wide.inl).
-#include "accel/trace_wide.inl"
+#include "scene/trace_wide.inl"
 
 namespace sahara {
 

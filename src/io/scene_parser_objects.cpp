@@ -5,7 +5,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
-#include "scene/scene_parser_internal.h"
+#include "io/scene_parser_internal.h"
 
 namespace sahara {
 

@@ -19,7 +19,7 @@
 
 #include "math/ray.h"
 #include "math/vec3.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

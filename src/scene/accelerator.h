@@ -5,14 +5,14 @@
 /// in the primitive id (geometry/hit.h) with a switch, never a virtual call.
 /// The accelerator copies the primitive data it tests (triangle vertices in
 /// leaf order, spheres, boxes), so it stays valid when the Scene is moved.
-/// Scenes with cut-out triangles (accel/alpha_filter.h) run a second
+/// Scenes with cut-out triangles (scene/alpha_filter.h) run a second
 /// instantiation of the traversal whose triangle hits pass the alpha test
 /// before they count; the others run the traversal without it.
 #include <algorithm>
 #include <string_view>
 #include <vector>
 
-#include "accel/alpha_filter.h"
+#include "scene/alpha_filter.h"
 #include "accel/bvh.h"
 #include "accel/bvh_wide.h"
 #include "accel/bvh4_leaf.h"
@@ -144,7 +144,7 @@ class Accelerator {
     double build_cpu_ms() const { return build_cpu_ms_; }
     size_t primitive_count() const { return primitive_count_; }
     /// Whether traversal runs the cut-out (alpha-tested) variant: the scene has
-    /// triangles with a cut-out material (accel/alpha_filter.h).
+    /// triangles with a cut-out material (scene/alpha_filter.h).
     bool has_cutouts() const { return !alpha_.empty(); }
     /// The alpha test applied to cut-out triangle hits.
     const AlphaFilter& alpha_filter() const { return alpha_; }

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "io/model_loader.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

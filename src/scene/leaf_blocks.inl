@@ -5,7 +5,7 @@
 // wide8 packet traversal (packet_wide8.cpp). Include only from those.
 #include <immintrin.h>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/bvh4_leaf.h"
 
 namespace sahara {

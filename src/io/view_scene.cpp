@@ -1,11 +1,11 @@
-#include "scene/view_scene.h"
+#include "io/view_scene.h"
 
 #include <cmath>
 
 #include "base/error.h"
 #include "base/log.h"
 #include "math/bounds.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 namespace sahara {
 

@@ -4,7 +4,7 @@
 /// at the bottom row of the image.
 #include <vector>
 
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

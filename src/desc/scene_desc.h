@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/bvh.h"
+#include "base/bvh_choice.h"
 #include "math/bounds.h"
 #include "math/transform.h"
 #include "math/vec3.h"
@@ -34,7 +34,7 @@ struct TextureDesc {
     std::shared_ptr<const Image> image;
     WrapMode wrap_u = WrapMode::repeat, wrap_v = WrapMode::repeat;
     /// uv' = [offset] + rotate(rotation) * (scale * uv), rotate(a) = [cos a, sin a; -sin a, cos a]
-    /// as render/texture.cpp applies it (glTF's transform, expressed in these v-up uvs).
+    /// as scene/texture.cpp applies it (glTF's transform, expressed in these v-up uvs).
     Vec2 uv_offset{0, 0}, uv_scale{1, 1};
     float uv_rotation = 0;
     int texcoord = 0;  ///< which UV set (only set 0 is stored on meshes today)

@@ -6,8 +6,8 @@
 #include <string>
 #include <unordered_map>
 
-#include "scene/json_reader.h"
-#include "scene/scene_parser.h"
+#include "io/json_reader.h"
+#include "io/scene_parser.h"
 
 namespace sahara {
 
