@@ -9,7 +9,7 @@
 
 #include "math/bounds.h"
 #include "math/ray.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara::test {
 

@@ -5,7 +5,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "app/mesh_input.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
 #include "mesh_fixtures.h"
 
 namespace sahara::test {

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "base/bvh_choice.h"
 #include "math/bounds.h"
 
 namespace sahara {
@@ -83,18 +84,6 @@ struct Bvh {
     size_t bytes() const { return nodes.size() * sizeof(BvhNode) + prim_indices.size() * sizeof(uint32_t); }
 };
 
-enum class BvhBuilder : uint8_t {
-    binned,    ///< binned SAH, parallel over subtrees (fast default)
-    sweep,     ///< exact sweep SAH over all centroid-sorted splits (quality reference)
-    reinsert,  ///< binned SAH, then insertion-based reinsertion (accel/bvh_optimize.cpp)
-};
-
-/// The builder used unless a scene ("render": {"bvh_builder"}) or --builder says otherwise.
-/// Binned: on a typical render (some 60M rays) the better trees of sweep and reinsert
-/// save no more tracing time than their slower builds cost, and on shorter renders the
-/// build dominates. Reinsert pays off on long renders of meshes with uneven triangle sizes.
-inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::binned;
-
 /// SAH cost model and build limits. The costs are relative: visiting an inner
 /// node (two box tests) costs `traversal`, testing one primitive costs
 /// `intersection`. A node becomes a leaf when that is cheaper than its best split.
@@ -144,17 +133,6 @@ inline constexpr int kBvhMedianSplitDepth = 32;
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out);
 /// "binned", "sweep" or "reinsert".
 const char* bvh_builder_name(BvhBuilder builder);
-
-/// Traversal structure built from the binary SAH tree (accel/accelerator.h).
-enum class BvhLayout : uint8_t {
-    wide4,        ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
-    wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
-    pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
-    wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
-};
-
-/// The layout used unless --layout says otherwise (render, view, bench, bvh).
-inline constexpr BvhLayout kDefaultBvhLayout = BvhLayout::wide8;
 
 /// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
 inline bool layout_has_blocks(BvhLayout layout) {

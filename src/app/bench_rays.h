@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "math/ray.h"
 #include "scene/scene.h"
 

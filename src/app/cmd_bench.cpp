@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "app/bench_rays.h"
 #include "app/commands.h"
 #include "app/mesh_input.h"

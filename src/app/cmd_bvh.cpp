@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/bvh_stats.h"
 #include "app/bench_rays.h"
 #include "app/commands.h"

@@ -19,7 +19,7 @@
 #include "render/progress.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 namespace sahara {
 

@@ -12,7 +12,7 @@
 #include "render/features.h"
 #include "render/stats.h"
 #include "scene/scene.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 namespace sahara {
 

@@ -23,7 +23,7 @@
 #include "render/features.h"
 #include "render/stats.h"
 #include "render/tonemap.h"
-#include "scene/scene_parser.h"
+#include "io/scene_parser.h"
 
 namespace sahara {
 

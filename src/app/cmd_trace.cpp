@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "app/commands.h"
 #include "app/mesh_input.h"
 #include "app/tool_args.h"

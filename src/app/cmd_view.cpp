@@ -6,7 +6,7 @@
 #include "app/render_args.h"
 #include "app/tool_args.h"
 #include "io/model_loader.h"
-#include "scene/view_scene.h"
+#include "io/view_scene.h"
 
 namespace sahara {
 

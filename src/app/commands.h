@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "app/render_args.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -1,32 +1,14 @@
 #pragma once
-/// A small private OBJ reader for the BVH tools (`sahara bvh`, `bench`,
-/// `trace`) and their tests, until they switch to io/model_loader.h.
-///
-/// Primitive order (the `trace` command's primitive indices): triangles in
-/// file order; a polygon v0 v1 ... vk is fan-split into (v0,v1,v2),
-/// (v0,v2,v3), ..., (v0,vk-1,vk). Concave polygons are fan-split the same way,
-/// without ear clipping, so their fan may cover area outside the polygon.
-/// Zero-area triangles are KEPT so that indices stay file-order indices.
-/// Only positions are read (the tools need no normals, UVs or materials).
+/// What the BVH tools (`sahara bvh`, `bench`, `trace`) read: a mesh
+/// (io/mesh_triangles.h, scene/mesh_scene.h) or a whole scene file.
 #include <filesystem>
 #include <string>
 
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
 #include "scene/scene.h"
-#include "scene/scene_desc.h"
 
 namespace sahara {
-
-/// Reads positions and fan-split triangles of an OBJ file; throws InputError
-/// for a missing or malformed file, an out-of-range index or a non-finite position.
-TriangleMesh read_obj_triangles(const std::filesystem::path& file);
-
-/// Triangles of any mesh file: OBJ through read_obj_triangles (file order kept,
-/// degenerate triangles kept), .gltf/.glb through the glTF loader with every
-/// mesh of the default scene merged into one.
-TriangleMesh read_mesh_triangles(const std::filesystem::path& file);
-
-/// A Scene holding only `mesh`'s triangles (no BVH yet; call build_accelerator or build an Accelerator).
-Scene scene_from_mesh(const TriangleMesh& mesh);
 
 /// Whether the BVH tools read `file` as a scene file (extension .json) rather than a mesh.
 bool is_scene_file(const std::filesystem::path& file);

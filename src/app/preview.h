@@ -9,7 +9,7 @@
 
 #include "render/film.h"
 #include "render/renderer.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/embree_reference.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

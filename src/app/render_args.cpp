@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "accel/bvh.h"
 #include "render/tonemap.h"
 
 namespace sahara {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -7,7 +7,7 @@
 
 #include "math/bounds.h"
 #include "math/transform.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

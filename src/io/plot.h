@@ -3,9 +3,6 @@
 /// texts (PlotDrawing), then written as SVG (here) or drawn into a PNG by the
 /// image codec plugin (OpenImageIO's line, box and TrueType text renderers).
 /// The drawing types use the standard library only, so the plugin can read them.
-///
-/// Raster and its 5x7 bitmap font remain only for the bvh-cost heat map legend
-/// (render/bvh_cost.cpp); plots do not use them.
 #include <string>
 #include <variant>
 #include <vector>
@@ -110,20 +107,5 @@ struct TickLabel {
 
 /// Tick label of 10^e: decimal for -3 <= e <= 3 ("0.01", "100"), else a power of ten.
 TickLabel decade_label(int e);
-
-/// A linear RGB raster, row 0 at the top (what write_image takes).
-struct Raster {
-    int width = 0, height = 0;
-    std::vector<float> rgb;
-    Raster(int w, int h, Rgb fill);
-    void set(int x, int y, Rgb c);
-    void fill_rect(int x0, int y0, int x1, int y1, Rgb c);
-    /// Draws text in the 5x7 bitmap font with its top-left corner at (x, y);
-    /// `scale` pixels per font dot.
-    void text(int x, int y, const std::string& s, Rgb c, int scale = 2);
-};
-
-/// Width in pixels of `s` drawn by Raster::text at `scale`.
-int text_width(const std::string& s, int scale = 2);
 
 }  // namespace sahara

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "math/sampling.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

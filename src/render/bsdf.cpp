@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "render/texture.h"
+#include "scene/texture.h"
 
 namespace sahara {
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <string>
 
-#include "accel/accelerator.h"
-#include "io/plot.h"
+#include "scene/accelerator.h"
 #include "render/camera.h"
+#include "render/raster.h"
 
 namespace sahara {
 

@@ -2,7 +2,7 @@
 /// Camera: both scene-format camera forms (look-at + vfov, and the "20 minutes"
 /// Euler + focal length form) and glTF cameras reduce to one basis here.
 #include "math/ray.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

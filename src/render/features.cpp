@@ -1,6 +1,6 @@
 #include "render/features.h"
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "render/integrator.h"
 
 namespace sahara {

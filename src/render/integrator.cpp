@@ -5,7 +5,7 @@
 #include "render/background.h"
 #include "render/bsdf.h"
 #include "render/lights.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 
 namespace sahara {
 

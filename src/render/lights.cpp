@@ -5,7 +5,7 @@
 #include "geometry/spawn.h"
 #include "math/sampling.h"
 #include "render/background.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 
 namespace sahara {
 

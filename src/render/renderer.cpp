@@ -8,8 +8,7 @@
 #include <exception>
 #include <thread>
 
-#include "accel/accelerator.h"
-#include "accel/packet.h"
+#include "scene/accelerator.h"
 #include "base/counters.h"
 #include "render/camera.h"
 #include "render/integrator.h"

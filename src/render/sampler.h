@@ -8,7 +8,7 @@
 #include "math/rng.h"
 #include "math/vec3.h"
 #include "render/sobol.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 

@@ -4,7 +4,7 @@
 #include "render/background.h"
 #include "render/bsdf.h"
 #include "render/integrator.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 
 namespace sahara {
 

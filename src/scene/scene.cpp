@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <numbers>
 
-#include "accel/accelerator.h"
+#include "scene/accelerator.h"
 #include "accel/packet.h"
 #include "base/counters.h"
 

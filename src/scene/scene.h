@@ -6,11 +6,12 @@
 #include <memory>
 #include <vector>
 
+#include "accel/packet.h"  // RayPacket, HitPacket: the packet interface render uses
 #include "geometry/hit.h"
 #include "geometry/quadric.h"
 #include "geometry/sphere.h"
 #include "math/distribution.h"
-#include "scene/scene_desc.h"
+#include "desc/scene_desc.h"
 
 namespace sahara {
 
@@ -68,9 +69,7 @@ struct Emitter {
 };
 inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
 
-class Accelerator;  // accel/: the BVH over bounded primitives
-struct RayPacket;   // accel/packet.h
-struct HitPacket;
+class Accelerator;  // scene/accelerator.h: the BVH over bounded primitives
 
 class Scene {
    public:

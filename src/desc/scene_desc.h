@@ -1,0 +1,215 @@
+#pragma once
+/// Plain scene data: what the JSON parser, the built-in scenes and the mesh
+/// loaders produce, and what the renderer builds its runtime Scene from.
+/// No behaviour here and no BVH; indices refer into the vectors of SceneDesc.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/bvh_choice.h"
+#include "math/bounds.h"
+#include "math/transform.h"
+#include "math/vec3.h"
+
+namespace sahara {
+
+/// A decoded image, linear float RGBA, row 0 at the top.
+struct Image {
+    int width = 0, height = 0;
+    std::vector<float> rgba;  ///< width * height * 4 floats
+};
+
+enum class WrapMode : uint8_t { repeat, clamp, mirror };
+
+/// An image texture addressed by UVs. Convention for everything in SceneDesc:
+/// v = 0 is the image BOTTOM (as in OBJ), so the texel row is (1 - v') * height
+/// with Image row 0 at the top. OBJ uvs are stored as written; glTF uvs (v = 0
+/// at the top) are converted at load to v = 1 - v_gltf, and their
+/// KHR_texture_transform is rewritten for the flipped space (gltf_loader.cpp).
+struct TextureDesc {
+    std::string path;  ///< for messages and `sahara info`
+    std::shared_ptr<const Image> image;
+    WrapMode wrap_u = WrapMode::repeat, wrap_v = WrapMode::repeat;
+    /// uv' = [offset] + rotate(rotation) * (scale * uv), rotate(a) = [cos a, sin a; -sin a, cos a]
+    /// as scene/texture.cpp applies it (glTF's transform, expressed in these v-up uvs).
+    Vec2 uv_offset{0, 0}, uv_scale{1, 1};
+    float uv_rotation = 0;
+    int texcoord = 0;  ///< which UV set (only set 0 is stored on meshes today)
+};
+
+/// Where a colour comes from: a constant, a world-space 3-D checker, or a texture
+/// (times `color`, which then acts as a factor).
+struct ColorSource {
+    enum class Kind : uint8_t { constant, checker, texture } kind = Kind::constant;
+    Rgb color{0.5f, 0.5f, 0.5f};
+    Rgb even{0.9f, 0.9f, 0.9f}, odd{0.1f, 0.1f, 0.1f};
+    float checker_scale = 1.0f;  ///< size of one checker cell in scene units
+    int texture = -1;            ///< index into SceneDesc::textures
+};
+
+enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive };
+
+struct MaterialDesc {
+    std::string name;
+    MaterialType type = MaterialType::lambertian;
+    ColorSource albedo;                                            ///< lambertian and metal
+    float roughness = 0.0f;                                        ///< metal
+    float ior = 1.5f;                                              ///< dielectric
+    ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};  ///< emissive (front side)
+    /// Lambertian only: radiance it also emits, from both sides. Not light-sampled
+    /// (found by BSDF sampling only); meant for analytic scenes such as the closed
+    /// glowing sphere whose radiance is emission / (1 - albedo).
+    Rgb emission{0.0f, 0.0f, 0.0f};
+    /// Cut-outs: alpha in [0,1] (times the texture's alpha when alpha_texture >= 0).
+    float alpha = 1.0f;
+    int alpha_texture = -1;
+    std::optional<float> alpha_cutoff;  ///< set: MASK; unset with alpha < 1 or texture: stochastic
+};
+
+/// Either form of the scene-format camera; the renderer turns both into one basis.
+struct CameraDesc {
+    Vec3 position{0, 0, 0};
+    // look-at form
+    Vec3 look_at{0, 1, 0};
+    Vec3 up{0, 0, 1};
+    float vfov = 40.0f;  ///< degrees
+    // "20 minutes" form: rotations about X, Y, Z (degrees) of right=+X, up=+Y, front=+Z
+    bool euler_form = false;
+    Vec3 euler{0, 0, 0};
+    float focal_length = 1.0f;  ///< view plane 1 unit wide at this distance
+    // glTF-sourced cameras give an explicit basis instead (see SceneDesc loaders)
+    bool has_basis = false;
+    Vec3 basis_right, basis_up, basis_forward;
+    bool orthographic = false;
+    float ortho_height = 2.0f;  ///< full height of the orthographic view
+    // lens and shutter
+    float aperture = 0.0f;                ///< lens diameter; 0 = pinhole
+    std::optional<float> focus_distance;  ///< default: distance to look_at
+    float shutter_open = 0.0f, shutter_close = 1.0f;
+};
+
+struct BackgroundDesc {
+    enum class Type : uint8_t { constant, gradient, envmap } type = Type::gradient;
+    Rgb color{1, 1, 1};
+    Rgb bottom{1, 1, 1}, top{0.5f, 0.7f, 1.0f};
+    Vec3 up{0, 0, 1};
+    std::string file;
+    float strength = 1.0f;
+    std::shared_ptr<const Image> image;  ///< envmap, linear RGB
+};
+
+struct SphereDesc {
+    Vec3 center;
+    float radius = 1;
+    uint32_t material = 0;
+    Vec3 velocity{0, 0, 0};  ///< centre(t) = center + velocity * t
+};
+
+struct PlaneDesc {
+    Vec3 point, normal{0, 0, 1};
+    uint32_t material = 0;
+};
+
+struct BoxDesc {
+    Vec3 lo, hi;
+    uint32_t material = 0;
+};
+
+/// Indexed triangles with optional per-vertex normals and UVs, already in
+/// world space (transforms are applied at load).
+struct TriangleMesh {
+    std::string name;  ///< source file and element, for messages and stats
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;           ///< empty, or one per position
+    std::vector<Vec2> uvs;               ///< empty, or one per position
+    std::vector<uint32_t> indices;       ///< 3 per triangle, counter-clockwise = front
+    std::vector<uint32_t> material_ids;  ///< empty (all use `material`) or one per triangle
+    uint32_t material = 0;
+
+    size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// A bounded quadric surface: the format's ellipsoid, cylinder, cone, paraboloid,
+/// hyperboloid and general `quadric` objects. Every type is reduced to one
+/// canonical form for the renderer: the implicit surface
+///   A x² + B y² + C z² + D xy + E xz + F yz + G x + H y + I z + J = 0
+/// in a local frame, clipped to the axis-aligned box `local_bounds` of that frame,
+/// placed by `world_from_local`. The named forms put their symmetry axis on local
+/// +z with the named point (centre, base, apex, vertex) at the local origin.
+/// The parameters as written in the scene are kept for messages and `sahara info`.
+struct QuadricDesc {
+    enum class Type : uint8_t { ellipsoid, cylinder, cone, paraboloid, hyperboloid, general };
+    Type type = Type::general;
+    // --- parameters as written (before the object's transform) ---
+    Vec3 origin{0, 0,
+                0};  ///< centre (ellipsoid, hyperboloid), base (cylinder), apex (cone), vertex (paraboloid)
+    Vec3 axis{0, 0, 1};   ///< unit symmetry axis (not used by ellipsoid and general)
+    Vec3 radii{1, 1, 1};  ///< ellipsoid semi-axes along the scene's x, y, z
+    float radius = 1;     ///< cylinder; paraboloid at `height`; hyperboloid at both ends
+    float height = 1;     ///< cylinder, cone, paraboloid: from origin along axis; hyperboloid: total, centred
+    float angle = 45;     ///< cone: half-angle between axis and side, degrees, in (0, 90)
+    float waist = 0.5f;   ///< hyperboloid: radius at the centre, 0 < waist < radius
+    bool capped = false;  ///< cylinder: discs at both ends; cone: disc at the open end
+    // --- canonical form ---
+    std::array<double, 10> coefficients{};  ///< A..J above, in the local frame
+    Bounds3 local_bounds;                   ///< clip box in the local frame
+    Mat4 world_from_local, local_from_world;
+    Bounds3 world_bounds;  ///< bounds of the transformed clip box (conservative)
+    uint32_t material = 0;
+};
+
+struct LightDesc {
+    enum class Type : uint8_t { point, directional } type = Type::point;
+    Vec3 position{0, 0, 0};
+    Vec3 direction{0, 0, -1};  ///< direction the light travels
+    Rgb intensity{0, 0, 0};    ///< point: W/sr
+    Rgb irradiance{0, 0, 0};   ///< directional: on a surface facing it
+};
+
+enum class IntegratorType : uint8_t { path, whitted, albedo, normals, depth, bvh_cost };
+enum class Tonemap : uint8_t { clamp, reinhard, aces, filmic };
+/// Where the per-sample random numbers come from: Owen-scrambled Sobol
+/// (low discrepancy, the default) or independent uniform random numbers.
+enum class SamplerType : uint8_t { sobol, independent };
+
+struct RenderSettings {
+    int width = 640, height = 480;
+    int spp = 64;
+    int max_depth = 8;  ///< rays per path, camera ray included
+    uint64_t seed = 0;
+    IntegratorType integrator = IntegratorType::path;
+    std::optional<double> time_limit_s;
+    std::optional<double> target_error;
+    float exposure = 0.0f;  ///< stops
+    Tonemap tonemap = Tonemap::clamp;
+    SamplerType sampler = SamplerType::sobol;     ///< command line only (--sampler)
+    BvhBuilder bvh_builder = kDefaultBvhBuilder;  ///< "bvh_builder" / --builder
+    BvhLayout bvh_layout = kDefaultBvhLayout;     ///< command line only (--layout)
+};
+
+struct SceneDesc {
+    std::string source;  ///< scene file path, or "<default>" for the built-in scene
+    RenderSettings render;
+    CameraDesc camera;
+    BackgroundDesc background;
+    std::vector<MaterialDesc> materials;  ///< index 0 is the default material
+    std::vector<TextureDesc> textures;
+    std::vector<SphereDesc> spheres;
+    std::vector<PlaneDesc> planes;
+    std::vector<BoxDesc> boxes;
+    std::vector<TriangleMesh> meshes;
+    std::vector<QuadricDesc> quadrics;  ///< bounded quadrics (ellipsoid, cylinder, cone, ...)
+    std::vector<LightDesc> lights;
+};
+
+/// The default material of the scene format: lambertian [0.5, 0.5, 0.5].
+inline MaterialDesc default_material() {
+    MaterialDesc m;
+    m.name = "default";
+    return m;
+}
+
+}  // namespace sahara

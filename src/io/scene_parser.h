@@ -1,0 +1,49 @@
+#pragma once
+/// Reads scene files (format "scene/1", see scenes/FORMAT.md) into plain
+/// SceneDesc data, strictly: unknown keys, wrong types and out-of-range values
+/// throw InputError naming the file, the JSON path and what was expected.
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "io/model_loader.h"
+#include "desc/scene_desc.h"
+
+namespace sahara {
+
+/// The file readers the parser calls; tests substitute their own.
+struct SceneLoaders {
+    /// Loads a mesh file with `world_from_model` applied (default: load_model).
+    std::function<LoadedModel(const std::filesystem::path&, const Mat4&)> load_model;
+    /// Reads an image, optionally sRGB-decoded (default: read_image).
+    std::function<std::shared_ptr<const Image>(const std::filesystem::path&, bool srgb_to_linear)> read_image;
+
+    /// The real loaders (io/model_loader.h, io/image_io.h).
+    static SceneLoaders standard();
+};
+
+/// Reads, parses and validates a scene file; paths inside resolve relative to it.
+SceneDesc parse_scene_file(const std::filesystem::path& file);
+
+/// Parses scene JSON text. `file` names the scene in messages and is the base
+/// for relative paths (its parent directory).
+SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file);
+/// As above, with substitute loaders.
+SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file,
+                           const SceneLoaders& loaders);
+
+/// The built-in scene (the workshop's final image): a red sphere on a big green
+/// ground sphere under the white-to-blue gradient sky, z up.
+SceneDesc default_scene();
+
+/// Appends a loaded model to `scene`: its materials and textures are appended
+/// with every index shifted, its lights appended. With `material_override`,
+/// every triangle uses that material instead and the model's own are dropped.
+void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uint32_t> material_override);
+
+/// Inverse of an affine matrix (last row 0 0 0 1, invertible upper 3x3).
+Mat4 affine_inverse(const Mat4& m);
+
+}  // namespace sahara

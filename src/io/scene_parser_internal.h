@@ -1,0 +1,33 @@
+#pragma once
+/// Shared state of one scene parse, split over scene_parser.cpp (settings,
+/// camera, background, materials) and scene_parser_objects.cpp (objects, lights).
+#include <filesystem>
+#include <map>
+#include <string>
+#include <unordered_map>
+
+#include "io/json_reader.h"
+#include "io/scene_parser.h"
+
+namespace sahara {
+
+struct ParseContext {
+    std::string file;            ///< scene file name as given, for messages
+    std::filesystem::path base;  ///< directory relative paths resolve against
+    const SceneLoaders* loaders = nullptr;
+    SceneDesc* scene = nullptr;
+    std::unordered_map<std::string, uint32_t> material_by_name;
+    std::map<std::pair<std::string, bool>, int> texture_by_path;  ///< (resolved path, srgb) -> index
+
+    /// Resolves a relative path from `where` and checks that the file exists.
+    std::filesystem::path resolve_existing(const JsonValue& where) const;
+    /// Texture index for the image file named by `where` (loaded once per path and mode).
+    int texture(const JsonValue& where, bool srgb);
+    /// Material index for a `"material": "name"` value.
+    uint32_t material(const JsonValue& where) const;
+};
+
+void parse_objects(ParseContext& ctx, const JsonValue& objects);
+void parse_lights(ParseContext& ctx, const JsonValue& lights);
+
+}  // namespace sahara

@@ -1,0 +1,426 @@
+#include "scene/accelerator.h"
+
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "accel/box_intersect.h"
+#include "scene/leaf_blocks.inl"
+#include "scene/scene.h"
+
+namespace sahara {
+
+namespace {
+
+/// Loops over fewer items than this stay serial (a parallel region costs more).
+constexpr int64_t kParallelLoopMin = 8192;
+
+/// The builder's view of the scene: one box, one centre and one id per primitive.
+struct PrimitiveList {
+    std::vector<Bounds3> boxes;
+    std::vector<Vec3> centers;
+    std::vector<uint32_t> ids;
+
+    void set(size_t k, const Bounds3& b, uint32_t id) {
+        // A primitive with non-finite coordinates can never be hit; give it an
+        // empty box (ignored by node bounds) and a harmless centre.
+        const bool finite = is_finite(b.lo) && is_finite(b.hi);
+        boxes[k] = finite ? b : Bounds3{};
+        centers[k] = finite ? b.center() : Vec3(0.0f);
+        ids[k] = id;
+    }
+};
+
+PrimitiveList collect_primitives(const Scene& scene) {
+    PrimitiveList list;
+    const TriangleSoup& soup = scene.triangles;
+    const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
+    list.boxes.resize(n);
+    list.centers.resize(n);
+    list.ids.resize(n);
+    const auto triangles = int64_t(soup.size());
+#pragma omp parallel for schedule(static) if (triangles > kParallelLoopMin)
+    for (int64_t i = 0; i < triangles; ++i) {
+        Bounds3 b;
+        for (int k = 0; k < 3; ++k) b.extend(soup.positions[soup.indices[3 * size_t(i) + size_t(k)]]);
+        list.set(size_t(i), b, make_prim_id(PrimKind::triangle, uint32_t(i)));
+    }
+    size_t k = soup.size();
+    for (uint32_t i = 0; i < scene.spheres.size(); ++i)
+        list.set(k++, scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
+                 make_prim_id(PrimKind::sphere, i));
+    for (uint32_t i = 0; i < scene.boxes.size(); ++i)
+        list.set(k++, scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+    for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
+        list.set(k++, scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
+    return list;
+}
+
+/// Bytes of L2 cache per core (1 MiB when the system does not say).
+size_t l2_cache_bytes() {
+    const long bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
+    return bytes > 0 ? size_t(bytes) : size_t(1) << 20;
+}
+
+double process_cpu_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
+/// The flat loop: one root leaf over every primitive.
+Bvh single_leaf_bvh(const PrimitiveList& prims) {
+    Bvh bvh;
+    const auto n = uint32_t(prims.ids.size());
+    if (n == 0) return bvh;
+    Bounds3 all;
+    for (const Bounds3& b : prims.boxes) all.extend(b);
+    BvhNode root{};
+    root.set_box(all);
+    root.index = 0;
+    root.count = n;
+    bvh.nodes.push_back(root);
+    for (uint32_t i = 0; i < n; ++i) bvh.prim_indices.push_back(i);
+    return bvh;
+}
+
+}  // namespace
+
+const char* bvh_layout_name(BvhLayout layout) {
+    switch (layout) {
+        case BvhLayout::pairs:
+            return "pairs";
+        case BvhLayout::wide4_slots:
+            return "wide4-slots";
+        case BvhLayout::wide8:
+            return "wide8";
+        case BvhLayout::wide4:
+            break;
+    }
+    return "wide4";
+}
+
+bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
+    if (text == "wide4")
+        out = BvhLayout::wide4;
+    else if (text == "wide4-slots")
+        out = BvhLayout::wide4_slots;
+    else if (text == "pairs")
+        out = BvhLayout::pairs;
+    else if (text == "wide8")
+        out = BvhLayout::wide8;
+    else
+        return false;
+    return true;
+}
+
+Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
+    : spheres_(scene.spheres), quadrics_(scene.quadrics), alpha_(scene) {
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = process_cpu_ms();
+    for (const Box& b : scene.boxes) boxes_.push_back(b.box);
+    const PrimitiveList prims = collect_primitives(scene);
+    uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
+    const BvhBuildParams params = options.build_params();
+    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
+                      : single_leaf_bvh(prims);
+    // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
+    const size_t slots = bvh_.prim_indices.size();
+    std::vector<uint32_t> ids(slots);
+    std::vector<TriangleVerts> tris(slots);
+    const TriangleSoup& soup = scene.triangles;
+#pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
+    for (size_t s = 0; s < slots; ++s) {
+        ids[s] = prims.ids[bvh_.prim_indices[s]];
+        tris[s] = TriangleVerts{};
+        if (prim_kind(ids[s]) == PrimKind::triangle) {
+            const uint32_t* v = &soup.indices[3 * size_t(prim_index(ids[s]))];
+            tris[s] = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
+        }
+    }
+    layout_ = options.layout;
+    if (layout_ == BvhLayout::pairs)
+        pairs_ = make_bvh_pairs(bvh_);
+    else {
+        // Merging leaves only pays where a leaf is tested in blocks.
+        const WideCollapse wc = layout_has_blocks(layout_) ? options.collapse : WideCollapse{};
+        if (layout_ == BvhLayout::wide8)
+            wide8_ = make_bvh_wide<8>(bvh_, wc);
+        else
+            wide_ = make_bvh4(bvh_, wc);
+    }
+    if (layout_has_blocks(layout_)) {
+        // The tree and the blocks are all the block layouts keep (plus others_).
+        if (layout_ == BvhLayout::wide8)
+            make_leaf_blocks(wide8_, ids, tris);
+        else
+            make_leaf_blocks(wide_, ids, tris);
+    } else {
+        slots_.resize(slots);
+        for (size_t s = 0; s < slots; ++s) slots_[s] = Slot{tris[s], ids[s]};
+    }
+    if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
+    primitive_count_ = bvh_.prim_indices.size();
+    if (layout_has_blocks(layout_) && !options.keep_binary_tree) bvh_ = Bvh{};
+    if (layout_ == BvhLayout::wide8 && options.node_pairing != NodePairing::never) {
+        if (options.node_pairing == NodePairing::always)
+            pair_rays_ = PairRays::all;
+        else if (bytes() > l2_cache_bytes())
+            pair_rays_ = PairRays::inside;
+    }
+    build_cpu_ms_ = process_cpu_ms() - cpu_start;
+    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
+/// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
+/// The blocks are in node order, leaves numbered by a serial prefix sum, filled in parallel.
+template <int N>
+void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
+                                   const std::vector<TriangleVerts>& tris) {
+    // Non-triangle slots get consecutive entries of others_ in slot order (fixed
+    // before the parallel fill, so the result does not depend on the threads).
+    std::vector<uint32_t> other_rank;
+    const size_t other_count = size_t(std::count_if(
+        ids.begin(), ids.end(), [](uint32_t id) { return prim_kind(id) != PrimKind::triangle; }));
+    if (other_count) {
+        other_rank.resize(ids.size());
+        uint32_t k = 0;
+        for (size_t s = 0; s < ids.size(); ++s)
+            if (prim_kind(ids[s]) != PrimKind::triangle) other_rank[s] = k++;
+    }
+    others_.assign(other_count, 0);
+    auto fill_leaf = [&](uint32_t first, uint32_t count, uint32_t block) {
+        for (uint32_t s = first; s < first + count; s += 4, ++block) {
+            TriangleBlock4& b = blocks_[block];
+            for (int l = 0; l < 4; ++l) {
+                const uint32_t slot = s + uint32_t(l);
+                const bool in_leaf = slot < first + count;
+                const bool tri = in_leaf && prim_kind(ids[slot]) == PrimKind::triangle;
+                if (!in_leaf) {
+                    b.slot[l] = TriangleBlock4::kEmptyLane;
+                } else if (tri) {
+                    b.slot[l] = ids[slot];
+                } else {
+                    b.slot[l] = other_rank[slot] | TriangleBlock4::kOtherKind;
+                    others_[other_rank[slot]] = ids[slot];
+                }
+                for (int v = 0; v < 3; ++v)
+                    for (int a = 0; a < 3; ++a)
+                        b.p[v][a][l] = tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
+            }
+        }
+    };
+    auto blocks_of = [](uint32_t count) { return (count + 3) / 4; };
+    if (tree.empty) return;
+    if (tree.root.is_leaf()) {
+        const auto block = uint32_t(blocks_.size());
+        blocks_.resize(block + blocks_of(tree.root.count));
+        fill_leaf(tree.root.index, tree.root.count, block);
+        tree.root.index = block;
+        return;
+    }
+    const auto nodes = int64_t(tree.nodes.size());
+    std::vector<uint32_t> first_block(tree.nodes.size());
+    auto total = uint32_t(blocks_.size());
+    for (int64_t i = 0; i < nodes; ++i) {
+        first_block[size_t(i)] = total;
+        for (int c = 0; c < N; ++c) total += blocks_of(tree.nodes[size_t(i)].leaf_count(c));
+    }
+    blocks_.resize(total);
+#pragma omp parallel for schedule(static) if (nodes > kParallelLoopMin / N)
+    for (int64_t i = 0; i < nodes; ++i) {
+        BvhWideNode<N>& n = tree.nodes[size_t(i)];
+        uint32_t block = first_block[size_t(i)];
+        for (int c = 0; c < N; ++c)
+            if (const uint32_t count = n.leaf_count(c)) {
+                fill_leaf(ref_first(n.child[c]), count, block);
+                n.child[c] = wide_leaf_ref(block, count);
+                block += blocks_of(count);
+            }
+    }
+}
+
+size_t Accelerator::bytes() const {
+    const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
+                         quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
+    // The block layouts keep only the tree, the blocks (vertices and triangle ids) and the
+    // ids of other kinds.
+    if (layout_has_blocks(layout_))
+        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) +
+               blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) + other;
+    return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
+           bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
+}
+
+/// Tests sphere, box or quadric `id` for a hit in (ray.tmin, tmax); sets its t and u.
+bool Accelerator::intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const {
+    switch (prim_kind(id)) {
+        case PrimKind::sphere: {
+            const Sphere& sp = spheres_[prim_index(id)];
+            Ray r = ray;
+            r.tmax = tmax;
+            const double ts = intersect_sphere(r, sp.center_at(ray.time), sp.radius);
+            if (ts < 0.0) return false;
+            t = float(ts);
+            return true;
+        }
+        case PrimKind::box:
+            return intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t);
+        case PrimKind::quadric: {
+            Ray r = ray;
+            r.tmax = tmax;
+            const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
+            if (!qh.hit()) return false;
+            t = qh.t;
+            u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
+            return true;
+        }
+        default:
+            return false;  // triangles are tested by the caller; planes are never in the tree
+    }
+}
+
+template <bool kAnyHit, class Counters>
+bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
+    return alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
+                          : trace_layout<kAnyHit, true>(ray, hit, counters);
+}
+
+template <bool kAnyHit, bool kCutouts, class Counters>
+bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
+    if (layout_ != BvhLayout::pairs) {
+        // The wide layouts: one traversal body compiled three times (SSE2, AVX2, AVX-512),
+        // each in its own file (trace_wide.inl).
+        const SimdPath path = active_simd_path();
+        const bool blocks = layout_ != BvhLayout::wide4_slots;
+        if (layout_ == BvhLayout::wide8) {
+            if (path == SimdPath::avx512) {
+                // Closest-hit rays pair nodes until their first hit (traverse_wide) where
+                // AcceleratorOptions::node_pairing says so; occlusion rays only on AVX2.
+                if (!kAnyHit && pair_rays_ != PairRays::none &&
+                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                    return trace_wide_avx512<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
+                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
+            }
+            if (path == SimdPath::avx2) {
+                if (pair_rays_ != PairRays::none &&
+                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                    return trace_wide_avx2<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
+                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
+            }
+            return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+        }
+        if (blocks) {
+            if (path == SimdPath::avx512)
+                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
+            if (path == SimdPath::avx2)
+                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
+            return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+        }
+        if (path == SimdPath::avx512)
+            return trace_wide_avx512<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
+        if (path == SimdPath::avx2)
+            return trace_wide_avx2<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
+        return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+    }
+    return trace_pairs<kAnyHit, kCutouts>(ray, hit, counters);
+}
+
+/// The binary tree in pair layout. Not inlined into trace_layout: its frame and
+/// saved registers would otherwise be paid by every call of the wide layouts, which
+/// trace_layout reaches by a tail call.
+template <bool kAnyHit, bool kCutouts, class Counters>
+__attribute__((noinline)) bool Accelerator::trace_pairs(Ray& ray, Hit& hit, Counters& counters) const {
+    const TriangleRay tr(ray);
+    BvhRay br(ray);
+    Hit best;
+    const bool found = traverse_bvh_pairs<kAnyHit>(
+        pairs_, br,
+        [&](uint32_t first, uint32_t count, float& tmax) {
+            return test_slots<kAnyHit, kCutouts>(ray, tr, first, count, tmax, best);
+        },
+        counters);
+    if (found && !kAnyHit) {
+        hit = best;
+        ray.tmax = best.t;
+    }
+    return found;
+}
+
+bool Accelerator::intersect(Ray& ray, Hit& hit) const {
+    NoTraversalCounters none;
+    return trace<false>(ray, hit, none);
+}
+
+bool Accelerator::occluded(const Ray& ray) const {
+    NoTraversalCounters none;
+    Hit h;
+    // Any-hit traces only read the ray (only closest-hit ones write tmax back), so it
+    // is not copied: reading a copy just made waits for its stores to be forwarded.
+    return trace<true>(const_cast<Ray&>(ray), h, none);
+}
+
+bool Accelerator::intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const {
+    return trace<false>(ray, hit, counters);
+}
+
+bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) const {
+    Hit h;
+    return trace<true>(const_cast<Ray&>(ray), h, counters);  // read only, as in occluded()
+}
+
+/// The block layouts' brute force: every lane of every block, triangles by the scalar test.
+bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const {
+    bool found = false;
+    for (const TriangleBlock4& b : blocks_)
+        for (int l = 0; l < 4; ++l) {
+            if (b.slot[l] == TriangleBlock4::kEmptyLane) continue;
+            const uint32_t id = lane_prim(b.slot[l]);
+            float t = 0.0f, u = 0.0f, v = 0.0f;
+            if (prim_kind(id) == PrimKind::triangle) {
+                const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
+                                         {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
+                                         {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
+                TriangleHit th;
+                if (!intersect_triangle(tr, tri, ray.tmin, tmax, th)) continue;
+                if (!alpha_.empty() && !keep_triangle_hit(ray, id, th.u, th.v)) continue;
+                t = th.t, u = th.u, v = th.v;
+            } else if (!intersect_other(ray, id, tmax, t, u)) {
+                continue;
+            }
+            tmax = t;
+            hit = Hit{t, id, u, v};
+            found = true;
+        }
+    return found;
+}
+
+/// Packet fallback for a non-triangle lane of a leaf block (packets run only on the block layouts, without
+/// cut-outs).
+bool Accelerator::intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const {
+    const uint32_t id = others_[other];
+    float t = 0.0f, u = 0.0f;
+    if (!intersect_other(ray, id, ray.tmax, t, u)) return false;
+    hit = Hit{t, id, u, 0.0f};
+    return true;
+}
+
+bool Accelerator::intersect_brute_force(Ray& ray, Hit& hit) const {
+    const TriangleRay tr(ray);
+    float tmax = ray.tmax;
+    Hit best;
+    const bool found = layout_has_blocks(layout_) ? brute_force_blocks(ray, tr, tmax, best)
+                       : alpha_.empty()
+                           ? test_slots<false, false>(ray, tr, 0, uint32_t(slots_.size()), tmax, best)
+                           : test_slots<false, true>(ray, tr, 0, uint32_t(slots_.size()), tmax, best);
+    if (!found) return false;
+    hit = best;
+    ray.tmax = best.t;
+    return true;
+}
+
+}  // namespace sahara

@@ -1,0 +1,203 @@
+#include "accel/packet.h"
+
+#include <immintrin.h>
+
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <type_traits>
+
+#include "scene/accelerator.h"
+
+namespace sahara {
+
+namespace {
+
+/// What every ISA's kernel needs: the packet, the tree, and the permutation
+/// and plane choice shared by all active rays (see packet_eligible).
+struct PacketContext {
+    const RayPacket* rays;
+    const TriangleBlock4* blocks;
+    const Accelerator* accel;
+    int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
+    int neg[3];       ///< direction sign per axis, common to all active rays
+    int near_off[3];  ///< offset of each axis's near planes in a node, in units of N floats
+    int far_off[3];   ///< offset of each axis's far planes, in units of N floats
+    int first;        ///< first active lane
+};
+
+/// Fills the common permutation and signs; false when the active rays do not
+/// share them (or a direction is zero or not finite, or an origin not finite): such packets are traced ray by
+/// ray.
+bool packet_eligible(const RayPacket& p, PacketContext& c) {
+    c.first = std::countr_zero(p.active);
+    int key = -1;
+    for (uint32_t m = p.active; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        const Vec3 d(p.dir[0][i], p.dir[1][i], p.dir[2][i]);
+        if (!is_finite(d) || !is_finite(Vec3(p.org[0][i], p.org[1][i], p.org[2][i]))) return false;
+        const int kz = max_dimension(abs(d));
+        if (!(std::fabs(d[kz]) > 0.0f)) return false;
+        const int k =
+            kz | (std::signbit(d.x) ? 4 : 0) | (std::signbit(d.y) ? 8 : 0) | (std::signbit(d.z) ? 16 : 0);
+        if (key >= 0 && k != key) return false;
+        key = k;
+    }
+    c.kz = key & 3;
+    c.kx = c.kz == 2 ? 0 : c.kz + 1;
+    c.ky = c.kx == 2 ? 0 : c.kx + 1;
+    for (int a = 0; a < 3; ++a) c.neg[a] = (key >> (2 + a)) & 1;
+    if (c.neg[c.kz]) std::swap(c.kx, c.ky);  // as in TriangleRay: keeps the winding
+    // lo_x, hi_x, lo_y, hi_y, lo_z, hi_z of an N-wide node start at N floats times 0, 1, ..., 5.
+    for (int a = 0; a < 3; ++a) {
+        c.near_off[a] = 2 * a + c.neg[a];
+        c.far_off[a] = 2 * a + 1 - c.neg[a];
+    }
+    return true;
+}
+
+}  // namespace
+
+// The kernels pass 64-byte vectors between always-inline helpers only, so
+// GCC's note that such arguments change the ABI without AVX-512 is moot.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off")
+namespace packet_sse2 {
+#define SAHARA_PACKET_ISA 128
+#include "scene/packet_kernel.inc"
+#undef SAHARA_PACKET_ISA
+}  // namespace packet_sse2
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#pragma GCC optimize("fp-contract=off")
+namespace packet_avx2 {
+#define SAHARA_PACKET_ISA 256
+#include "scene/packet_kernel.inc"
+#undef SAHARA_PACKET_ISA
+}  // namespace packet_avx2
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+#pragma GCC optimize("fp-contract=off")
+namespace packet_avx512 {
+#define SAHARA_PACKET_ISA 512
+#include "scene/packet_kernel.inc"
+#undef SAHARA_PACKET_ISA
+}  // namespace packet_avx512
+#pragma GCC pop_options
+
+namespace {
+
+std::atomic<int> g_forced_simd{-1};
+std::atomic<int> g_packets_override{-1};
+
+}  // namespace
+
+bool cpu_supports_packet_simd(PacketSimd path) {
+    switch (path) {
+        case PacketSimd::avx512:
+            return __builtin_cpu_supports("avx512f");
+        case PacketSimd::avx2:
+            return __builtin_cpu_supports("avx2");
+        case PacketSimd::sse2:
+            break;
+    }
+    return true;
+}
+
+namespace {
+
+PacketSimd widest_supported(PacketSimd want) {
+    if (want == PacketSimd::avx512 && !cpu_supports_packet_simd(want)) want = PacketSimd::avx2;
+    if (want == PacketSimd::avx2 && !cpu_supports_packet_simd(want)) want = PacketSimd::sse2;
+    return want;
+}
+
+}  // namespace
+
+PacketSimd active_packet_simd() {
+    const int forced = g_forced_simd.load(std::memory_order_relaxed);
+    if (forced >= 0) return PacketSimd(forced);
+    static const PacketSimd from_env = [] {
+        const char* env = std::getenv("SAHARA_SIMD");
+        PacketSimd want = PacketSimd::avx512;
+        if (env && std::strcmp(env, "sse2") == 0) want = PacketSimd::sse2;
+        if (env && std::strcmp(env, "avx2") == 0) want = PacketSimd::avx2;
+        return widest_supported(want);
+    }();
+    return from_env;
+}
+
+void force_packet_simd(PacketSimd path) {
+    g_forced_simd.store(int(widest_supported(path)), std::memory_order_relaxed);
+}
+
+void clear_forced_packet_simd() { g_forced_simd.store(-1, std::memory_order_relaxed); }
+
+const char* packet_simd_name(PacketSimd path) {
+    return path == PacketSimd::avx512 ? "avx512" : path == PacketSimd::avx2 ? "avx2" : "sse2";
+}
+
+bool packets_enabled() {
+    const int o = g_packets_override.load(std::memory_order_relaxed);
+    if (o >= 0) return o != 0;
+    static const bool from_env = [] {
+        const char* env = std::getenv("SAHARA_PACKETS");
+        return !(env && std::strcmp(env, "0") == 0);
+    }();
+    return from_env;
+}
+
+void set_packets_enabled(bool on) { g_packets_override.store(on ? 1 : 0, std::memory_order_relaxed); }
+
+void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
+    for (int i = 0; i < kPacketSize; ++i) hits.prim[i] = kNoPrim, hits.t[i] = kInfinity;
+    if (!packet.active) return;
+    PacketContext c{};
+    c.rays = &packet;
+    c.blocks = blocks_.data();
+    c.accel = this;
+    // Other layouts, scenes with cut-outs (the alpha test is single-ray only),
+    // mixed directions and near-empty packets: single rays.
+    const bool wide8 = layout_ == BvhLayout::wide8;
+    const bool tree_empty = wide8 ? wide8_.empty : wide_.empty;
+    if (!layout_has_blocks(layout_) || tree_empty || has_cutouts() || std::popcount(packet.active) < 2 ||
+        !packet_eligible(packet, c)) {
+        for (uint32_t m = packet.active; m; m &= m - 1) {
+            const int i = std::countr_zero(m);
+            Ray r = packet.ray(i);
+            Hit h;
+            if (intersect(r, h)) {
+                hits.t[i] = h.t, hits.prim[i] = h.prim, hits.u[i] = h.u, hits.v[i] = h.v;
+                packet.tmax[i] = h.t;
+            }
+        }
+        return;
+    }
+    switch (active_packet_simd()) {
+        case PacketSimd::avx512:
+            wide8 ? packet_avx512::trace_packet(c, wide8_, hits)
+                  : packet_avx512::trace_packet(c, wide_, hits);
+            break;
+        case PacketSimd::avx2:
+            // 8-wide nodes: one AVX box test per ray and child set beats 16 rays per box in two halves.
+            wide8 ? trace_packet8_avx2(packet, hits) : packet_avx2::trace_packet(c, wide_, hits);
+            break;
+        case PacketSimd::sse2:
+            wide8 ? packet_sse2::trace_packet(c, wide8_, hits) : packet_sse2::trace_packet(c, wide_, hits);
+            break;
+    }
+    for (uint32_t m = packet.active; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        if (hits.prim[i] != kNoPrim) packet.tmax[i] = hits.t[i];
+    }
+}
+
+}  // namespace sahara

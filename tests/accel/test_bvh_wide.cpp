@@ -1,0 +1,768 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <limits>
+#include <map>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "scene/accelerator.h"
+#include "accel/bvh_stats.h"
+#include "accel/bvh_wide.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
+#include "mesh_fixtures.h"
+#include "scene/scene.h"
+#include "test_data.h"
+
+using namespace sahara;
+using namespace sahara::test;
+
+namespace {
+
+std::vector<TriangleMesh> procedural() {
+    return {make_icosphere(3), make_tiny_grid(30), make_slivers(1000), make_degenerate_mesh()};
+}
+
+/// Restores automatic SIMD path selection when a test ends.
+struct SimdPathGuard {
+    ~SimdPathGuard() { force_simd_path(best_simd_path()); }
+};
+
+/// The SIMD paths this CPU can run (SSE2 always).
+std::vector<SimdPath> runnable_paths() { return runnable_simd_paths(); }
+
+template <int N>
+Bounds3 child_box(const BvhWideNode<N>& n, int c) {
+    return {{n.lo_x[c], n.lo_y[c], n.lo_z[c]}, {n.hi_x[c], n.hi_y[c], n.hi_z[c]}};
+}
+
+bool inside(const Bounds3& inner, const Bounds3& outer) {
+    if (inner.lo.x > inner.hi.x) return true;  // empty
+    for (int a = 0; a < 3; ++a)
+        if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+    return true;
+}
+
+/// Marks the primitives of one leaf (first slot or, with leaf blocks, first block; count
+/// slots): by slot index, or with leaf blocks by primitive id.
+void use_leaf(const Accelerator& acc, uint32_t first, uint32_t count, std::map<uint32_t, int>& uses) {
+    if (!layout_has_blocks(acc.layout())) {
+        REQUIRE(first + count <= acc.primitive_count());
+        for (uint32_t s = 0; s < count; ++s) ++uses[first + s];
+        return;
+    }
+    const auto& blocks = acc.leaf_blocks();
+    REQUIRE(first + (count + 3) / 4 <= blocks.size());
+    uint32_t lanes = 0;
+    for (uint32_t b = first; b < first + (count + 3) / 4; ++b)
+        for (uint32_t slot : blocks[b].slot) {
+            if (slot == TriangleBlock4::kEmptyLane) continue;
+            ++lanes;
+            ++uses[acc.lane_prim(slot)];
+        }
+    CHECK(lanes == count);
+}
+
+/// Every slot in exactly one leaf, every node reached once, child boxes inside the parent's box.
+template <int N>
+void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
+    REQUIRE_FALSE(t.empty);
+    std::map<uint32_t, int> slot_uses;
+    std::vector<int> node_uses(t.nodes.size(), 0);
+    if (t.root.is_leaf()) {
+        use_leaf(acc, t.root.index, t.root.count, slot_uses);
+    } else {
+        std::vector<std::pair<uint32_t, Bounds3>> stack{{0u, t.root.box()}};
+        while (!stack.empty()) {
+            const auto [index, box] = stack.back();
+            stack.pop_back();
+            REQUIRE(index < t.nodes.size());
+            ++node_uses[index];
+            const BvhWideNode<N>& n = t.nodes[index];
+            int children = 0;
+            for (int c = 0; c < N; ++c) {
+                if (!n.has_child(c)) {
+                    CHECK(n.leaf_count(c) == 0);
+                    CHECK(child_box(n, c).lo.x > child_box(n, c).hi.x);
+                    continue;
+                }
+                ++children;
+                CHECK(inside(child_box(n, c), box));
+                // A reference tells a leaf and its count by itself (wide_leaf_ref).
+                if (const uint32_t count = n.leaf_count(c)) {
+                    use_leaf(acc, ref_first(n.child[c]), count, slot_uses);
+                } else {
+                    // Inner children hold node byte offsets (BvhWide::node_at).
+                    CHECK(n.child[c] % sizeof(BvhWideNode<N>) == 0);
+                    CHECK(&t.node_at(n.child[c]) == &t.nodes[BvhWide<N>::index_of(n.child[c])]);
+                    stack.push_back({uint32_t(BvhWide<N>::index_of(n.child[c])), child_box(n, c)});
+                }
+            }
+            CHECK(children >= 2);
+        }
+    }
+    CHECK(slot_uses.size() == acc.primitive_count());
+    CHECK(std::all_of(slot_uses.begin(), slot_uses.end(), [](const auto& u) { return u.second == 1; }));
+    CHECK(std::all_of(node_uses.begin(), node_uses.end(), [](int u) { return u == 1; }));
+}
+
+/// check_wide_valid on the tree of the accelerator's layout.
+void check_bvh4_valid(const Accelerator& acc) {
+    if (acc.layout() == BvhLayout::wide8) {
+        CHECK(acc.bvh4().empty);
+        check_wide_valid(acc, acc.bvh8());
+    } else {
+        CHECK(acc.bvh8().empty);
+        check_wide_valid(acc, acc.bvh4());
+    }
+}
+
+bool same_t(float a, float b) { return std::fabs(a - b) <= 1e-6f * std::max(std::fabs(a), std::fabs(b)); }
+
+/// Rays on which `acc` (BVH4) disagrees with the brute-force loop, for intersect and occluded.
+int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
+    int bad = 0;
+    for (const Ray& r0 : rays) {
+        Ray a = r0, b = r0;
+        Hit ha, hb;
+        const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
+        if (fa != fb || acc.occluded(r0) != fb)
+            ++bad;
+        else if (fa && (!same_t(ha.t, hb.t) || (ha.prim != hb.prim && ha.t != hb.t) || a.tmax != ha.t))
+            ++bad;
+    }
+    return bad;
+}
+
+/// The wide layouts on `paths`: valid trees, brute-force answers; `reinsert` adds the
+/// wide8 layout over the reinsertion builder's tree. The wide8 tree is also traced with
+/// node pairing for every closest-hit ray (the AVX-512 path).
+void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert,
+                const std::vector<SimdPath>& paths = runnable_paths()) {
+    const Scene scene = scene_from_mesh(mesh);
+    const double budget = 2.5e7 / double(std::max<size_t>(mesh.triangle_count(), 1));
+    const int count = int(std::clamp(budget, 1000.0, 20000.0)) / kSanitizerDivisor;
+    const std::vector<Ray> rays = make_random_rays(mesh_bounds(mesh), count, seed);
+    SimdPathGuard guard;
+    struct Config {
+        BvhLayout layout;
+        BvhBuilder builder;
+        NodePairing pairing;
+    };
+    for (auto [layout, builder, pairing] :
+         {Config{BvhLayout::wide4, BvhBuilder::binned, NodePairing::automatic},
+          Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::never},
+          Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::always},
+          Config{BvhLayout::wide4_slots, BvhBuilder::binned, NodePairing::automatic},
+          Config{BvhLayout::wide8, BvhBuilder::reinsert, NodePairing::always}}) {
+        if (builder == BvhBuilder::reinsert && !reinsert) continue;
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        opt.builder = builder;
+        opt.node_pairing = pairing;
+        const Accelerator acc(scene, opt);
+        REQUIRE(acc.layout() == layout);
+        if (pairing != NodePairing::automatic) CHECK(acc.pairs_nodes() == (pairing == NodePairing::always));
+        check_bvh4_valid(acc);
+        for (SimdPath path : paths) {
+            force_simd_path(path);
+            INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " builder ",
+                 std::string(bvh_builder_name(builder)), " pairing ", int(pairing), " path ",
+                 std::string(simd_path_name(path)), " rays ", rays.size());
+            CHECK(active_simd_path() == path);
+            CHECK(disagreements(acc, rays) == 0);
+        }
+    }
+}
+
+/// A ray for the box-test cases: integer origin (often exactly on a slab plane),
+/// direction components zeroed (+0 or -0) a third of the time, sometimes a short tmax.
+Ray random_slab_test_ray(std::mt19937& rng, std::uniform_int_distribution<int>& coord,
+                         std::uniform_real_distribution<float>& u) {
+    // Braced initialisation: the draws happen left to right.
+    Ray ray{Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))), Vec3(u(rng), u(rng), u(rng))};
+    for (int a = 0; a < 3; ++a)
+        if (rng() % 3 == 0) ray.dir[a] = (rng() % 2) ? -0.0f : 0.0f;
+    if (rng() % 4 == 0) ray.tmax = std::fabs(u(rng));
+    return ray;
+}
+
+}  // namespace
+
+// One test case per SIMD path, so that a CPU without AVX2 or AVX-512 shows those paths as skipped.
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the SSE2 path") {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::sse2});
+}
+
+TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
+          doctest::skip(!cpu_has_avx2())) {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx2});
+}
+
+TEST_CASE(
+    "BVH4 is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
+    "[needs AVX-512]" *
+    doctest::skip(!cpu_has_avx512())) {
+    uint32_t seed = 500;
+    for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx512});
+}
+
+TEST_CASE("BVH4 is valid and agrees with brute force on real and scan-like meshes, on every SIMD path") {
+    uint32_t seed = 600;
+    // (The reinsertion tree on these meshes is checked against brute force in test_bvh.cpp.)
+    for (const TriangleMesh& m : realistic_meshes()) check_mesh(m, seed++, false);
+}
+
+TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
+    // Triangles at geometrically growing distances along x, each also scaled up: the SAH
+    // splits off one or a few at a time, so the tree runs as deep as the builder lets it,
+    // and rays along the axis pass through every level with pending siblings on the stack.
+    TriangleMesh m;
+    m.name = "comb";
+    for (int i = 0; i < 3000; ++i) {
+        const float x = std::pow(1.01f, float(i)), s = 0.3f * x;
+        const auto base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), {Vec3(x, -s, -s), Vec3(x, s, -s), Vec3(x, 0.0f, s)});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    const Scene scene = scene_from_mesh(m);
+    AcceleratorOptions opt;
+    opt.node_pairing = NodePairing::always;
+    const Accelerator acc(scene, opt);
+    CHECK(acc.pairs_nodes());
+    int depth = 0;  // of the wide tree
+    for (std::vector<std::pair<uint32_t, int>> pending{{0u, 1}}; !pending.empty();) {
+        const auto [offset, d] = pending.back();
+        pending.pop_back();
+        depth = std::max(depth, d);
+        const Bvh8Node& n = acc.bvh8().node_at(offset);
+        for (int c = 0; c < 8; ++c)
+            if (n.has_child(c) && n.leaf_count(c) == 0) pending.push_back({n.child[c], d + 1});
+    }
+    CHECK(depth >= 8);
+    MESSAGE("wide tree depth " << depth);
+    std::vector<Ray> rays = make_random_rays(acc.bounds(), 4000 / kSanitizerDivisor, 71);
+    for (int i = 0; i < 2000 / kSanitizerDivisor; ++i)  // along the comb, from both ends
+        rays.push_back(Ray{Vec3(i % 2 ? -1.0f : 1e13f, 0.01f * float(i % 7), 0.01f * float(i % 5)),
+                           Vec3(i % 2 ? 1.0f : -1.0f, 1e-3f * float(i % 3), 0.0f)});
+    SimdPathGuard guard;
+    for (SimdPath path : runnable_paths()) {
+        force_simd_path(path);
+        INFO(std::string(simd_path_name(path)));
+        CHECK(disagreements(acc, rays) == 0);
+    }
+}
+
+TEST_CASE("BVH4 and pair layouts give the same hits") {
+    const TriangleMesh m = make_icosphere(4);  // random rays hit it often, even the few under ASan
+    const Scene scene = scene_from_mesh(m);
+    AcceleratorOptions wide, pairs;
+    pairs.layout = BvhLayout::pairs;
+    const Accelerator a(scene, wide), b(scene, pairs);
+    CHECK(b.layout() == BvhLayout::pairs);
+    CHECK(b.bvh4().empty);
+    int bad = 0, hits = 0;
+    for (const Ray& r0 : make_random_rays(mesh_bounds(m), 20000 / kSanitizerDivisor, 77)) {
+        Ray ra = r0, rb = r0;
+        Hit ha, hb;
+        const bool fa = a.intersect(ra, ha), fb = b.intersect(rb, hb);
+        hits += fa;
+        if (fa != fb || (fa && ha.t != hb.t) || a.occluded(r0) != b.occluded(r0)) ++bad;
+        // The wide4 brute force reads the leaf blocks, the pair one the scene's triangles.
+        Ray ba = r0, bb = r0;
+        const bool ga = a.intersect_brute_force(ba, ha), gb = b.intersect_brute_force(bb, hb);
+        if (ga != gb || (ga && ha.t != hb.t)) ++bad;
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+}
+
+TEST_CASE("BVH4 box test matches the single-node test, including zero directions on slab planes") {
+    std::mt19937 rng(31);
+    std::uniform_int_distribution<int> coord(-2, 2);  // small integers: origins often exactly on planes
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0;
+    for (int i = 0; i < 100000 / kSanitizerDivisor; ++i) {
+        BvhNode child[4];
+        Bvh4Node n{};
+        for (int c = 0; c < 4; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};  // empty box
+            child[c].set_box(b);
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+        }
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
+        __m128 tv;
+        const int mask = intersect_bvh4(n, Bvh4Ray(r), r.tmin, r.tmax, tv);
+        alignas(16) float t4[4];
+        _mm_store_ps(t4, tv);
+        for (int c = 0; c < 4; ++c) {
+            float t = 0.0f;
+            const bool hit = intersect_bvh_node(child[c], r, t);
+            if (hit != bool(mask & (1 << c)) || (hit && t != t4[c])) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+}
+
+TEST_CASE("BVH8 box test in SSE halves matches the single-node test") {
+    std::mt19937 rng(32);
+    std::uniform_int_distribution<int> coord(-2, 2);
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0, hits = 0;
+    for (int i = 0; i < 50000 / kSanitizerDivisor; ++i) {
+        BvhNode child[8];
+        Bvh8Node n{};
+        for (int c = 0; c < 8; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 50 == 0) b = Bounds3{};
+            child[c].set_box(b);
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+        }
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
+        alignas(32) float t_sse[8];
+        const int mask_sse = WideRay<8, false>(r).test(n, r.tmin, r.tmax * kRobustFarScale, t_sse);
+        for (int c = 0; c < 8; ++c) {
+            float t = 0.0f;
+            const bool hit = intersect_bvh_node(child[c], r, t);
+            hits += hit;
+            if (hit != bool(mask_sse & (1 << c))) ++bad;
+            if (hit && t != t_sse[c]) ++bad;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+}
+
+namespace {
+
+/// The BVH8 AVX2 node step (and with `avx512` the AVX-512 ones, compressed in slot
+/// order, and the paired step) against the exact slab test, on random nodes and rays.
+void check_bvh8_node_steps(bool avx512) {
+    std::mt19937 rng(33);
+    std::uniform_int_distribution<int> coord(-2, 2);
+    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+    int bad = 0, multi = 0, on_far_plane = 0, tighter = 0, paired_both = 0;
+    // The previous iteration's node: the paired step's `a`.
+    Bvh8Node prev{};
+    for (int i = 0; i < 50000 / kSanitizerDivisor; ++i) {
+        Bvh8Node n{};
+        BvhNode single[8];
+        for (int c = 0; c < 8; ++c) {
+            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
+            if (rng() % 8 == 0) b = Bounds3{};  // empty slot
+            single[c].set_box(b);
+            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
+            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
+            n.child[c] = b.empty() ? kNoNode : uint32_t(rng());
+        }
+        const BvhRay r(random_slab_test_ray(rng, coord, u));
+        const float tmax_far = r.tmax * kRobustFarScale;
+        // Reference: the slab distances of intersect_bvh_node, every NaN (a zero direction
+        // component, the origin on the plane) dropped on its own, and the documented extra
+        // hit for an exit distance of +0 (the origin on the far plane of a positive direction).
+        int mask = 0;
+        float entry[8];
+        for (int c = 0; c < 8; ++c) {
+            const float lo[3] = {n.lo_x[c], n.lo_y[c], n.lo_z[c]}, hi[3] = {n.hi_x[c], n.hi_y[c], n.hi_z[c]};
+            float t0 = r.tmin, t1 = tmax_far;
+            bool exit_plus_zero = false;
+            for (int a = 0; a < 3; ++a) {
+                const float tn = ((r.neg[a] ? hi[a] : lo[a]) - r.org[a]) * r.inv_dir[a];
+                const float tf = ((r.neg[a] ? lo[a] : hi[a]) - r.org[a]) * r.inv_far[a];
+                if (!std::isnan(tn)) t0 = std::max(t0, tn);
+                if (!std::isnan(tf)) t1 = std::min(t1, tf);
+                exit_plus_zero |= tf == 0.0f && !std::signbit(tf);
+            }
+            entry[c] = t0;
+            if (t0 <= t1)
+                mask |= 1 << c;
+            else if (exit_plus_zero)
+                mask |= 1 << c, ++on_far_plane;
+            // The scalar test drops a whole pair around a NaN, so it can hit children the
+            // exact test misses (counted, not an error), never the other way round.
+            float t_single = 0.0f;
+            const bool hit_single = intersect_bvh_node(single[c], r, t_single);
+            if (t0 <= t1 && !hit_single) ++bad;
+            tighter += hit_single && !(mask & (1 << c));
+        }
+        multi += __builtin_popcount(unsigned(mask)) > 1;
+        const WideRay<8, true> rw(r);
+        alignas(32) float t_avx[8];
+        const int mask_avx = rw.test(n, r.tmin, tmax_far, t_avx);
+        if (mask_avx != mask) ++bad;
+        for (int c = 0; c < 8; ++c)
+            if ((mask & (1 << c)) && t_avx[c] != entry[c]) ++bad;
+        if (!avx512) continue;
+        alignas(32) float t[8];
+        alignas(32) uint32_t child[8];
+        const Bvh8HitChildren h = intersect_bvh8_compress_avx512(n, rw.avx, r.tmin, tmax_far, child, t);
+        if (int(h.mask) != mask) ++bad;
+        // The any-hit form: the first hit in registers, the others as stack entries (the
+        // reference in the low word; the high word is garbage).
+        uint64_t entries[8];
+        const Bvh8HitChildren ha = intersect_bvh8_entries_avx512(n, rw.avx, r.tmin, tmax_far, entries);
+        if (ha.mask != h.mask || ha.ref0 != h.ref0) ++bad;
+        for (int i = 1; i < __builtin_popcount(h.mask); ++i)
+            if (uint32_t(entries[i - 1]) != child[i]) ++bad;
+        int i_hit = 0;
+        std::vector<std::array<uint32_t, 2>> hits;  // child, entry bits (slot order)
+        for (int c = 0; c < 8; ++c) {
+            if (!(mask & (1 << c))) continue;
+            if (child[i_hit] != n.child[c] || t[i_hit] != entry[c]) ++bad;
+            if (i_hit == 0 && (h.ref0 != n.child[c] || h.t0 != entry[c])) ++bad;
+            hits.push_back({n.child[c], std::bit_cast<uint32_t>(entry[c])});
+            ++i_hit;
+        }
+        // The paired step over the previous node (tested with this ray) and this one: the
+        // hit children of both, the previous node's first, all of them with their distances
+        // as stack entries (reference low, distance high).
+        if (i > 0) {
+            std::vector<std::array<uint32_t, 2>> expected;
+            alignas(32) float tp[8];
+            const int mask_prev = rw.test(prev, r.tmin, tmax_far, tp);
+            for (int c = 0; c < 8; ++c)
+                if (mask_prev & (1 << c)) expected.push_back({prev.child[c], std::bit_cast<uint32_t>(tp[c])});
+            paired_both += !expected.empty() && !hits.empty();
+            expected.insert(expected.end(), hits.begin(), hits.end());
+            alignas(32) uint64_t pe[16];
+            const Bvh8HitChildren hp = intersect_bvh8_pair_avx512(prev, n, rw.avx, r.tmin, tmax_far, pe);
+            if (hp.mask != expected.size()) {
+                ++bad;
+            } else if (hp.mask > 0) {
+                if (hp.ref0 != expected[0][0] || std::bit_cast<uint32_t>(hp.t0) != expected[0][1]) ++bad;
+                for (size_t k = 0; k < hp.mask; ++k)
+                    if (pe[k] != (uint64_t(expected[k][1]) << 32 | expected[k][0])) ++bad;
+            }
+        }
+        prev = n;
+    }
+    CHECK(bad == 0);
+    if (avx512) CHECK(paired_both > 0);
+    CHECK(multi > 0);
+    CHECK(on_far_plane > 0);
+    CHECK(tighter > 0);
+    MESSAGE("hit only for an origin on the far plane: " << on_far_plane
+                                                        << "; hit by the scalar test only: " << tighter);
+}
+
+}  // namespace
+
+TEST_CASE("BVH8 AVX2 node step: the exact slab test's hits [needs AVX2]" * doctest::skip(!cpu_has_avx2())) {
+    check_bvh8_node_steps(false);
+}
+
+TEST_CASE("BVH8 AVX-512 node steps: the exact slab test's hits, compressed in slot order [needs AVX-512]" *
+          doctest::skip(!cpu_has_avx512())) {
+    check_bvh8_node_steps(true);
+}
+
+namespace {
+
+/// The four-lane triangle test (and with `eight_lanes` the AVX pair test) against the
+/// scalar watertight test, bit for bit.
+void check_lane_triangle_tests(bool eight_lanes) {
+    // A fine grid: rays through shared edges and vertices give exactly-zero edge functions.
+    const TriangleMesh m = make_tiny_grid(12, 1.0f, 1.0f);
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> coord(-1, 13);
+    int bad = 0, hits = 0, checked = 0;
+    const std::vector<Ray> random = make_random_rays(mesh_bounds(m), 4000 / kSanitizerDivisor, 8);
+    for (size_t i = 0; i < random.size(); ++i) {
+        Ray ray = random[i];
+        if (i % 2 == 0)  // integer origins straight down: through grid vertices and edges
+            ray =
+                Ray{Vec3(float(coord(rng)) * 0.5f, float(coord(rng)) * 0.5f, 3.0f), Vec3(0.0f, 0.0f, -1.0f)};
+        const TriangleRay tr(ray);
+        for (size_t first = 0; first + 4 <= m.triangle_count(); first += 4) {
+            TriangleBlock4 b{};
+            TriangleVerts tri[4];
+            for (int l = 0; l < 4; ++l) {
+                const uint32_t* v = &m.indices[3 * (first + size_t(l))];
+                tri[l] = TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]);
+                for (int k = 0; k < 3; ++k)
+                    for (int a = 0; a < 3; ++a) b.p[k][a][l] = tri[l].p[k][a];
+                b.slot[l] = uint32_t(l);
+            }
+            float t[4], u[4], v[4];
+            const int mask = intersect_triangle_block4(tr, b, ray.tmin, ray.tmax, t, u, v);
+            // The AVX pair test on (b, b) must give the same answer in both halves.
+            alignas(32) float t8[8], u8[8], v8[8];
+            const TriangleBlock4 pair[2] = {b, b};
+            const int mask8 =
+                eight_lanes ? intersect_triangle_blocks2_avx(tr, pair, ray.tmin, ray.tmax, t8, u8, v8) : 0;
+            for (int l = 0; l < 4; ++l) {
+                TriangleHit h{};
+                const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
+                ++checked;
+                hits += hit;
+                if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l])))
+                    ++bad;
+                if (!eight_lanes) continue;
+                for (int half = 0; half < 2; ++half) {
+                    const int k = 4 * half + l;
+                    if (hit != bool(mask8 & (1 << k)) ||
+                        (hit && (h.t != t8[k] || h.u != u8[k] || h.v != v8[k])))
+                        ++bad;
+                }
+            }
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(hits > 0);
+    CHECK(checked > 0);
+}
+
+}  // namespace
+
+TEST_CASE("four-lane triangle test is bit-identical to the scalar watertight test") {
+    check_lane_triangle_tests(false);
+}
+
+TEST_CASE("eight-lane (AVX pair) triangle test is bit-identical to the scalar watertight test [needs AVX2]" *
+          doctest::skip(!cpu_has_avx2())) {
+    check_lane_triangle_tests(true);
+}
+
+TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
+    Scene scene = scene_from_mesh(make_icosphere(2, 0.5f));
+    scene.spheres.push_back(Sphere{Vec3(2.0f, 0.0f, 0.0f), 0.4f});
+    scene.boxes.push_back(Box{Bounds3{{-2.5f, -0.5f, -0.5f}, {-1.5f, 0.5f, 0.5f}}});
+    SimdPathGuard guard;
+    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        const Accelerator acc(scene, opt);
+        check_bvh4_valid(acc);
+        for (SimdPath path : runnable_paths()) {
+            force_simd_path(path);
+            INFO(std::string(bvh_layout_name(layout)), " ", std::string(simd_path_name(path)));
+            CHECK(disagreements(acc, make_random_rays(acc.bounds(), 20000 / kSanitizerDivisor, 91)) == 0);
+        }
+        TraversalCounters counters;
+        Ray r{Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1.0f)};
+        Hit h;
+        REQUIRE(acc.intersect_counted(r, h, counters));
+        CHECK(counters.nodes_visited > 1);
+        CHECK(counters.prims_tested > 0);
+    }
+    BvhLayout layout{};
+    CHECK(parse_bvh_layout("pairs", layout));
+    CHECK(layout == BvhLayout::pairs);
+    CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide4), layout));
+    CHECK(layout == BvhLayout::wide4);
+    CHECK(parse_bvh_layout("wide4-slots", layout));
+    CHECK(layout == BvhLayout::wide4_slots);
+    CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide8), layout));
+    CHECK(layout == BvhLayout::wide8);
+    CHECK_FALSE(parse_bvh_layout("bvh8", layout));
+}
+
+TEST_CASE("wide tree statistics follow Embree's definitions") {
+    // One 8-wide node holding two leaves: unit cubes at x = 0 and x = 2, of 5 and 4
+    // primitives (two blocks of four and one). Root box: 3 x 1 x 1, area 14; each leaf area 6.
+    Bvh8 tree;
+    tree.empty = false;
+    tree.root.set_box(Bounds3{Vec3(0.0f), Vec3(3.0f, 1.0f, 1.0f)});
+    tree.root.index = 0;
+    tree.root.count = 0;
+    Bvh8Node n{};
+    for (int c = 0; c < 8; ++c) {
+        n.lo_x[c] = n.lo_y[c] = n.lo_z[c] = kInfinity;
+        n.hi_x[c] = n.hi_y[c] = n.hi_z[c] = -kInfinity;
+        n.child[c] = kNoNode;
+    }
+    for (int c = 0; c < 2; ++c) {
+        n.lo_x[c] = 2.0f * float(c), n.hi_x[c] = 2.0f * float(c) + 1.0f;
+        n.lo_y[c] = n.lo_z[c] = 0.0f;
+        n.hi_y[c] = n.hi_z[c] = 1.0f;
+        n.child[c] = wide_leaf_ref(uint32_t(2 * c), c == 0 ? 5 : 4);  // first blocks 0 and 2
+    }
+    tree.nodes.push_back(n);
+    const WideBvhStats s = compute_wide_bvh_stats(tree, 4);
+    CHECK(s.nodes == 1);
+    CHECK(s.children == 2);
+    CHECK(s.leaves == 2);
+    CHECK(s.leaf_primitives == 9);
+    CHECK(s.leaf_blocks == 3);
+    CHECK(s.sah_nodes == doctest::Approx(1.0));
+    CHECK(s.sah_leaves == doctest::Approx((6.0 * 2 + 6.0 * 1) / 14.0));
+    // Counted one primitive at a time (the slots layout), the leaves weigh 5 and 4.
+    CHECK(compute_wide_bvh_stats(tree, 1).sah_leaves == doctest::Approx((6.0 * 5 + 6.0 * 4) / 14.0));
+
+    // A built tree: every primitive in one leaf, every node but the first a child of another.
+    const TriangleMesh mesh = make_icosphere(3);
+    Scene scene;
+    scene.triangles.positions = mesh.positions;
+    scene.triangles.indices = mesh.indices;
+    const Accelerator acc(scene);
+    const WideBvhStats b = compute_wide_bvh_stats(acc.bvh8(), 4);
+    CHECK(b.leaf_primitives == mesh.indices.size() / 3);
+    CHECK(b.children == b.nodes - 1 + b.leaves);
+    CHECK(b.sah_nodes >= 1.0);
+    CHECK(b.leaf_blocks * 4 >= b.leaf_primitives);
+}
+
+namespace {
+
+/// Every way to cut the subtree of binary node `x` into at most `limit` pieces
+/// (x itself, or a cut of each child), as lists of binary node indices.
+std::vector<std::vector<uint32_t>> cuts(const Bvh& bvh, uint32_t x, size_t limit) {
+    std::vector<std::vector<uint32_t>> out{{x}};
+    const BvhNode& n = bvh.nodes[x];
+    if (n.is_leaf() || limit < 2) return out;
+    for (const auto& a : cuts(bvh, n.index, limit - 1))
+        for (const auto& b : cuts(bvh, n.index + 1, limit - a.size())) {
+            std::vector<uint32_t> both = a;
+            both.insert(both.end(), b.begin(), b.end());
+            out.push_back(both);
+        }
+    return out;
+}
+
+/// Slots [first, first + count) of the subtree of `x`; first = kNoNode when not contiguous.
+std::pair<uint32_t, uint32_t> slot_range(const Bvh& bvh, uint32_t x) {
+    const BvhNode& n = bvh.nodes[x];
+    if (n.is_leaf()) return {n.index, n.count};
+    const auto l = slot_range(bvh, n.index), r = slot_range(bvh, n.index + 1);
+    if (l.first == kNoNode || r.first != l.first + l.second) return {kNoNode, 0};
+    return {l.first, l.second + r.second};
+}
+
+/// Least cost of any N-wide collapse of the subtree of inner node `x` (x's own node
+/// included), by trying every cut: each wide node costs its surface area, each leaf
+/// `block_cost` times its area and its blocks of four. A piece of a cut is a leaf of
+/// the binary tree, an inner node (a wide node of its own) or, when it covers at most
+/// `merge` contiguous slots, one merged leaf.
+double least_cost(const Bvh& bvh, uint32_t x, size_t width, uint32_t merge, double block_cost,
+                  std::map<uint32_t, double>& memo) {
+    if (auto it = memo.find(x); it != memo.end()) return it->second;
+    auto leaf_cost = [&](uint32_t y, uint32_t count) {
+        return block_cost * double(bvh.nodes[y].box().surface_area()) * double((count + 3) / 4);
+    };
+    double best = std::numeric_limits<double>::infinity();
+    const BvhNode& n = bvh.nodes[x];
+    for (const auto& a : cuts(bvh, n.index, width - 1))
+        for (const auto& b : cuts(bvh, n.index + 1, width - a.size())) {
+            double sum = 0.0;
+            for (const auto* part : {&a, &b})
+                for (uint32_t y : *part) {
+                    if (bvh.nodes[y].is_leaf()) {
+                        sum += leaf_cost(y, bvh.nodes[y].count);
+                        continue;
+                    }
+                    double c = least_cost(bvh, y, width, merge, block_cost, memo);
+                    const auto range = slot_range(bvh, y);
+                    if (range.first != kNoNode && range.second <= merge)
+                        c = std::min(c, leaf_cost(y, range.second));
+                    sum += c;
+                }
+            best = std::min(best, sum);
+        }
+    best += double(n.box().surface_area());
+    memo[x] = best;
+    return best;
+}
+
+}  // namespace
+
+TEST_CASE("wide collapse: least SAH cost, as an exhaustive search finds it") {
+    bool merged = false;  // some binary leaves were merged (the merging cases are not vacuous)
+    for (const TriangleMesh& mesh : {make_icosphere(1), make_icosphere(2), make_slivers(150)}) {
+        Scene scene;
+        scene.triangles.positions = mesh.positions;
+        scene.triangles.indices = mesh.indices;
+        for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
+            for (const WideCollapse collapse :
+                 {WideCollapse{0, 1.0}, WideCollapse{8, 1.0}, WideCollapse{8, 0.5}}) {
+                INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " merge ",
+                     collapse.merge_leaves_up_to, " block cost ", collapse.block_cost);
+                AcceleratorOptions opt;
+                opt.layout = layout;
+                opt.collapse = collapse;
+                opt.keep_binary_tree = true;
+                opt.flat_loop_max_prims = 0;
+                const Accelerator acc(scene, opt);
+                const Bvh& bvh = acc.bvh();
+                REQUIRE(!bvh.nodes[0].is_leaf());
+                std::map<uint32_t, double> memo;
+                const size_t width = layout == BvhLayout::wide8 ? 8 : 4;
+                const double best =
+                    least_cost(bvh, 0, width, collapse.merge_leaves_up_to, collapse.block_cost, memo) /
+                    double(bvh.nodes[0].box().surface_area());
+                const WideBvhStats s = layout == BvhLayout::wide8 ? compute_wide_bvh_stats(acc.bvh8(), 4)
+                                                                  : compute_wide_bvh_stats(acc.bvh4(), 4);
+                CHECK(s.sah_nodes + collapse.block_cost * s.sah_leaves ==
+                      doctest::Approx(best).epsilon(1e-5));
+                if (collapse.merge_leaves_up_to == 0) CHECK(s.leaves == (bvh.nodes.size() + 1) / 2);
+                merged = merged || s.leaves < (bvh.nodes.size() + 1) / 2;
+                check_bvh4_valid(acc);
+            }
+    }
+    CHECK(merged);
+}
+
+TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused oversize leaves") {
+    // Primitives cost far more than nodes, so the builder keeps leaves as large as it may:
+    // a max_leaf_size of 1000 is clamped to the largest count a leaf reference holds.
+    const TriangleMesh m = make_icosphere(3);
+    const Scene scene = scene_from_mesh(m);
+    const std::vector<Ray> rays = make_random_rays(mesh_bounds(m), 4000 / kSanitizerDivisor, 91);
+    SimdPathGuard guard;
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::wide4, BvhLayout::wide4_slots}) {
+        AcceleratorOptions opt;
+        opt.layout = layout;
+        opt.params.max_leaf_size = 1000;
+        opt.params.intersection_cost = 1e-4f;
+        opt.collapse.merge_leaves_up_to = kMaxWideLeafCount;
+        opt.flat_loop_max_prims = 0;
+        CHECK(opt.build_params().max_leaf_size == kMaxWideLeafCount);
+        const Accelerator acc(scene, opt);
+        check_bvh4_valid(acc);
+        uint32_t largest = 0;
+        auto largest_leaf = [&](const auto& tree) {
+            for (const auto& n : tree.nodes)
+                for (int c = 0; c < std::decay_t<decltype(n)>::kWidth; ++c)
+                    largest = std::max(largest, n.leaf_count(c));
+        };
+        if (layout == BvhLayout::wide8)
+            largest_leaf(acc.bvh8());
+        else
+            largest_leaf(acc.bvh4());
+        INFO("layout ", std::string(bvh_layout_name(layout)), " largest leaf ", largest);
+        CHECK(largest > 32);  // the count's top bit is used
+        CHECK(largest <= kMaxWideLeafCount);
+        for (SimdPath path : runnable_paths()) {
+            force_simd_path(path);
+            INFO(std::string(simd_path_name(path)));
+            CHECK(disagreements(acc, rays) == 0);
+        }
+    }
+    // The collapse itself refuses leaves its references cannot hold.
+    AcceleratorOptions big;
+    big.layout = BvhLayout::pairs;  // keeps max_leaf_size unclamped
+    big.params.max_leaf_size = 1000;
+    big.params.intersection_cost = 1e-4f;
+    big.flat_loop_max_prims = 0;
+    const Accelerator pairs(scene, big);
+    const Bvh& bvh = pairs.bvh();
+    REQUIRE(!bvh.nodes.empty());
+    CHECK(std::any_of(bvh.nodes.begin(), bvh.nodes.end(),
+                      [](const BvhNode& n) { return n.is_leaf() && n.count > kMaxWideLeafCount; }));
+    CHECK_THROWS_AS(make_bvh_wide<8>(bvh), std::invalid_argument);
+    CHECK_THROWS_AS(make_bvh_wide<8>(bvh, WideCollapse{kMaxWideLeafCount + 1, 1.0}), std::invalid_argument);
+}

@@ -1,0 +1,198 @@
+// End-to-end tests of `sahara bvh` and `sahara bench` on scene files, through the real executable.
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "accel/embree_reference.h"
+#include "io/scene_parser.h"
+
+using namespace sahara;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A fresh directory per test, removed afterwards.
+struct ToolDir {
+    fs::path path;
+    explicit ToolDir(const std::string& name)
+        : path(fs::temp_directory_path() / ("sahara_tools_" + std::to_string(::getpid()) + "_" + name)) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~ToolDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+};
+
+struct ToolRun {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string read_text(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// Runs `sahara ARGS` through the shell, capturing stdout and stderr.
+ToolRun run_tool(const std::string& args, const ToolDir& dir) {
+    const fs::path out = dir.path / "stdout.txt", err = dir.path / "stderr.txt";
+    const std::string cmd = std::string(SAHARA_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_text(out), read_text(err)};
+}
+
+std::string scene_path(const char* name) { return std::string(SAHARA_SOURCE_DIR) + "/scenes/" + name; }
+
+/// Triangle count of a parsed scene (all meshes merged).
+size_t triangle_count(const SceneDesc& d) {
+    size_t n = 0;
+    for (const TriangleMesh& m : d.meshes) n += m.triangle_count();
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree skipped") {
+    ToolDir dir("showcase");
+    const std::string file = scene_path("showcase.json");
+    const SceneDesc desc = parse_scene_file(file);
+    REQUIRE(!desc.spheres.empty());
+    const size_t tris = triangle_count(desc);
+    REQUIRE(tris > 0);
+
+    const ToolRun bvh = run_tool("bvh " + file + " --size 32 --json", dir);
+    REQUIRE(bvh.code == 0);
+    const auto j = nlohmann::json::parse(bvh.out);
+    CHECK(j["input"] == "scene");
+    CHECK(j["primitives"] == tris + desc.spheres.size());
+    CHECK(j["primitives_by_kind"]["triangles"] == tris);
+    CHECK(j["primitives_by_kind"]["spheres"] == desc.spheres.size());
+    CHECK(j["primitives_by_kind"]["boxes"] == 0);
+    CHECK(j["planes_outside_tree"] == 0);
+    CHECK(j["nodes"].get<size_t>() > 1);
+    CHECK(j["rays"]["primary"]["count"] == 32 * 32);
+    CHECK(j["rays"]["diffuse"]["count"] == 32 * 32);  // the camera sees the scene: there are hits
+    CHECK(j["rays"]["primary"]["nodes_visited"].get<double>() > 0.0);
+    // Occlusion rays from the primary hits towards the light: counted like the others.
+    CHECK(j["rays"]["shadow"]["count"] == 32 * 32);
+    CHECK(j["rays"]["shadow"]["nodes_visited"].get<double>() > 0.0);
+
+    const ToolRun bench = run_tool("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
+    REQUIRE(bench.code == 0);
+    const auto b = nlohmann::json::parse(bench.out);
+    CHECK(b["primitives"] == tris + desc.spheres.size());
+    const std::string embree = b["embree"];
+    if (EmbreeReference::available())
+        CHECK(embree.find("skipped: scene has " + std::to_string(desc.spheres.size()) + " spheres") == 0);
+    else
+        CHECK(embree == "skipped: sahara was built without Embree 3");
+    for (const char* set : {"primary", "diffuse", "shadow"}) {
+        INFO(set);
+        CHECK(b["rays"][set]["count"] == 64 * 64);
+        CHECK(!b["rays"][set].contains("embree_mrays_s"));
+    }
+    CHECK(b["rays"]["primary"]["hit_rate"].get<double>() > 0.5);  // showcase: a floor fills the view
+
+    const ToolRun text = run_tool("bench " + file + " --size 16 --repeat 1 --rays primary", dir);
+    CHECK(text.code == 0);
+    CHECK(text.out.find(EmbreeReference::available()
+                            ? "skipped: scene has"
+                            : "skipped: sahara was built without Embree 3") != std::string::npos);
+}
+
+TEST_CASE("bvh on a scene with quadrics and a plane: the plane stays outside the tree") {
+    ToolDir dir("quadrics");
+    const std::string file = scene_path("quadrics.json");
+    const SceneDesc desc = parse_scene_file(file);
+    REQUIRE(!desc.planes.empty());
+    const ToolRun bvh = run_tool("bvh " + file + " --size 16 --json", dir);
+    REQUIRE(bvh.code == 0);
+    const auto j = nlohmann::json::parse(bvh.out);
+    CHECK(j["primitives_by_kind"]["quadrics"] == desc.quadrics.size());
+    CHECK(j["primitives_by_kind"]["spheres"] == desc.spheres.size());
+    CHECK(j["planes_outside_tree"] == desc.planes.size());
+    CHECK(j["primitives"] ==
+          desc.quadrics.size() + desc.spheres.size() + desc.boxes.size() + triangle_count(desc));
+    const ToolRun text = run_tool("bvh " + file + " --size 16", dir);
+    CHECK(text.code == 0);
+    CHECK(text.out.find("not in the tree") != std::string::npos);
+}
+
+namespace {
+
+struct SceneBench {
+    SceneDesc desc;
+    nlohmann::json bench;
+};
+
+/// `sahara bench` on the Cornell box scene (triangles only), parsed.
+SceneBench bench_triangle_only_scene() {
+    ToolDir dir("cornell");
+    const std::string file = scene_path("cornell-box.json");
+    SceneBench r{parse_scene_file(file), {}};
+    REQUIRE(r.desc.spheres.empty());
+    REQUIRE(r.desc.boxes.empty());
+    REQUIRE(r.desc.quadrics.empty());
+    const ToolRun bench = run_tool("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
+    REQUIRE(bench.code == 0);
+    r.bench = nlohmann::json::parse(bench.out);
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("bench on a triangle-only scene counts its triangles") {
+    const SceneBench r = bench_triangle_only_scene();
+    CHECK(r.bench["primitives"] == triangle_count(r.desc));
+    if (!EmbreeReference::available())
+        CHECK(r.bench["embree"] == "skipped: sahara was built without Embree 3");
+}
+
+TEST_CASE("bench on a triangle-only scene compares with Embree [needs Embree]" *
+          doctest::skip(!EmbreeReference::available())) {
+    const nlohmann::json b = bench_triangle_only_scene().bench;
+    CHECK(b["embree"] == "compared");
+    for (const char* set : {"primary", "diffuse", "shadow"}) {
+        INFO(set);
+        CHECK(b["rays"][set]["disagreements"] == 0);
+        CHECK(b["rays"][set]["hit_rate"].get<double>() > 0.0);
+    }
+}
+
+TEST_CASE("bvh and bench reject a broken scene file with exit 2, naming the file") {
+    ToolDir dir("broken");
+    const fs::path broken = dir.path / "broken-scene.json";
+    std::ofstream(broken) << "{ \"format\": \"scene/1\", \"objects\": [ { \"type\": \"sphere\", \"radius\": ";
+    for (const char* cmd : {"bvh", "bench"}) {
+        INFO(cmd);
+        const ToolRun r = run_tool(std::string(cmd) + " " + broken.string() + " --size 8", dir);
+        CHECK(r.code == 2);
+        CHECK(r.err.find("broken-scene.json") != std::string::npos);
+        const ToolRun missing = run_tool(std::string(cmd) + " " + (dir.path / "absent.json").string(), dir);
+        CHECK(missing.code == 2);
+        CHECK(missing.err.find("absent.json") != std::string::npos);
+    }
+    const ToolRun bad_sphere = [&] {
+        const fs::path f = dir.path / "negative-radius.json";
+        std::ofstream(f) << R"({ "format": "scene/1", "objects": [ { "type": "sphere", "center": [0, 0, 0],
+                                 "radius": -1 } ] })";
+        return run_tool("bvh " + f.string(), dir);
+    }();
+    CHECK(bad_sphere.code == 2);
+    CHECK(bad_sphere.err.find("negative-radius.json") != std::string::npos);
+    const ToolRun trace =
+        run_tool("trace " + scene_path("workshop.json") + " --rays x.rays --hits x.hits", dir);
+    CHECK(trace.code == 2);
+    CHECK(trace.err.find("meshes only") != std::string::npos);
+}

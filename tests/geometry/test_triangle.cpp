@@ -1,0 +1,175 @@
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "scene/accelerator.h"
+#include "base/error.h"
+#include "io/mesh_triangles.h"
+#include "scene/mesh_scene.h"
+#include "geometry/triangle.h"
+#include "mesh_fixtures.h"
+#include "scene/scene.h"
+
+using namespace sahara;
+using namespace sahara::test;
+
+namespace {
+
+bool hit_triangle(const Ray& r, const Vec3& a, const Vec3& b, const Vec3& c, TriangleHit& h) {
+    return intersect_triangle(TriangleRay(r), TriangleVerts::of(a, b, c), r.tmin, r.tmax, h);
+}
+
+}  // namespace
+
+TEST_CASE("triangle hit gives t and barycentrics of vertices 1 and 2") {
+    const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+    TriangleHit h{};
+    REQUIRE(hit_triangle(Ray{{0.25f, 0.5f, 2}, {0, 0, -2}}, a, b, c, h));
+    CHECK(h.t == doctest::Approx(1.0f));
+    CHECK(h.u == doctest::Approx(0.25f));
+    CHECK(h.v == doctest::Approx(0.5f));
+    // Back side hits too (no culling), with the same barycentrics.
+    REQUIRE(hit_triangle(Ray{{0.25f, 0.5f, -1}, {0, 0, 1}}, a, b, c, h));
+    CHECK(h.t == doctest::Approx(1.0f));
+    CHECK(h.u == doctest::Approx(0.25f));
+    // Outside, behind the origin, beyond tmax, and exactly at tmax (open interval).
+    CHECK(!hit_triangle(Ray{{0.75f, 0.75f, 1}, {0, 0, -1}}, a, b, c, h));
+    CHECK(!hit_triangle(Ray{{0.25f, 0.25f, -1}, {0, 0, -1}}, a, b, c, h));
+    CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 0.0f, 0.5f}, a, b, c, h));
+    CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 0.0f, 1.0f}, a, b, c, h));
+    CHECK(!hit_triangle(Ray{{0.25f, 0.25f, 1}, {0, 0, -1}, 1.0f, 2.0f}, a, b, c, h));
+}
+
+TEST_CASE("TriangleRay::scattered gives the constructor's axes and shear, ties and signed zeros included") {
+    // Components drawn from a small set, so that ties between |x|, |y|, |z|, negative
+    // zeros and every dominant axis and sign occur many times.
+    const float values[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 3.0f, -3.0f, 1e-30f, -2.5e7f};
+    int checked = 0, mismatched = 0;
+    for (float x : values)
+        for (float y : values)
+            for (float z : values) {
+                if (x == 0.0f && y == 0.0f && z == 0.0f) continue;  // no direction
+                const Ray r{{0.25f, -1.5f, 2.0f}, {x, y, z}};
+                const float inv[3] = {1.0f / x, 1.0f / y, 1.0f / z};  // as BvhRay has them
+                const TriangleRay a(r);
+                // With the box test's inverse direction, and dividing itself.
+                for (const TriangleRay& b :
+                     {TriangleRay::scattered(r, inv), TriangleRay::scattered(r, nullptr)}) {
+                    ++checked;
+                    if (a.kx != b.kx || a.ky != b.ky || a.kz != b.kz || std::memcmp(&a.sx, &b.sx, 4) ||
+                        std::memcmp(&a.sy, &b.sy, 4) || std::memcmp(&a.sz, &b.sz, 4) ||
+                        std::memcmp(a.org, b.org, sizeof a.org))
+                        ++mismatched;
+                }
+            }
+    CHECK(checked == 2 * 992);  // 1000 less the eight all-zero combinations of +0 and -0, twice
+    CHECK(mismatched == 0);
+}
+
+TEST_CASE("degenerate triangles never hit") {
+    TriangleHit h{};
+    const Ray r{{0.5f, 0, 1}, {0, 0, -1}};
+    CHECK(!hit_triangle(r, {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, h));
+    CHECK(!hit_triangle(r, {0.5f, 0, 0}, {0.5f, 0, 0}, {0.5f, 0, 0}, h));
+    CHECK(!hit_triangle(Ray{{0, 0, 1}, {0, 0, -1}}, {0, 0, 0}, {0, 0, 0}, {1, 1, 0}, h));
+}
+
+TEST_CASE("rays aimed at the shared diagonal of a quad hit one of its triangles") {
+    // Quad split along the diagonal; rays through points of the diagonal must hit at least one.
+    const Vec3 a(0, 0, 0), b(1, 0, 0), c(1, 1, 0), d(0, 1, 0);
+    int lost = 0;
+    for (int i = 1; i < 1000; ++i) {
+        const float s = float(i) / 1000.0f;
+        TriangleHit h{};
+        const Vec3 target(s, s, 0);
+        const Ray aimed{target + Vec3(0.3f, -0.7f, 2.0f), target - (target + Vec3(0.3f, -0.7f, 2.0f))};
+        if (!hit_triangle(aimed, a, b, c, h) && !hit_triangle(aimed, a, c, d, h)) ++lost;
+    }
+    CHECK(lost == 0);
+}
+
+TEST_CASE("watertight: rays from inside a closed icosphere at vertices and edge midpoints never escape") {
+    const TriangleMesh m = make_icosphere(3, 1.0f, {0.3f, -0.2f, 0.1f});
+    Scene scene = scene_from_mesh(m);
+    const Accelerator acc(scene);
+    // Targets: every vertex and every edge midpoint (computed in float, so near the edge).
+    std::vector<Vec3> targets = m.positions;
+    for (size_t i = 0; i < m.indices.size(); i += 3)
+        for (int k = 0; k < 3; ++k)
+            targets.push_back(
+                (m.positions[m.indices[i + size_t(k)]] + m.positions[m.indices[i + size_t((k + 1) % 3)]]) *
+                0.5f);
+    const int rays = 1000000 / kSanitizerDivisor;
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(-0.6f, 0.6f);
+    int escapes = 0, occl_escapes = 0;
+    for (int i = 0; i < rays; ++i) {
+        const Vec3 o = Vec3(0.3f, -0.2f, 0.1f) + Vec3(u(rng), u(rng), u(rng)) * 0.9f;
+        const Vec3& target = targets[size_t(i) % targets.size()];
+        Ray r{o, target - o};
+        Hit h;
+        if (!acc.intersect(r, h)) ++escapes;
+        if (!acc.occluded(Ray{o, target - o})) ++occl_escapes;
+    }
+    CHECK(escapes == 0);
+    CHECK(occl_escapes == 0);
+}
+
+TEST_CASE("watertight: brute-force triangle loop, rays through vertices of a closed icosphere") {
+    const TriangleMesh m = make_icosphere(2);
+    std::vector<TriangleVerts> tris;
+    for (size_t i = 0; i < m.indices.size(); i += 3)
+        tris.push_back(TriangleVerts::of(m.positions[m.indices[i]], m.positions[m.indices[i + 1]],
+                                         m.positions[m.indices[i + 2]]));
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    int escapes = 0;
+    for (int i = 0; i < 20000 / kSanitizerDivisor; ++i) {
+        const Vec3 o(u(rng), u(rng), u(rng));
+        const Ray r{o, m.positions[size_t(i) % m.positions.size()] - o};
+        const TriangleRay tr(r);
+        bool any = false;
+        TriangleHit h{};
+        for (const TriangleVerts& t : tris) any |= intersect_triangle(tr, t, r.tmin, r.tmax, h);
+        if (!any) ++escapes;
+    }
+    CHECK(escapes == 0);
+}
+
+TEST_CASE("geometric normal, shading normal and uv interpolation") {
+    TriangleMesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    m.indices = {0, 1, 2};
+    CHECK(triangle_geometric_normal(m, 0) == Vec3(0, 0, 1));
+    CHECK(triangle_shading_normal(m, 0, 0.2f, 0.3f) == Vec3(0, 0, 1));  // no normals: geometric
+    m.normals = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+    const Vec3 n = triangle_shading_normal(m, 0, 0.5f, 0.0f);
+    CHECK(n.x == doctest::Approx(std::sqrt(0.5f)));
+    CHECK(n.z == doctest::Approx(std::sqrt(0.5f)));
+    m.uvs = {{0, 0}, {1, 0}, {0, 2}};
+    const Vec2 uv = triangle_uv(m, 0, 0.25f, 0.5f);
+    CHECK(uv.x == doctest::Approx(0.25f));
+    CHECK(uv.y == doctest::Approx(1.0f));
+    // Clockwise winding flips the geometric normal.
+    m.indices = {0, 2, 1};
+    CHECK(triangle_geometric_normal(m, 0) == Vec3(0, 0, -1));
+}
+
+TEST_CASE("OBJ reader fan-splits polygons in file order and keeps degenerate triangles") {
+    const auto dir = std::filesystem::temp_directory_path() / "sahara_test_obj";
+    std::filesystem::create_directories(dir);
+    const auto file = dir / "fan.obj";
+    {
+        std::FILE* f = std::fopen(file.string().c_str(), "w");
+        REQUIRE(f);
+        std::fputs("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 1 2 5\nf -5 -4 -3\n", f);
+        std::fclose(f);
+    }
+    const TriangleMesh m = read_obj_triangles(file);
+    REQUIRE(m.triangle_count() == 4);
+    CHECK(m.indices == std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 1, 4, 0, 1, 2});
+    CHECK_THROWS_AS(read_obj_triangles(dir / "missing.obj"), InputError);
+    std::filesystem::remove_all(dir);
+}
