@@ -1,5 +1,7 @@
 #include "app/cli.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -8,7 +10,7 @@
 #include "app/cmd_info.h"
 #include "app/cmd_version.h"
 #include "app/commands.h"
-#include "app/tool_args.h"
+#include "app/cli_args.h"
 #include "base/error.h"
 
 namespace sahara {
@@ -32,29 +34,60 @@ const char* const kUsage =
     "  sahara COMMAND --help   options of a command\n"
     "  sahara --version        the version and the optional parts built in\n";
 
-}  // namespace
-
-int run_cli(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty()) {
-        std::fputs(kUsage, stderr);
-        return 2;
-    }
-    const std::string& cmd = args[0];
-    if (cmd == "-h" || cmd == "--help" || cmd == "help") {
-        std::fputs(kUsage, stdout);
-        return 0;
-    }
-    if (cmd == "--version" || cmd == "-V" || cmd == "version") return run_version_command();
-    const std::vector<std::string> rest(args.begin() + 1, args.end());
+/// The command's entry point, given the words after the command name.
+int dispatch(const std::string& cmd, const std::vector<std::string>& rest) {
     if (cmd == "render") return run_render_command(rest);
     if (cmd == "info") return run_info_command(rest);
     if (cmd == "view") return run_view_command(rest);
     if (cmd == "converge") return run_converge_command(rest);
-    if (cmd == "bvh") return run_bvh_command(argc - 1, argv + 1);
-    if (cmd == "bench") return run_bench_command(argc - 1, argv + 1);
-    if (cmd == "trace") return run_trace_command(argc - 1, argv + 1);
-    return usage_error("", std::string(cmd[0] == '-' ? "unknown option '" : "unknown command '") + cmd + "'");
+    // The tool commands take argc/argv with argv[0] the command name.
+    std::vector<std::string> words{cmd};
+    words.insert(words.end(), rest.begin(), rest.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    const int argc = int(words.size());
+    if (cmd == "bvh") return run_bvh_command(argc, argv.data());
+    if (cmd == "bench") return run_bench_command(argc, argv.data());
+    return run_trace_command(argc, argv.data());
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty()) {
+        std::fputs(kUsage, stderr);
+        return 2;
+    }
+    CLI::App app;
+    bool help = false, version = false;
+    configure_app(app, help);
+    app.add_flag("-V,--version", version);
+    for (const char* name :
+         {"render", "view", "info", "converge", "bvh", "bench", "trace", "version", "help"}) {
+        CLI::App* sub = app.add_subcommand(name);
+        sub->set_help_flag();   // the command parses its own words, --help included
+        sub->prefix_command();  // every word after the command name is the command's
+    }
+    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes from the back
+    try {
+        app.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        return usage_error("", e.what());
+    }
+    const std::vector<CLI::App*> chosen = app.get_subcommands();
+    const std::string cmd = chosen.empty() ? "" : chosen[0]->get_name();
+    if (help || cmd == "help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+    }
+    if (version || cmd == "version") return run_version_command();
+    if (cmd.empty() || !app.remaining().empty()) {
+        const std::string first = app.remaining().empty() ? args[0] : app.remaining()[0];
+        return usage_error("", (first[0] == '-' ? "unknown option '" : "unknown command '") + first + "'");
+    }
+    return dispatch(cmd, chosen[0]->remaining());
 }
 
 }  // namespace sahara

@@ -1,19 +1,21 @@
 /// `sahara bench`: builds the BVH over a mesh or a scene file, traces fixed seeded
 /// ray sets and reports throughput, with Embree 3 on the same rays as the
 /// yardstick (triangles only: skipped for scenes with other primitives).
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <tuple>
 
 #include "scene/accelerator.h"
 #include "app/bench_rays.h"
 #include "app/commands.h"
 #include "app/mesh_input.h"
 #include "app/ray_batch.h"
-#include "app/tool_args.h"
+#include "app/cli_args.h"
 #include "accel/packet.h"
 #include "base/error.h"
 
@@ -22,9 +24,9 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBenchUsage =
-    "usage: sahara bench FILE [--threads N] [--rays primary|primary_packet|diffuse|shadow|all]\n"
+    "usage: sahara bench FILE [--threads N] [--ray-set primary|primary_packet|diffuse|shadow|all]\n"
     "                         [--json]\n"
-    "                         [--builder binned|sweep|reinsert] [--layout L] [--size N] [--repeat K]\n"
+    "                         [--builder binned|sweep|reinsert] [--layout L] [--size WxH|N] [--repeat K]\n"
     "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
@@ -32,7 +34,7 @@ constexpr const char* kBenchUsage =
     "              tree, not traced), primary rays come from the scene's camera (lens centre), and\n"
     "              the Embree comparison runs only if every bounded primitive is a triangle\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
-    "  --rays      ray set to trace (default all): primary = N x N camera rays framing the mesh\n"
+    "  --ray-set S ray set to trace (default all): primary = W x H camera rays framing the mesh\n"
     "              (a scene: its camera), primary_packet = the primary rays as 16-ray packets of\n"
     "              4x4 pixel tiles (Embree: rtcIntersect16 on the same tiles; also compared with\n"
     "              sahara's single rays),\n"
@@ -43,7 +45,7 @@ constexpr const char* kBenchUsage =
     "              time, 8 with AVX2), wide4 (4-wide BVH), wide4-slots (4-wide BVH, one leaf slot at\n"
     "              a time) or pairs (binary BVH); the wide layouts use the widest of AVX-512, AVX2\n"
     "              and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a narrower one)\n"
-    "  --size N    primary image side (default 1024: 1M rays per set)\n"
+    "  --size WxH  primary image size, N x N for one number (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
     "  --embree-robust\n"
@@ -75,7 +77,7 @@ struct BenchOptions {
     std::vector<std::string> sets;
     BvhBuilder builder = BvhBuilder::binned;
     BvhLayout layout = AcceleratorOptions{}.layout;
-    int size = 1024;
+    int width = 1024, height = 1024;
     int repeat = 3;
     bool embree = true;
     bool embree_robust = false;
@@ -140,8 +142,9 @@ nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelera
     PassTimes ours, theirs;
     RayAnswers a, b, single;
     for (int k = 0; k < opt.repeat; ++k) {
-        ours.add(trace_sahara_packets(accel, rays, opt.size, opt.size, opt.threads, true, a));
-        if (embree) theirs.add(trace_embree_packets(*embree, rays, opt.size, opt.size, opt.threads, true, b));
+        ours.add(trace_sahara_packets(accel, rays, opt.width, opt.height, opt.threads, true, a));
+        if (embree)
+            theirs.add(trace_embree_packets(*embree, rays, opt.width, opt.height, opt.threads, true, b));
     }
     trace_sahara(accel, rays, false, opt.threads, true, single);
     const Disagreements ds = compare_answers(a, single, rays, mesh);
@@ -183,7 +186,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust,
                                                    opt.threads, opt.embree_isa);
     const BenchRaySets rays =
-        make_bench_rays(scene, accel, opt.size, opt.size,
+        make_bench_rays(scene, accel, opt.width, opt.height,
                         input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     nlohmann::ordered_json j = {
         {"mesh", opt.mesh},
@@ -324,53 +327,66 @@ int run_small_scenes() {
     return 0;
 }
 
-/// Fills `opt` from the flags; returns an error message (empty on success).
-std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
-    if (args.positional.size() != 1) return "expected one mesh or scene file";
-    opt.mesh = args.positional[0];
-    opt.threads = omp_get_num_procs();
-    if (args.has("--threads") && !parse_positive_int(args.values.at("--threads"), opt.threads))
-        return "--threads must be a positive integer";
-    if (args.has("--size") && !parse_positive_int(args.values.at("--size"), opt.size))
-        return "--size must be a positive integer";
-    if (args.has("--repeat") && !parse_positive_int(args.values.at("--repeat"), opt.repeat))
-        return "--repeat must be a positive integer";
-    if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), opt.builder))
-        return "--builder must be binned, sweep or reinsert";
-    if (!parse_bvh_layout(args.value_or("--layout", bvh_layout_name(opt.layout)), opt.layout))
-        return "--layout must be wide8, wide4, wide4-slots or pairs";
-    const std::string sets = args.value_or("--rays", "all");
-    if (sets == "all")
-        opt.sets = {"primary", "primary_packet", "diffuse", "shadow"};
-    else if (sets == "primary" || sets == "primary_packet" || sets == "diffuse" || sets == "shadow")
-        opt.sets = {sets};
-    else
-        return "--rays must be primary, primary_packet, diffuse, shadow or all";
-    opt.embree = !args.switches.count("--no-embree");
-    opt.embree_robust = args.switches.count("--embree-robust") != 0;
-    opt.embree_isa = args.value_or("--embree-isa", "best");
-    if (std::find(std::begin(kEmbreeIsas), std::end(kEmbreeIsas), opt.embree_isa) == std::end(kEmbreeIsas))
-        return "--embree-isa must be best, sse2, avx, avx2 or avx512";
-    opt.json = args.switches.count("--json") != 0;
-    return "";
+/// The ray sets --ray-set names ("all": every one).
+std::vector<std::string> parse_ray_sets(const std::string& flag, const std::string& v) {
+    if (v == "all") return {"primary", "primary_packet", "diffuse", "shadow"};
+    if (v == "primary" || v == "primary_packet" || v == "diffuse" || v == "shadow") return {v};
+    throw UsageError(flag + ": expected primary|primary_packet|diffuse|shadow|all, got '" + v + "'");
+}
+
+/// Adds bench's options to `app`, filling `opt`; `small_scenes` and `help` are the two modes without a file.
+void add_bench_options(CLI::App& app, BenchOptions& opt, bool& small_scenes) {
+    add_threads_option(app, opt.threads);
+    app.add_option_function<std::string>(
+        "--ray-set", [&opt](const std::string& v) { opt.sets = parse_ray_sets("--ray-set", v); });
+    // --rays names a ray file in `sahara trace`; here it was the set, renamed so one name means one thing.
+    app.add_option_function<std::string>("--rays", [](const std::string&) {
+        throw UsageError("--rays is now --ray-set (--rays names a ray file)");
+    });
+    app.add_option_function<std::string>(
+        "--builder", [&opt](const std::string& v) { opt.builder = parse_builder_name("--builder", v); });
+    app.add_option_function<std::string>(
+        "--layout", [&opt](const std::string& v) { opt.layout = parse_layout_name("--layout", v); });
+    app.add_option_function<std::string>("--size", [&opt](const std::string& v) {
+        std::tie(opt.width, opt.height) = parse_size_value("--size", v);
+    });
+    app.add_option_function<std::string>("--repeat", [&opt](const std::string& v) {
+        opt.repeat = int(parse_int_value("--repeat", v, 1, 1 << 20));
+    });
+    app.add_option_function<std::string>("--embree-isa", [&opt](const std::string& v) {
+        if (std::find(std::begin(kEmbreeIsas), std::end(kEmbreeIsas), v) == std::end(kEmbreeIsas))
+            throw UsageError("--embree-isa: expected best|sse2|avx|avx2|avx512, got '" + v + "'");
+        opt.embree_isa = v;
+    });
+    app.add_flag("--json", opt.json);
+    app.add_flag_callback("--no-embree", [&opt] { opt.embree = false; });
+    app.add_flag("--embree-robust", opt.embree_robust);
+    app.add_flag("--small-scenes", small_scenes);
 }
 
 }  // namespace
 
 int run_bench_command(int argc, char** argv) {
-    ToolArgs args;
-    std::string err = parse_tool_args(
-        argc, argv, {"--threads", "--rays", "--builder", "--layout", "--size", "--repeat", "--embree-isa"},
-        {"--json", "--no-embree", "--embree-robust", "--small-scenes"}, args);
-    if (!err.empty()) return usage_error("bench", err);
-    if (args.help) {
+    BenchOptions opt;
+    opt.threads = omp_get_num_procs();
+    opt.sets = parse_ray_sets("--ray-set", "all");
+    bool small_scenes = false, help = false;
+    try {
+        CLI::App app;
+        configure_app(app, help);
+        add_bench_options(app, opt, small_scenes);
+        const std::vector<std::string> files =
+            parse_command_line(app, std::vector<std::string>(argv + 1, argv + argc));
+        if (!help && !small_scenes && files.size() != 1) throw UsageError("expected one mesh or scene file");
+        if (files.size() == 1) opt.mesh = files[0];
+    } catch (const UsageError& e) {
+        return usage_error("bench", e.what());
+    }
+    if (help) {
         std::fputs(kBenchUsage, stdout);
         return 0;
     }
-    if (args.switches.count("--small-scenes")) return run_small_scenes();
-    BenchOptions opt;
-    err = bench_options(args, opt);
-    if (!err.empty()) return usage_error("bench", err);
+    if (small_scenes) return run_small_scenes();
     try {
         const nlohmann::ordered_json j = run_bench(opt);
         if (opt.json)

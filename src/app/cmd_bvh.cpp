@@ -1,6 +1,7 @@
 /// `sahara bvh`: builds the BVH over a mesh or a scene file's bounded primitives
 /// and prints its statistics, plus
 /// the mean traversal work per ray for primary, diffuse-bounce and shadow (occlusion) rays.
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
@@ -13,7 +14,7 @@
 #include "app/bench_rays.h"
 #include "app/commands.h"
 #include "app/mesh_input.h"
-#include "app/tool_args.h"
+#include "app/cli_args.h"
 #include "base/error.h"
 
 namespace sahara {
@@ -21,8 +22,8 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBvhUsage =
-    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--layout L] [--threads N] [--size N]\n"
-    "                       [--json]\n"
+    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--layout L] [--threads N]\n"
+    "                       [--size WxH|N] [--json]\n"
     "  FILE        a mesh (.obj, .gltf, .glb; OBJ polygons are fan-split, degenerate triangles kept)\n"
     "              or a scene file (.json): the tree holds its triangles, spheres, boxes and quadrics;\n"
     "              planes are unbounded, stay outside the tree and are not traced here\n"
@@ -32,9 +33,10 @@ constexpr const char* kBvhUsage =
     "  --layout L  traversal structure the counts below are taken on: wide8 (default), wide4,\n"
     "              wide4-slots or pairs (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
-    "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays and\n"
-    "              as many shadow rays (occlusion, to a light above; the sets of `sahara bench`);\n"
-    "              a mesh is framed from (0.4, 0.3, 1), a scene is seen through its own camera\n"
+    "  --size WxH  primary rays W x H, N x N for one number (default 1024, i.e. 1M), as many\n"
+    "              diffuse-bounce rays and as many shadow rays (occlusion, to a light above; the sets\n"
+    "              of `sahara bench`); a mesh is framed from (0.4, 0.3, 1), a scene is seen through\n"
+    "              its own camera\n"
     "  --json      print one JSON object instead of text\n"
     "SAH costs: traversal 1, primitive intersection 1 (relative), normalised to the root's area.\n";
 
@@ -75,8 +77,21 @@ nlohmann::ordered_json primitive_kinds_json(const Scene& scene) {
             {"quadrics", scene.quadrics.size()}};
 }
 
-nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuilder> chosen, BvhLayout layout,
-                                  int size, int threads) {
+struct BvhArgs {
+    std::string file;
+    std::optional<BvhBuilder> builder;  ///< none: the scene's render.bvh_builder (for a mesh, the default)
+    std::optional<BvhLayout> layout;
+    std::optional<int> width, height;  ///< the primary-ray grid (default 1024 x 1024)
+    int threads = 0;
+    bool json = false;
+    bool help = false;
+};
+
+nlohmann::ordered_json bvh_report(const BvhArgs& args) {
+    const std::string& file = args.file;
+    const std::optional<BvhBuilder> chosen = args.builder;
+    const BvhLayout layout = args.layout.value_or(AcceleratorOptions{}.layout);
+    const int threads = args.threads;
     const ToolInput input = read_tool_input(file);
     const Scene& scene = input.scene;
     const BvhBuilder builder = chosen.value_or(scene.render.bvh_builder);
@@ -89,8 +104,9 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
     // The SAH cost of the tree as built (the block layouts scale the intersection cost).
     const BvhBuildParams built = opt.build_params();
     const BvhStats s = compute_bvh_stats(accel.bvh(), built);
-    const BenchRaySets rays = make_bench_rays(
-        scene, accel, size, size, input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
+    const BenchRaySets rays =
+        make_bench_rays(scene, accel, args.width.value_or(1024), args.height.value_or(1024),
+                        input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     const size_t prims = accel.primitive_count();
     nlohmann::ordered_json j = {
         {"mesh", file},
@@ -184,37 +200,40 @@ void print_text(const nlohmann::ordered_json& j) {
     }
 }
 
+BvhArgs parse_bvh_args(const std::vector<std::string>& words) {
+    BvhArgs a;
+    a.threads = omp_get_num_procs();
+    CLI::App app;
+    configure_app(app, a.help);
+    app.add_option_function<std::string>(
+        "--builder", [&a](const std::string& v) { a.builder = parse_builder_name("--builder", v); });
+    app.add_option_function<std::string>(
+        "--layout", [&a](const std::string& v) { a.layout = parse_layout_name("--layout", v); });
+    add_threads_option(app, a.threads);
+    add_size_option(app, a.width, a.height);
+    app.add_flag("--json", a.json);
+    const std::vector<std::string> files = parse_command_line(app, words);
+    if (!a.help && files.size() != 1) throw UsageError("expected one mesh or scene file");
+    if (!a.help) a.file = files[0];
+    return a;
+}
+
 }  // namespace
 
 int run_bvh_command(int argc, char** argv) {
-    ToolArgs args;
-    const std::string err =
-        parse_tool_args(argc, argv, {"--builder", "--layout", "--size", "--threads"}, {"--json"}, args);
-    if (!err.empty()) return usage_error("bvh", err);
+    BvhArgs args;
+    try {
+        args = parse_bvh_args(std::vector<std::string>(argv + 1, argv + argc));
+    } catch (const UsageError& e) {
+        return usage_error("bvh", e.what());
+    }
     if (args.help) {
         std::fputs(kBvhUsage, stdout);
         return 0;
     }
-    if (args.positional.size() != 1) return usage_error("bvh", "expected one mesh or scene file");
-    std::optional<BvhBuilder> builder;  // none: the scene's render.bvh_builder (for a mesh, the default)
-    if (args.has("--builder")) {
-        BvhBuilder b{};
-        if (!parse_bvh_builder(args.values["--builder"], b))
-            return usage_error("bvh", "--builder must be binned, sweep or reinsert");
-        builder = b;
-    }
-    BvhLayout layout = AcceleratorOptions{}.layout;
-    if (args.has("--layout") && !parse_bvh_layout(args.values["--layout"], layout))
-        return usage_error("bvh", "--layout must be wide8, wide4, wide4-slots or pairs");
-    int size = 1024;
-    if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
-        return usage_error("bvh", "--size must be a positive integer");
-    int threads = omp_get_num_procs();
-    if (args.has("--threads") && !parse_positive_int(args.values["--threads"], threads))
-        return usage_error("bvh", "--threads must be a positive integer");
     try {
-        const nlohmann::ordered_json j = bvh_report(args.positional[0], builder, layout, size, threads);
-        if (args.switches.count("--json"))
+        const nlohmann::ordered_json j = bvh_report(args);
+        if (args.json)
             std::printf("%s\n", j.dump().c_str());
         else
             print_text(j);

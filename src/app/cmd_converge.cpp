@@ -1,5 +1,7 @@
 #include "app/cmd_converge.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,7 +12,6 @@
 
 #include <omp.h>
 
-#include "app/tool_args.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_io.h"
@@ -54,11 +55,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
-    if (i + 1 >= args.size()) throw UsageError(args[i] + ": missing value");
-    return args[++i];
-}
-
 ConvergeConfig parse_config(const std::string& spec) {
     const size_t eq = spec.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -68,9 +64,22 @@ ConvergeConfig parse_config(const std::string& spec) {
     std::istringstream in(spec.substr(eq + 1));
     std::vector<std::string> words;
     for (std::string w; in >> w;) words.push_back(w);
-    for (size_t i = 0; i < words.size(); ++i)
-        if (!parse_override_flag(words, i, c.overrides))
-            throw UsageError("--compare '" + c.label + "': unknown render flag '" + words[i] + "'");
+    CLI::App app;
+    bool help = false;
+    configure_app(app, help);
+    add_render_flags(app, c.overrides);
+    try {
+        const std::vector<std::string> rest = parse_command_line(app, words);
+        if (help || !rest.empty())
+            throw UsageError("unknown option '" + (help ? std::string("--help") : rest[0]) + "'");
+    } catch (const UsageError& e) {
+        const std::string what = e.what();
+        const std::string unknown = "unknown option '";
+        if (what.rfind(unknown, 0) == 0)
+            throw UsageError("--compare '" + c.label + "': unknown render flag '" +
+                             what.substr(unknown.size()));
+        throw UsageError("--compare '" + c.label + "': " + what);
+    }
     return c;
 }
 
@@ -344,31 +353,26 @@ int run(const ConvergeArgs& a) {
 
 ConvergeArgs parse_converge_args(const std::vector<std::string>& args) {
     ConvergeArgs r;
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        if (a == "-h" || a == "--help")
-            r.help = true;
-        else if (a == "-o" || a == "--output")
-            r.prefix = flag_value(args, i);
-        else if (a == "--reference")
-            r.reference = flag_value(args, i);
-        else if (a == "--budget")
-            r.budget_s = parse_real_value(a, flag_value(args, i), 0.001, 1e6);
-        else if (a == "--max-spp")
-            r.max_spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
-        else if (a == "--threads")
-            r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
-        else if (a == "--compare")
-            r.configs.push_back(parse_config(flag_value(args, i)));
-        else if (parse_override_flag(args, i, r.overrides))
-            continue;
-        else if (!a.empty() && a[0] == '-')
-            throw UsageError("unknown option '" + a + "'");
-        else if (r.scene)
-            throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
-        else
-            r.scene = a;
-    }
+    CLI::App app;
+    configure_app(app, r.help);
+    app.add_option("-o,--output", r.prefix);
+    app.add_option_function<std::string>("--reference", [&r](const std::string& v) { r.reference = v; });
+    app.add_option_function<std::string>(
+        "--budget", [&r](const std::string& v) { r.budget_s = parse_real_value("--budget", v, 0.001, 1e6); });
+    app.add_option_function<std::string>("--max-spp", [&r](const std::string& v) {
+        r.max_spp = int(parse_int_value("--max-spp", v, 1, 1 << 24));
+    });
+    add_threads_option(app, r.threads);
+    std::vector<std::string> compare;
+    app.add_option("--compare", compare)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    add_render_flags(app, r.overrides);
+    const std::vector<std::string> scenes = parse_command_line(app, args);
+    if (scenes.size() > 1)
+        throw UsageError("more than one scene given ('" + scenes[0] + "' and '" + scenes[1] + "')");
+    if (!scenes.empty()) r.scene = scenes[0];
+    for (const std::string& spec : compare) r.configs.push_back(parse_config(spec));
     return r;
 }
 

@@ -1,12 +1,14 @@
 #include "app/cmd_info.h"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 
-#include "app/tool_args.h"
+#include "app/cli_args.h"
 #include "base/error.h"
 #include "io/model_loader.h"
 #include "render/features.h"
@@ -150,20 +152,21 @@ StatsReport scene_info(const std::optional<std::string>& input) {
 
 int run_info_command(const std::vector<std::string>& args) {
     std::optional<std::string> input;
-    bool json = false;
-    for (const std::string& a : args) {
-        if (a == "-h" || a == "--help") {
-            std::fputs(kInfoUsage, stdout);
-            return 0;
-        }
-        if (a == "--json")
-            json = true;
-        else if (!a.empty() && a[0] == '-')
-            return usage_error("info", "unknown option '" + a + "'");
-        else if (input)
-            return usage_error("info", "more than one input given ('" + *input + "' and '" + a + "')");
-        else
-            input = a;
+    bool json = false, help = false;
+    try {
+        CLI::App app;
+        configure_app(app, help);
+        app.add_flag("--json", json);
+        const std::vector<std::string> inputs = parse_command_line(app, args);
+        if (inputs.size() > 1)
+            throw UsageError("more than one input given ('" + inputs[0] + "' and '" + inputs[1] + "')");
+        if (!inputs.empty()) input = inputs[0];
+    } catch (const UsageError& e) {
+        return usage_error("info", e.what());
+    }
+    if (help) {
+        std::fputs(kInfoUsage, stdout);
+        return 0;
     }
     try {
         const StatsReport s = scene_info(input);

@@ -12,7 +12,6 @@
 #include "app/render_args.h"
 #include "app/render_file.h"
 #include "app/signals.h"
-#include "app/tool_args.h"
 #include "base/counters.h"
 #include "base/error.h"
 #include "base/log.h"

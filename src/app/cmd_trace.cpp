@@ -1,5 +1,6 @@
 /// `sahara trace`: traces a raw ray file against a mesh and writes raw hit
 /// (and optionally occlusion) files, for checking sahara against other tracers.
+#include <CLI/CLI.hpp>
 #include <unistd.h>
 
 #include <bit>
@@ -14,7 +15,7 @@
 #include "scene/accelerator.h"
 #include "app/commands.h"
 #include "app/mesh_input.h"
-#include "app/tool_args.h"
+#include "app/cli_args.h"
 #include "base/error.h"
 #include "base/pending_file.h"
 
@@ -80,14 +81,19 @@ void write_atomically(const std::string& path, const std::vector<char>& bytes) {
     }
 }
 
-int trace(const ToolArgs& args) {
-    if (is_scene_file(args.positional[0]))
-        throw input_error(args.positional[0], "",
+struct TraceArgs {
+    std::string mesh, rays, hits, occlusion;  ///< occlusion empty: not written
+    bool help = false;
+};
+
+int trace(const TraceArgs& args) {
+    if (is_scene_file(args.mesh))
+        throw input_error(args.mesh, "",
                           "trace reads meshes only (primitive indices are OBJ triangle indices)");
-    const std::vector<Ray> rays = read_ray_file(args.values.at("--rays"));
-    const Scene scene = scene_from_mesh(read_obj_triangles(args.positional[0]));
+    const std::vector<Ray> rays = read_ray_file(args.rays);
+    const Scene scene = scene_from_mesh(read_obj_triangles(args.mesh));
     const Accelerator accel(scene);
-    const bool want_occl = args.values.count("--occlusion") != 0;
+    const bool want_occl = !args.occlusion.empty();
     std::vector<char> hits(rays.size() * 8), occl(want_occl ? rays.size() : 0);
 #pragma omp parallel for schedule(dynamic, 1024)
     for (size_t i = 0; i < rays.size(); ++i) {
@@ -100,24 +106,39 @@ int trace(const ToolArgs& args) {
         std::memcpy(&hits[8 * i + 4], &prim, 4);
         if (want_occl) occl[i] = accel.occluded(rays[i]) ? 1 : 0;
     }
-    write_atomically(args.values.at("--hits"), hits);
-    if (want_occl) write_atomically(args.values.at("--occlusion"), occl);
+    write_atomically(args.hits, hits);
+    if (want_occl) write_atomically(args.occlusion, occl);
     return 0;
+}
+
+TraceArgs parse_trace_args(const std::vector<std::string>& words) {
+    TraceArgs a;
+    CLI::App app;
+    configure_app(app, a.help);
+    app.add_option("--rays", a.rays);
+    app.add_option("--hits", a.hits);
+    app.add_option("--occlusion", a.occlusion);
+    const std::vector<std::string> meshes = parse_command_line(app, words);
+    if (a.help) return a;
+    if (meshes.size() != 1) throw UsageError("expected one mesh file");
+    if (a.rays.empty() || a.hits.empty()) throw UsageError("--rays and --hits are required");
+    a.mesh = meshes[0];
+    return a;
 }
 
 }  // namespace
 
 int run_trace_command(int argc, char** argv) {
-    ToolArgs args;
-    const std::string err = parse_tool_args(argc, argv, {"--rays", "--hits", "--occlusion"}, {}, args);
-    if (!err.empty()) return usage_error("trace", err);
+    TraceArgs args;
+    try {
+        args = parse_trace_args(std::vector<std::string>(argv + 1, argv + argc));
+    } catch (const UsageError& e) {
+        return usage_error("trace", e.what());
+    }
     if (args.help) {
         std::fputs(kTraceUsage, stdout);
         return 0;
     }
-    if (args.positional.size() != 1) return usage_error("trace", "expected one mesh file");
-    if (!args.values.count("--rays") || !args.values.count("--hits"))
-        return usage_error("trace", "--rays and --hits are required");
     try {
         return trace(args);
     } catch (const InputError& e) {

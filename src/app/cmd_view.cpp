@@ -1,10 +1,12 @@
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "app/commands.h"
 #include "app/render_args.h"
-#include "app/tool_args.h"
 #include "io/model_loader.h"
 #include "io/view_scene.h"
 
@@ -20,7 +22,7 @@ const char* const kViewUsage =
     "framing it from a three-quarter view, a ground plane under it, the sky and a sun.\n"
     "\n"
     "  -o, --output FILE   output image (default view.png)\n"
-    "  --size WxH          image size (default 800x600)\n"
+    "  --size WxH          image size (default 800x600; N: N x N)\n"
     "  --up y|z            the model's up axis (default: y for glTF, guessed for OBJ)\n"
     "  --gltf-camera N     look through the model's glTF camera N instead\n"
     "  --no-ground         no ground plane\n"
@@ -33,39 +35,18 @@ struct ViewArgs {
 
 ViewArgs parse_view_args(const std::vector<std::string>& args) {
     ViewArgs v;
-    std::vector<std::string> rest;
-    bool output_given = false;
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        auto value = [&]() -> const std::string& {
-            if (i + 1 >= args.size()) throw UsageError(a + ": missing value");
-            return args[++i];
-        };
-        if (a == "--size") {
-            const std::string& s = value();
-            const size_t x = s.find('x');
-            if (x == std::string::npos) throw UsageError("--size: expected WxH, got '" + s + "'");
-            v.render.overrides.width = int(parse_int_value("--size", s.substr(0, x), 1, 32768));
-            v.render.overrides.height = int(parse_int_value("--size", s.substr(x + 1), 1, 32768));
-        } else if (a == "--up") {
-            const std::string& s = value();
+    v.render.output = "view.png";
+    v.render.auto_exposure = true;
+    parse_render_args(args, v.render, [&v](CLI::App& app) {
+        app.add_option_function<std::string>("--up", [&v](const std::string& s) {
             if (s != "y" && s != "z") throw UsageError("--up: expected y or z, got '" + s + "'");
             v.view.up = s == "y" ? UpAxis::y : UpAxis::z;
-        } else if (a == "--gltf-camera") {
-            v.view.gltf_camera = int(parse_int_value(a, value(), 0, 1 << 20));
-        } else if (a == "--no-ground") {
-            v.view.ground = false;
-        } else {
-            output_given |= a == "-o" || a == "--output";
-            rest.push_back(a);
-        }
-    }
-    const RenderOverrides size = v.render.overrides;
-    v.render = parse_render_args(rest);
-    if (size.width) v.render.overrides.width = size.width;
-    if (size.height) v.render.overrides.height = size.height;
-    if (!output_given) v.render.output = "view.png";
-    v.render.auto_exposure = true;
+        });
+        app.add_option_function<std::string>("--gltf-camera", [&v](const std::string& s) {
+            v.view.gltf_camera = int(parse_int_value("--gltf-camera", s, 0, 1 << 20));
+        });
+        app.add_flag_callback("--no-ground", [&v] { v.view.ground = false; });
+    });
     if (!v.render.help && !v.render.scene) throw UsageError("no MODEL given");
     return v;
 }

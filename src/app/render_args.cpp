@@ -1,8 +1,8 @@
 #include "app/render_args.h"
 
+#include <CLI/CLI.hpp>
+
 #include <cctype>
-#include <cmath>
-#include <cstdlib>
 
 #include "accel/bvh.h"
 #include "render/tonemap.h"
@@ -18,8 +18,9 @@ const char* const kRenderUsage =
     "  -o, --output FILE    output image (default sahara.png); the extension picks the format\n"
     "  --spp N              samples per pixel\n"
     "  --width W, --height H  image size in pixels\n"
-    "  --max-depth D        rays per path, camera ray included\n"
-    "  --seed S             random seed (same seed + settings = same image)\n"
+    "  --size WxH           both at once (N: N x N)\n"
+    "  --max-depth D        rays per path, camera ray included (1..1024)\n"
+    "  --seed S             random seed, 0..2^64-1 (same seed + settings = same image)\n"
     "  --integrator NAME    path | whitted | albedo | normals | depth | bvh-cost\n"
     "  --exposure STOPS     exposure for 8-bit outputs (EXR stays linear)\n"
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
@@ -43,50 +44,10 @@ const char* const kRenderUsage =
     "                       shutter by f (moving spheres move). Under mpirun, ranks take\n"
     "                       whole frames; otherwise frames render one after another\n"
     "  --stats              print statistics at the end\n"
-    "  --quiet              no progress and no summary line\n"
+    "  -q, --quiet          no progress and no summary line\n"
     "  -h, --help           this text\n";
 
-long long parse_int_value(const std::string& flag, const std::string& value, long long lo, long long hi) {
-    char* end = nullptr;
-    errno = 0;
-    long long v = std::strtoll(value.c_str(), &end, 10);
-    if (value.empty() || *end != '\0' || errno == ERANGE || v < lo || v > hi)
-        throw UsageError(flag + ": expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                         ", got '" + value + "'");
-    return v;
-}
-
-double parse_real_value(const std::string& flag, const std::string& value, double lo, double hi) {
-    char* end = nullptr;
-    double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
-        throw UsageError(flag + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                         "], got '" + value + "'");
-    return v;
-}
-
-IntegratorType parse_integrator_name(const std::string& flag, const std::string& v) {
-    if (v == "path") return IntegratorType::path;
-    if (v == "whitted") return IntegratorType::whitted;
-    if (v == "albedo") return IntegratorType::albedo;
-    if (v == "normals") return IntegratorType::normals;
-    if (v == "depth") return IntegratorType::depth;
-    if (v == "bvh-cost") return IntegratorType::bvh_cost;
-    throw UsageError(flag + ": expected path|whitted|albedo|normals|depth|bvh-cost, got '" + v + "'");
-}
-
-SamplerType parse_sampler_name(const std::string& flag, const std::string& v) {
-    if (v == "sobol") return SamplerType::sobol;
-    if (v == "independent") return SamplerType::independent;
-    throw UsageError(flag + ": expected sobol|independent, got '" + v + "'");
-}
-
 namespace {
-
-const std::string& flag_value(const std::vector<std::string>& args, size_t& i) {
-    if (i + 1 >= args.size()) throw UsageError(args[i] + ": missing value");
-    return args[++i];
-}
 
 /// "A..B" (or "A") as an inclusive frame range.
 std::pair<int, int> parse_frame_range(const std::string& flag, const std::string& v) {
@@ -126,50 +87,6 @@ std::string frame_output_name(const std::string& pattern, int frame) {
                      "' needs # or %04d where the frame number goes");
 }
 
-bool parse_override_flag(const std::vector<std::string>& args, size_t& i, RenderOverrides& o) {
-    const std::string& a = args[i];
-    if (a == "--spp")
-        o.spp = int(parse_int_value(a, flag_value(args, i), 1, 1 << 24));
-    else if (a == "--width")
-        o.width = int(parse_int_value(a, flag_value(args, i), 1, 32768));
-    else if (a == "--height")
-        o.height = int(parse_int_value(a, flag_value(args, i), 1, 32768));
-    else if (a == "--max-depth")
-        o.max_depth = int(parse_int_value(a, flag_value(args, i), 0, 100000));
-    else if (a == "--seed")
-        o.seed = uint64_t(parse_int_value(a, flag_value(args, i), 0, (1LL << 62)));
-    else if (a == "--integrator")
-        o.integrator = parse_integrator_name(a, flag_value(args, i));
-    else if (a == "--time")
-        o.time_limit_s = parse_real_value(a, flag_value(args, i), 0.0, 1e9);
-    else if (a == "--target-error")
-        o.target_error = parse_real_value(a, flag_value(args, i), 1e-6, 1e3);
-    else if (a == "--builder") {
-        const std::string& v = flag_value(args, i);
-        BvhBuilder b{};
-        if (!parse_bvh_builder(v, b))
-            throw UsageError(a + ": expected binned|sweep|reinsert, got '" + v + "'");
-        o.bvh_builder = b;
-    } else if (a == "--layout") {
-        const std::string& v = flag_value(args, i);
-        BvhLayout l{};
-        if (!parse_bvh_layout(v, l))
-            throw UsageError(a + ": expected wide8|wide4|wide4-slots|pairs, got '" + v + "'");
-        o.bvh_layout = l;
-    } else if (a == "--sampler")
-        o.sampler = parse_sampler_name(a, flag_value(args, i));
-    else if (a == "--exposure")
-        o.exposure = float(parse_real_value(a, flag_value(args, i), -64.0, 64.0));
-    else if (a == "--tonemap") {
-        const std::string& v = flag_value(args, i);
-        const std::optional<Tonemap> t = tonemap_from_name(v);
-        if (!t) throw UsageError(a + ": expected clamp|reinhard|aces|filmic, got '" + v + "'");
-        o.tonemap = *t;
-    } else
-        return false;
-    return true;
-}
-
 void RenderOverrides::apply(RenderSettings& r) const {
     if (width) r.width = *width;
     if (height) r.height = *height;
@@ -186,46 +103,40 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (bvh_layout) r.bvh_layout = *bvh_layout;
 }
 
-RenderArgs parse_render_args(const std::vector<std::string>& args) {
-    RenderArgs r;
-    for (size_t i = 0; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        if (a == "-h" || a == "--help")
-            r.help = true;
-        else if (a == "-o" || a == "--output")
-            r.output = flag_value(args, i);
-        else if (a == "--threads")
-            r.threads = int(parse_int_value(a, flag_value(args, i), 1, 1024));
-        else if (a == "--quiet" || a == "-q")
-            r.quiet = true;
-        else if (a == "--stats")
-            r.stats = true;
-        else if (a == "--checkpoint")
-            r.checkpoint_s = parse_real_value(a, flag_value(args, i), 0.1, 1e9);
-        else if (a == "--resume")
-            r.resume = flag_value(args, i);
-        else if (a == "--reference")
-            r.reference = flag_value(args, i);
-        else if (a == "--preview")
-            r.preview = true;
-        else if (a == "--preview-dump")
-            r.preview_dump = flag_value(args, i);
-        else if (a == "--frames")
-            r.frames = parse_frame_range(a, flag_value(args, i));
-        else if (parse_override_flag(args, i, r.overrides))
-            continue;
-        else if (!a.empty() && a[0] == '-')
-            throw UsageError("unknown option '" + a + "'");
-        else if (r.scene)
-            throw UsageError("more than one scene given ('" + *r.scene + "' and '" + a + "')");
-        else
-            r.scene = a;
-    }
+void parse_render_args(const std::vector<std::string>& args, RenderArgs& r,
+                       const std::function<void(CLI::App&)>& extra) {
+    CLI::App app;
+    configure_app(app, r.help);
+    app.add_option("-o,--output", r.output);
+    add_threads_option(app, r.threads);
+    app.add_flag("-q,--quiet", r.quiet);
+    app.add_flag("--stats", r.stats);
+    app.add_option_function<std::string>("--checkpoint", [&r](const std::string& v) {
+        r.checkpoint_s = parse_real_value("--checkpoint", v, 0.1, 1e9);
+    });
+    app.add_option_function<std::string>("--resume", [&r](const std::string& v) { r.resume = v; });
+    app.add_option_function<std::string>("--reference", [&r](const std::string& v) { r.reference = v; });
+    app.add_flag("--preview", r.preview);
+    app.add_option_function<std::string>("--preview-dump",
+                                         [&r](const std::string& v) { r.preview_dump = v; });
+    app.add_option_function<std::string>(
+        "--frames", [&r](const std::string& v) { r.frames = parse_frame_range("--frames", v); });
+    add_render_flags(app, r.overrides);
+    if (extra) extra(app);
+    const std::vector<std::string> scenes = parse_command_line(app, args);
+    if (scenes.size() > 1)
+        throw UsageError("more than one scene given ('" + scenes[0] + "' and '" + scenes[1] + "')");
+    if (!scenes.empty()) r.scene = scenes[0];
     if (r.frames) {
         if (r.resume)
             throw UsageError("--frames and --resume cannot be combined (resume one frame at a time)");
         frame_output_name(r.output, r.frames->first);  // checks the pattern now
     }
+}
+
+RenderArgs parse_render_args(const std::vector<std::string>& args) {
+    RenderArgs r;
+    parse_render_args(args, r, {});
     return r;
 }
 

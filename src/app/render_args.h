@@ -1,20 +1,16 @@
 #pragma once
-/// Command-line arguments of `sahara render` (and the shared render flags of
-/// `sahara view`), parsed by a pure function so it can be tested directly.
+/// Command-line arguments of `sahara render` (and `sahara view`), parsed by a
+/// pure function so it can be tested directly.
+#include <functional>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "app/cli_args.h"
 #include "desc/scene_desc.h"
 
 namespace sahara {
-
-/// A malformed command line: the app prints the message and the usage, exit 2.
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
 
 /// Render settings given on the command line; each overrides the scene's value.
 struct RenderOverrides {
@@ -55,18 +51,13 @@ struct RenderArgs {
 /// replaced. Throws UsageError when `pattern` has neither.
 std::string frame_output_name(const std::string& pattern, int frame);
 
-/// Parses the arguments after `render`. Throws UsageError.
+/// Parses the arguments after `render` (the shared render flags through
+/// add_render_flags). Throws UsageError.
 RenderArgs parse_render_args(const std::vector<std::string>& args);
-
-/// Tries to consume one shared render flag at args[i] (advancing i past its
-/// value). Returns false if args[i] is not such a flag. Throws UsageError.
-bool parse_override_flag(const std::vector<std::string>& args, size_t& i, RenderOverrides& o);
-
-/// Parses an integer/real flag value, throwing UsageError naming the flag.
-long long parse_int_value(const std::string& flag, const std::string& value, long long lo, long long hi);
-double parse_real_value(const std::string& flag, const std::string& value, double lo, double hi);
-IntegratorType parse_integrator_name(const std::string& flag, const std::string& value);
-SamplerType parse_sampler_name(const std::string& flag, const std::string& value);
+/// The same into `r`, whose values are the defaults; `extra` adds a command's
+/// own options (those of `sahara view`).
+void parse_render_args(const std::vector<std::string>& args, RenderArgs& r,
+                       const std::function<void(CLI::App&)>& extra);
 
 extern const char* const kRenderUsage;
 

@@ -379,3 +379,24 @@ TEST_CASE("render --layout picks the traversal structure the scene's tree is bui
     CHECK_THROWS_AS(parse_render_args({"--layout", "wide16"}), UsageError);
     CHECK_THROWS_AS(parse_render_args({"--layout"}), UsageError);
 }
+
+TEST_CASE("render flags accept the scene file's ranges, and --size WxH or N") {
+    const RenderArgs a =
+        parse_render_args({"--seed", "18446744073709551615", "--max-depth", "1024", "--size", "64x32"});
+    CHECK(*a.overrides.seed == UINT64_MAX);
+    CHECK(*a.overrides.max_depth == 1024);
+    CHECK(*a.overrides.width == 64);
+    CHECK(*a.overrides.height == 32);
+    const RenderArgs square = parse_render_args({"--size", "48", "--spp=3", "-q"});
+    CHECK(*square.overrides.width == 48);
+    CHECK(*square.overrides.height == 48);
+    CHECK(*square.overrides.spp == 3);
+    CHECK(square.quiet);
+    CHECK_THROWS_AS(parse_render_args({"--seed", "18446744073709551616"}), UsageError);
+    CHECK_THROWS_AS(parse_render_args({"--seed", "-1"}), UsageError);
+    CHECK_THROWS_AS(parse_render_args({"--max-depth", "0"}), UsageError);
+    CHECK_THROWS_AS(parse_render_args({"--max-depth", "1025"}), UsageError);
+    CHECK_THROWS_AS(parse_render_args({"--size", "8x8x8"}), UsageError);
+    // A repeated option keeps its last value, as before.
+    CHECK(*parse_render_args({"--spp", "2", "--spp", "5"}).overrides.spp == 5);
+}

@@ -104,7 +104,7 @@ TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree sk
     }
     CHECK(b["rays"]["primary"]["hit_rate"].get<double>() > 0.5);  // showcase: a floor fills the view
 
-    const ToolRun text = run_tool("bench " + file + " --size 16 --repeat 1 --rays primary", dir);
+    const ToolRun text = run_tool("bench " + file + " --size 16 --repeat 1 --ray-set primary", dir);
     CHECK(text.code == 0);
     CHECK(text.out.find(EmbreeReference::available()
                             ? "skipped: scene has"

@@ -90,8 +90,26 @@ TEST_CASE("cli usage: missing and malformed values are one line too") {
     check_one_line_usage_error("converge --budget", "converge", "--budget: missing value");
     check_one_line_usage_error("bvh", "bvh", "expected one mesh or scene file");
     check_one_line_usage_error("bvh m.obj --size", "bvh", "--size: missing value");
-    check_one_line_usage_error("bench m.obj --rays sideways", "bench", "--rays");
+    check_one_line_usage_error("bench m.obj --ray-set sideways", "bench", "--ray-set: expected");
+    check_one_line_usage_error("render --max-depth 0", "render",
+                               "--max-depth: expected an integer in 1..1024");
+    check_one_line_usage_error("render --threads 0", "render", "--threads: expected an integer in 1..1024");
+    check_one_line_usage_error("view m.obj --size 8x", "view", "--size: expected an integer");
+    check_one_line_usage_error("bvh m.obj --size 0", "bvh", "--size: expected an integer");
+    check_one_line_usage_error("--bogus render", "", "unknown option '--bogus'");
     check_one_line_usage_error("trace m.obj", "trace", "--rays and --hits are required");
+}
+
+TEST_CASE("cli usage: an option means one thing in every command") {
+    // bench's ray-set option was --rays, which in trace names a ray file: the old spelling says the new one.
+    check_one_line_usage_error("bench m.obj --rays shadow", "bench", "--rays is now --ray-set");
+    // --threads has one range everywhere; bench and bvh take --size as WxH like view.
+    for (const char* command : {"render", "converge", "bvh", "bench"}) {
+        CAPTURE(command);
+        check_one_line_usage_error(std::string(command) + " m.obj --threads 2000", command,
+                                   "--threads: expected");
+    }
+    check_one_line_usage_error("bench m.obj --size 16x", "bench", "--size: expected");
 }
 
 TEST_CASE("cli usage: --help still prints the whole text on stdout") {

@@ -192,10 +192,10 @@ TEST_CASE("bvh and bench commands: JSON output, usage errors") {
               std::string::npos);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-isa", "avx512skx"}).first == 2);
     const auto only = run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1",
-                                                       "--rays", "shadow", "--no-embree"});
+                                                       "--ray-set", "shadow", "--no-embree"});
     CHECK(only.first == 0);
     CHECK(only.second.find("primary") == std::string::npos);
-    CHECK(run_captured(run_bench_command, {"bench", mesh, "--rays", "sideways"}).first == 2);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--ray-set", "sideways"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--threads", "0"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--frobnicate"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", "--help"}).first == 0);
@@ -214,13 +214,13 @@ TEST_CASE("bench command compares with Embree: default, robust and ISA-capped mo
     CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
     // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.
     const auto robust = run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1",
-                                                         "--rays", "diffuse", "--embree-robust", "--json"});
+                                                         "--ray-set", "diffuse", "--embree-robust", "--json"});
     REQUIRE(robust.first == 0);
     CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
     CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
     CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
     const auto capped =
-        run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--rays", "shadow",
+        run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--ray-set", "shadow",
                                          "--embree-isa", "sse2", "--json"});
     REQUIRE(capped.first == 0);
     CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
