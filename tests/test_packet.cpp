@@ -119,7 +119,7 @@ void check_camera_tiles(PacketSimd path) {
     PacketSimdGuard guard;
     const Scene scene = mixed_scene();
     const int n = kSanitized ? 32 : 96;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs}) {
         const Accelerator acc(scene, with_layout(layout));
         force_packet_simd(path);
         const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
@@ -156,7 +156,7 @@ TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactiv
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     const int packets = kSanitized ? 150 : 2000;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs})
         for (PacketSimd path : runnable_packet_paths()) {
             const Accelerator acc(scene, with_layout(layout));
             force_packet_simd(path);
@@ -217,7 +217,7 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
     scene.triangles.material.assign(scene.triangles.indices.size() / 3, 0);
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs})
         for (PacketSimd path : runnable_packet_paths()) {
             const Accelerator acc(scene, with_layout(layout));
             force_packet_simd(path);

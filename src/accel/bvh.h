@@ -147,22 +147,20 @@ const char* bvh_builder_name(BvhBuilder builder);
 
 /// Traversal structure built from the binary SAH tree (accel/accelerator.h).
 enum class BvhLayout : uint8_t {
-    wide4,        ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
-    wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
-    pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
-    wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
+    pairs,  ///< binary tree, both child boxes per node block (accel/bvh_pairs.h): the reference
+    wide8,  ///< 8-wide BVH (accel/bvh_wide.h, AVX box test), leaf triangles in SSE blocks of 4
 };
 
 /// The layout used unless --layout says otherwise (render, view, bench, bvh).
 inline constexpr BvhLayout kDefaultBvhLayout = BvhLayout::wide8;
 
-/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
-inline bool layout_has_blocks(BvhLayout layout) {
-    return layout == BvhLayout::wide4 || layout == BvhLayout::wide8;
-}
+/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide8).
+inline bool layout_has_blocks(BvhLayout layout) { return layout == BvhLayout::wide8; }
 
-/// "wide4", "wide4-slots", "pairs" or "wide8".
+/// "pairs" or "wide8".
 const char* bvh_layout_name(BvhLayout layout);
+/// The accepted --layout values, for usage errors: "wide8|pairs".
+inline constexpr const char* kBvhLayoutChoices = "wide8|pairs";
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 

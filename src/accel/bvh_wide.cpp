@@ -198,7 +198,6 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     return out;
 }
 
-template Bvh4 make_bvh_wide<4>(const Bvh& bvh, const WideCollapse& opt);
 template Bvh8 make_bvh_wide<8>(const Bvh& bvh, const WideCollapse& opt);
 
 bool cpu_has_avx2() {

@@ -74,16 +74,6 @@ namespace packet_sse2 {
 #pragma GCC pop_options
 
 #pragma GCC push_options
-#pragma GCC target("avx2")
-#pragma GCC optimize("fp-contract=off")
-namespace packet_avx2 {
-#define SAHARA_PACKET_ISA 256
-#include "accel/packet_kernel.inc"
-#undef SAHARA_PACKET_ISA
-}  // namespace packet_avx2
-#pragma GCC pop_options
-
-#pragma GCC push_options
 #pragma GCC target("avx512f")
 #pragma GCC optimize("fp-contract=off")
 namespace packet_avx512 {
@@ -164,11 +154,9 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     c.rays = &packet;
     c.blocks = blocks_.data();
     c.accel = this;
-    // Other layouts, scenes with cut-outs (the alpha test is single-ray only),
+    // The pairs layout, scenes with cut-outs (the alpha test is single-ray only),
     // mixed directions and near-empty packets: single rays.
-    const bool wide8 = layout_ == BvhLayout::wide8;
-    const bool tree_empty = wide8 ? wide8_.empty : wide_.empty;
-    if (!layout_has_blocks(layout_) || tree_empty || has_cutouts() || std::popcount(packet.active) < 2 ||
+    if (!layout_has_blocks(layout_) || wide8_.empty || has_cutouts() || std::popcount(packet.active) < 2 ||
         !packet_eligible(packet, c)) {
         for (uint32_t m = packet.active; m; m &= m - 1) {
             const int i = std::countr_zero(m);
@@ -183,15 +171,14 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     }
     switch (active_packet_simd()) {
         case PacketSimd::avx512:
-            wide8 ? packet_avx512::trace_packet(c, wide8_, hits)
-                  : packet_avx512::trace_packet(c, wide_, hits);
+            packet_avx512::trace_packet(c, wide8_, hits);
             break;
         case PacketSimd::avx2:
-            // 8-wide nodes: one AVX box test per ray and child set beats 16 rays per box in two halves.
-            wide8 ? trace_packet8_avx2(packet, hits) : packet_avx2::trace_packet(c, wide_, hits);
+            // One AVX box test per ray and child set beats 16 rays per box in two halves.
+            trace_packet8_avx2(packet, hits);
             break;
         case PacketSimd::sse2:
-            wide8 ? packet_sse2::trace_packet(c, wide8_, hits) : packet_sse2::trace_packet(c, wide_, hits);
+            packet_sse2::trace_packet(c, wide8_, hits);
             break;
     }
     for (uint32_t m = packet.active; m; m &= m - 1) {

@@ -1,6 +1,6 @@
 #pragma once
 /// Coherent ray packets: 16 rays (typically a 4x4 pixel tile of camera rays)
-/// traced together through the 4-wide BVH. Each node's child boxes are tested
+/// traced together through the 8-wide BVH. Each node's child boxes are tested
 /// against all active rays at once and leaf triangles are broadcast against
 /// the rays (Wald, Slusallek, Benthin and Wagner, "Interactive Rendering with
 /// Coherent Ray Tracing", 2001; Wald, Benthin and Boulos, "Getting Rid of

@@ -40,9 +40,9 @@ constexpr const char* kBenchUsage =
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
     "              the camera's up axis)\n"
     "  --layout L  traversal structure: wide8 (default: 8-wide BVH, leaf triangles tested 4 at a\n"
-    "              time, 8 with AVX2), wide4 (4-wide BVH), wide4-slots (4-wide BVH, one leaf slot at\n"
-    "              a time) or pairs (binary BVH); the wide layouts use the widest of AVX-512, AVX2\n"
-    "              and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a narrower one)\n"
+    "              time, 8 with AVX2) or pairs (binary BVH, the reference); wide8 uses the widest\n"
+    "              of AVX-512, AVX2 and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a\n"
+    "              narrower one)\n"
     "  --size N    primary image side (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
@@ -338,7 +338,7 @@ std::string bench_options(const ToolArgs& args, BenchOptions& opt) {
     if (!parse_bvh_builder(args.value_or("--builder", bvh_builder_name(kDefaultBvhBuilder)), opt.builder))
         return "--builder must be binned, sweep or reinsert";
     if (!parse_bvh_layout(args.value_or("--layout", bvh_layout_name(opt.layout)), opt.layout))
-        return "--layout must be wide8, wide4, wide4-slots or pairs";
+        return "--layout must be wide8 or pairs";
     const std::string sets = args.value_or("--rays", "all");
     if (sets == "all")
         opt.sets = {"primary", "primary_packet", "diffuse", "shadow"};

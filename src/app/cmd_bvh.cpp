@@ -29,8 +29,8 @@ constexpr const char* kBvhUsage =
     "  --builder   binned (default: binned SAH, parallel), sweep (exact sweep SAH) or reinsert\n"
     "              (binned SAH, then insertion-based reinsertion of the most inefficient nodes);\n"
     "              a scene file's render.bvh_builder when not given\n"
-    "  --layout L  traversal structure the counts below are taken on: wide8 (default), wide4,\n"
-    "              wide4-slots or pairs (see `sahara bench --help`)\n"
+    "  --layout L  traversal structure the counts below are taken on: wide8 (default) or pairs\n"
+    "              (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
     "  --size N    primary rays N x N (default 1024, i.e. 1M), as many diffuse-bounce rays and\n"
     "              as many shadow rays (occlusion, to a light above; the sets of `sahara bench`);\n"
@@ -109,7 +109,7 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
         {"traversal_cost", opt.params.traversal_cost},
         {"intersection_cost", built.intersection_cost},
         {"layout", bvh_layout_name(accel.layout())},
-        {"wide_nodes", layout == BvhLayout::wide8 ? accel.bvh8().nodes.size() : accel.bvh4().nodes.size()},
+        {"wide_nodes", accel.bvh8().nodes.size()},
         {"build_ms", accel.build_ms()},
         {"build_cpu_ms", accel.build_cpu_ms()},
         {"build_threads", threads},
@@ -120,9 +120,8 @@ nlohmann::ordered_json bvh_report(const std::string& file, std::optional<BvhBuil
         {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
     if (layout != BvhLayout::pairs) {
         // Embree's verbose build report gives the same figures for its own tree.
-        const uint32_t block = layout == BvhLayout::wide4_slots ? 1 : 4;
-        const WideBvhStats w = layout == BvhLayout::wide8 ? compute_wide_bvh_stats(accel.bvh8(), block)
-                                                          : compute_wide_bvh_stats(accel.bvh4(), block);
+        const uint32_t block = 4;
+        const WideBvhStats w = compute_wide_bvh_stats(accel.bvh8(), block);
         j["wide"] = {{"nodes", w.nodes},
                      {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
                      {"leaves", w.leaves},
@@ -205,7 +204,7 @@ int run_bvh_command(int argc, char** argv) {
     }
     BvhLayout layout = AcceleratorOptions{}.layout;
     if (args.has("--layout") && !parse_bvh_layout(args.values["--layout"], layout))
-        return usage_error("bvh", "--layout must be wide8, wide4, wide4-slots or pairs");
+        return usage_error("bvh", "--layout must be wide8 or pairs");
     int size = 1024;
     if (args.has("--size") && !parse_positive_int(args.values["--size"], size))
         return usage_error("bvh", "--size must be a positive integer");

@@ -24,7 +24,7 @@ const char* const kRenderUsage =
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
-    "  --layout L           traversal structure: wide8 (default) | wide4 | wide4-slots | pairs\n"
+    "  --layout L           traversal structure: wide8 (default) | pairs\n"
     "                       (see sahara bench --help; pairs: a plain binary BVH, one ray at a time)\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
@@ -153,7 +153,7 @@ bool parse_override_flag(const std::vector<std::string>& args, size_t& i, Render
         const std::string& v = flag_value(args, i);
         BvhLayout l{};
         if (!parse_bvh_layout(v, l))
-            throw UsageError(a + ": expected wide8|wide4|wide4-slots|pairs, got '" + v + "'");
+            throw UsageError(a + ": expected " + kBvhLayoutChoices + ", got '" + v + "'");
         o.bvh_layout = l;
     } else if (a == "--sampler")
         o.sampler = parse_sampler_name(a, flag_value(args, i));
