@@ -259,6 +259,8 @@ void force_simd_path(SimdPath path) {
     detail::g_simd_path.store(int(supported(path)), std::memory_order_relaxed);
 }
 
+void clear_forced_simd_path() { detail::g_simd_path.store(-1, std::memory_order_relaxed); }
+
 const char* simd_path_name(SimdPath path) {
     return path == SimdPath::avx512 ? "avx512" : path == SimdPath::avx2 ? "avx2" : "sse2";
 }

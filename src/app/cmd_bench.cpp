@@ -147,7 +147,7 @@ nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelera
     const Disagreements ds = compare_answers(a, single, rays, mesh);
     const double count = double(rays.size());
     nlohmann::ordered_json j = throughput_json(count, ours, a);
-    j["packet_simd"] = packet_simd_name(active_packet_simd());
+    j["packet_simd"] = simd_path_name(active_simd_path());
     j["disagreements_single_ray"] = ds.total + ds.confirmed_for_a;
     j["ties_single_ray"] = ds.ties;
     if (embree) add_embree_json(j, count, theirs, compare_answers(a, b, rays, mesh));

@@ -45,8 +45,7 @@ bool use_packets(const Scene& scene) {
     if (!packets_enabled() || scene.render.integrator != IntegratorType::path || !accel ||
         !layout_has_blocks(accel->layout()) || !accel->uses_tree() || accel->has_cutouts())
         return false;
-    const PacketSimd simd = active_packet_simd();
-    return simd == PacketSimd::avx512 || simd == PacketSimd::avx2;
+    return active_simd_path() != SimdPath::sse2;
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4
