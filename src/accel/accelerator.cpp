@@ -235,7 +235,8 @@ size_t Accelerator::bytes() const {
     if (layout_has_blocks(layout_))
         return wide8_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) +
                other;
-    return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
+    return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
+           other;
 }
 
 /// Tests sphere, box or quadric `id` for a hit in (ray.tmin, tmax); sets its t and u.

@@ -4,14 +4,15 @@
 namespace sahara {
 
 template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
-__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const {
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
+                                                                  Counters& counters) const {
     return trace_wide_body<kAnyHit, kCutouts, true, false, kPairNodes>(ray, hit, counters);
 }
 
 template <class Form>
 struct TraceWideEntry<SimdPath::avx2, Form> {
     static constexpr auto ptr = &Accelerator::trace_wide_avx2<Form::kAnyHit, Form::kCutouts, Form::kPairNodes,
-                                                               typename Form::Counters>;
+                                                              typename Form::Counters>;
 };
 
 // Every form trace_layout calls on this path.

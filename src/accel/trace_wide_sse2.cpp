@@ -12,7 +12,7 @@ bool Accelerator::trace_wide_sse2(Ray& ray, Hit& hit, Counters& counters) const 
 template <class Form>
 struct TraceWideEntry<SimdPath::sse2, Form> {
     static constexpr auto ptr = &Accelerator::trace_wide_sse2<Form::kAnyHit, Form::kCutouts, Form::kPairNodes,
-                                                               typename Form::Counters>;
+                                                              typename Form::Counters>;
 };
 
 // Every form trace_layout calls on this path.
