@@ -134,13 +134,13 @@ bool parse_bvh_builder(std::string_view text, BvhBuilder& out);
 /// "binned", "sweep" or "reinsert".
 const char* bvh_builder_name(BvhBuilder builder);
 
-/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide4, wide8).
-inline bool layout_has_blocks(BvhLayout layout) {
-    return layout == BvhLayout::wide4 || layout == BvhLayout::wide8;
-}
+/// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide8).
+inline bool layout_has_blocks(BvhLayout layout) { return layout == BvhLayout::wide8; }
 
-/// "wide4", "wide4-slots", "pairs" or "wide8".
+/// "pairs" or "wide8".
 const char* bvh_layout_name(BvhLayout layout);
+/// The accepted --layout values, for usage errors: "wide8|pairs".
+inline constexpr const char* kBvhLayoutChoices = "wide8|pairs";
 /// Parses a bvh_layout_name(); returns false for anything else.
 bool parse_bvh_layout(std::string_view text, BvhLayout& out);
 

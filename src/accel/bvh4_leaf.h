@@ -1,5 +1,5 @@
 #pragma once
-/// BVH4 leaves as blocks of four triangles in structure-of-arrays form, tested
+/// Wide-BVH leaves as blocks of four triangles in structure-of-arrays form, tested
 /// with SSE four at a time by the watertight test of Woop, Benthin and Wald
 /// ("Watertight Ray/Triangle Intersection", JCGT 2013). Every lane performs
 /// exactly the float operations of intersect_triangle (geometry/triangle.h),

@@ -43,9 +43,6 @@ WideBvhStats wide_stats(const BvhWide<N>& bvh, uint32_t block_size) {
 
 }  // namespace
 
-WideBvhStats compute_wide_bvh_stats(const Bvh4& bvh, uint32_t block_size) {
-    return wide_stats(bvh, std::max(block_size, 1u));
-}
 WideBvhStats compute_wide_bvh_stats(const Bvh8& bvh, uint32_t block_size) {
     return wide_stats(bvh, std::max(block_size, 1u));
 }

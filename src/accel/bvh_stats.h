@@ -41,7 +41,6 @@ struct WideBvhStats {
 };
 
 /// `block_size`: primitives tested together in a leaf (4 for the block layouts, else 1).
-WideBvhStats compute_wide_bvh_stats(const Bvh4& bvh, uint32_t block_size);
 WideBvhStats compute_wide_bvh_stats(const Bvh8& bvh, uint32_t block_size);
 
 /// Checks the invariants of a built tree against the boxes it was built from:

@@ -198,7 +198,6 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     return out;
 }
 
-template Bvh4 make_bvh_wide<4>(const Bvh& bvh, const WideCollapse& opt);
 template Bvh8 make_bvh_wide<8>(const Bvh& bvh, const WideCollapse& opt);
 
 bool cpu_has_avx2() {
@@ -259,6 +258,8 @@ SimdPath init_simd_path() {
 void force_simd_path(SimdPath path) {
     detail::g_simd_path.store(int(supported(path)), std::memory_order_relaxed);
 }
+
+void clear_forced_simd_path() { detail::g_simd_path.store(-1, std::memory_order_relaxed); }
 
 const char* simd_path_name(SimdPath path) {
     return path == SimdPath::avx512 ? "avx512" : path == SimdPath::avx2 ? "avx2" : "sse2";

@@ -1,8 +1,8 @@
 #pragma once
-/// Wide BVHs (BVH4, BVH8) collapsed from the binary SAH tree: each node holds
-/// the boxes of up to N children in structure-of-arrays form, so one ray tests
-/// all children in one SIMD step (SSE for 4, AVX for 8; the SSE2 fallback tests
-/// an 8-wide node as two halves). Which binary nodes are merged into one wide
+/// Wide BVHs (the BVH8 of the wide8 layout) collapsed from the binary SAH tree: each
+/// node holds the boxes of up to N children in structure-of-arrays form, so one ray
+/// tests all children in one SIMD step (AVX; the SSE2 fallback tests an 8-wide node
+/// as two halves). Which binary nodes are merged into one wide
 /// node is chosen to minimise the summed area of the wide nodes (bvh_wide.cpp).
 ///
 /// Traversal is ordered: the hit children are sorted by entry distance and
@@ -59,11 +59,9 @@ struct alignas(64) BvhWideNode {
     /// first slot (or block), an inner child's node offset.
     uint32_t child_index(int c) const { return leaf_count(c) ? ref_first(child[c]) : child[c]; }
 };
-using Bvh4Node = BvhWideNode<4>;
 using Bvh8Node = BvhWideNode<8>;
-static_assert(sizeof(Bvh4Node) == 128, "two cache lines per node");
 static_assert(sizeof(Bvh8Node) == 256, "four cache lines per node");
-static_assert(sizeof(Bvh4Node) % (kMaxWideLeafCount + 1) == 0,
+static_assert(sizeof(Bvh8Node) % (kMaxWideLeafCount + 1) == 0,
               "node offsets keep the low bits of a reference 0");
 
 /// An N-wide BVH. `root` keeps the root box; a leaf root has no nodes.
@@ -88,7 +86,6 @@ struct BvhWide {
 
     size_t bytes() const { return sizeof(BvhNode) + nodes.size() * sizeof(BvhWideNode<N>); }
 };
-using Bvh4 = BvhWide<4>;
 using Bvh8 = BvhWide<8>;
 
 /// Cost model of the collapse (bvh_wide.cpp): a wide node visit costs 1.
@@ -103,9 +100,9 @@ struct WideCollapse {
 /// Collapses a canonical binary Bvh (slots unchanged; nodes in depth-first order).
 template <int N>
 BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt = {});
-inline Bvh4 make_bvh4(const Bvh& bvh, const WideCollapse& opt = {}) { return make_bvh_wide<4>(bvh, opt); }
 
-/// Which instruction set the wide-BVH traversal is compiled for (one body, three instantiations).
+/// Which instruction set the traversals run: the single-ray wide8 traversal (one body,
+/// three instantiations) and the packet kernels (accel/packet.h) alike.
 enum class SimdPath : uint8_t {
     sse2,    ///< baseline of every x86-64 CPU
     avx2,    ///< VEX encoding, 8-wide node tests in one AVX step
@@ -115,16 +112,21 @@ enum class SimdPath : uint8_t {
 namespace detail {
 extern std::atomic<int> g_simd_path;  ///< -1 until the first call of active_simd_path()
 }  // namespace detail
-/// Reads SAHARA_SIMD and the CPU once (behind active_simd_path()).
+/// Reads SAHARA_SIMD and the CPU once (behind active_simd_path()); the one reader of
+/// SAHARA_SIMD.
 SimdPath init_simd_path();
-/// The path in use: the widest the CPU has, unless SAHARA_SIMD=sse2|avx2|avx512
-/// asks for a narrower one or force_simd_path() was called. One relaxed load per ray.
+/// The path in use: the widest the CPU has, unless force_simd_path() was called or the
+/// environment variable SAHARA_SIMD=sse2|avx2|avx512 asks for a narrower one. SAHARA_SIMD
+/// is a testing switch: it runs the fallback paths on a CPU that has wider ones (results
+/// are the same on every path). One relaxed load per ray.
 inline SimdPath active_simd_path() {
     const int p = detail::g_simd_path.load(std::memory_order_relaxed);
     return p >= 0 ? SimdPath(p) : init_simd_path();
 }
 /// Forces a path (tests); a path the CPU lacks falls back to the widest it has.
 void force_simd_path(SimdPath path);
+/// Undoes force_simd_path(): back to the CPU's and SAHARA_SIMD's choice.
+void clear_forced_simd_path();
 /// Whether this CPU can run the AVX2 path.
 bool cpu_has_avx2();
 /// Whether this CPU can run the AVX-512 path (F, VL, BW, DQ).
@@ -157,7 +159,6 @@ struct WideRaySse {
         }
     }
 };
-using Bvh4Ray = WideRaySse<4>;
 
 /// Tests children [4 g, 4 g + 4) of an N-wide node with SSE; bit c of the result
 /// is set when child 4 g + c is hit, and lane c of t_near is then its entry
@@ -180,12 +181,6 @@ __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N
     const __m128 t1 = _mm_min_ps(_mm_min_ps(tf[1], tf[2]), _mm_min_ps(tf[0], _mm_set1_ps(tmax_far)));
     t_near = t0;
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
-}
-
-/// The four children of a BVH4 node (see intersect_wide_sse).
-__attribute__((always_inline)) inline int intersect_bvh4(const Bvh4Node& n, const Bvh4Ray& r, float tmin,
-                                                         float tmax, __m128& t_near) {
-    return intersect_wide_sse<4>(n, r, 0, tmin, tmax * kRobustFarScale, t_near);
 }
 
 /// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin, negated

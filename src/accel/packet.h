@@ -1,6 +1,6 @@
 #pragma once
 /// Coherent ray packets: 16 rays (typically a 4x4 pixel tile of camera rays)
-/// traced together through the 4-wide BVH. Each node's child boxes are tested
+/// traced together through the 8-wide BVH. Each node's child boxes are tested
 /// against all active rays at once and leaf triangles are broadcast against
 /// the rays (Wald, Slusallek, Benthin and Wagner, "Interactive Rendering with
 /// Coherent Ray Tracing", 2001; Wald, Benthin and Boulos, "Getting Rid of
@@ -10,8 +10,9 @@
 /// distance a single ray gets; only which of two primitives at exactly the
 /// same distance wins may differ (traversal order differs).
 ///
-/// The SIMD width is chosen at run time: AVX-512 (one 16-lane register),
-/// AVX2 (two 8-lane halves) or SSE2 (four 4-lane quarters).
+/// The instruction set is the single-ray traversal's, active_simd_path()
+/// (accel/bvh_wide.h): AVX-512 (one 16-lane register), AVX2 (the single-ray
+/// box and leaf tests per ray, packet_wide8.cpp) or SSE2 (four 4-lane quarters).
 #include <cstdint>
 
 #include "geometry/hit.h"
@@ -55,25 +56,6 @@ struct alignas(64) HitPacket {
     /// The hit of lane `i` as a single-ray Hit.
     Hit hit(int i) const { return Hit{t[i], prim[i], u[i], v[i]}; }
 };
-
-/// Instruction set of the packet kernels.
-enum class PacketSimd : uint8_t {
-    sse2,    ///< four 4-lane quarters
-    avx2,    ///< two 8-lane halves
-    avx512,  ///< one 16-lane register
-};
-
-/// The widest path this CPU runs, unless SAHARA_SIMD (sse2, avx2, avx512) asks
-/// for a narrower one or force_packet_simd() was called.
-PacketSimd active_packet_simd();
-/// Forces a path (tests); a request the CPU cannot run falls back to the widest it can.
-void force_packet_simd(PacketSimd path);
-/// Clears a forced path (back to the CPU / environment choice).
-void clear_forced_packet_simd();
-/// Whether this CPU can run `path`.
-bool cpu_supports_packet_simd(PacketSimd path);
-/// "sse2", "avx2" or "avx512".
-const char* packet_simd_name(PacketSimd path);
 
 /// Whether packets are enabled for rendering: true unless SAHARA_PACKETS=0 is
 /// set or set_packets_enabled(false) was called.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "accel/bvh.h"
 #include "app/render_args.h"
 #include "render/tonemap.h"
 
@@ -161,7 +162,7 @@ BvhBuilder parse_builder_name(const std::string& flag, const std::string& v) {
 BvhLayout parse_layout_name(const std::string& flag, const std::string& v) {
     BvhLayout l{};
     if (!parse_bvh_layout(v, l))
-        throw UsageError(flag + ": expected wide8|wide4|wide4-slots|pairs, got '" + v + "'");
+        throw UsageError(flag + ": expected " + std::string(kBvhLayoutChoices) + ", got '" + v + "'");
     return l;
 }
 

@@ -42,9 +42,9 @@ constexpr const char* kBenchUsage =
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
     "              the camera's up axis)\n"
     "  --layout L  traversal structure: wide8 (default: 8-wide BVH, leaf triangles tested 4 at a\n"
-    "              time, 8 with AVX2), wide4 (4-wide BVH), wide4-slots (4-wide BVH, one leaf slot at\n"
-    "              a time) or pairs (binary BVH); the wide layouts use the widest of AVX-512, AVX2\n"
-    "              and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a narrower one)\n"
+    "              time, 8 with AVX2) or pairs (binary BVH, the reference); wide8 uses the widest\n"
+    "              of AVX-512, AVX2 and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a\n"
+    "              narrower one)\n"
     "  --size WxH  primary image size, N x N for one number (default 1024: 1M rays per set)\n"
     "  --repeat K  time each pass K times and report the median (default 3)\n"
     "  --no-embree skip the Embree comparison\n"
@@ -150,7 +150,7 @@ nlohmann::ordered_json bench_packet_set(const TriangleMesh& mesh, const Accelera
     const Disagreements ds = compare_answers(a, single, rays, mesh);
     const double count = double(rays.size());
     nlohmann::ordered_json j = throughput_json(count, ours, a);
-    j["packet_simd"] = packet_simd_name(active_packet_simd());
+    j["packet_simd"] = simd_path_name(active_simd_path());
     j["disagreements_single_ray"] = ds.total + ds.confirmed_for_a;
     j["ties_single_ray"] = ds.ties;
     if (embree) add_embree_json(j, count, theirs, compare_answers(a, b, rays, mesh));

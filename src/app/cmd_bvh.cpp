@@ -30,8 +30,8 @@ constexpr const char* kBvhUsage =
     "  --builder   binned (default: binned SAH, parallel), sweep (exact sweep SAH) or reinsert\n"
     "              (binned SAH, then insertion-based reinsertion of the most inefficient nodes);\n"
     "              a scene file's render.bvh_builder when not given\n"
-    "  --layout L  traversal structure the counts below are taken on: wide8 (default), wide4,\n"
-    "              wide4-slots or pairs (see `sahara bench --help`)\n"
+    "  --layout L  traversal structure the counts below are taken on: wide8 (default) or pairs\n"
+    "              (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
     "  --size WxH  primary rays W x H, N x N for one number (default 1024, i.e. 1M), as many\n"
     "              diffuse-bounce rays and as many shadow rays (occlusion, to a light above; the sets\n"
@@ -125,7 +125,7 @@ nlohmann::ordered_json bvh_report(const BvhArgs& args) {
         {"traversal_cost", opt.params.traversal_cost},
         {"intersection_cost", built.intersection_cost},
         {"layout", bvh_layout_name(accel.layout())},
-        {"wide_nodes", layout == BvhLayout::wide8 ? accel.bvh8().nodes.size() : accel.bvh4().nodes.size()},
+        {"wide_nodes", accel.bvh8().nodes.size()},
         {"build_ms", accel.build_ms()},
         {"build_cpu_ms", accel.build_cpu_ms()},
         {"build_threads", threads},
@@ -136,9 +136,8 @@ nlohmann::ordered_json bvh_report(const BvhArgs& args) {
         {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
     if (layout != BvhLayout::pairs) {
         // Embree's verbose build report gives the same figures for its own tree.
-        const uint32_t block = layout == BvhLayout::wide4_slots ? 1 : 4;
-        const WideBvhStats w = layout == BvhLayout::wide8 ? compute_wide_bvh_stats(accel.bvh8(), block)
-                                                          : compute_wide_bvh_stats(accel.bvh4(), block);
+        const uint32_t block = 4;
+        const WideBvhStats w = compute_wide_bvh_stats(accel.bvh8(), block);
         j["wide"] = {{"nodes", w.nodes},
                      {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
                      {"leaves", w.leaves},

@@ -26,7 +26,7 @@ const char* const kRenderUsage =
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
     "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
-    "  --layout L           traversal structure: wide8 (default) | wide4 | wide4-slots | pairs\n"
+    "  --layout L           traversal structure: wide8 (default) | pairs\n"
     "                       (see sahara bench --help; pairs: a plain binary BVH, one ray at a time)\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"

@@ -21,10 +21,8 @@ inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::binned;
 
 /// Traversal structure built from the binary SAH tree (scene/accelerator.h).
 enum class BvhLayout : uint8_t {
-    wide4,        ///< 4-wide BVH (accel/bvh_wide.h), leaf triangles in SSE blocks of 4 (accel/bvh4_leaf.h)
-    wide4_slots,  ///< 4-wide BVH, leaves tested one slot at a time
-    pairs,        ///< binary tree, both child boxes per node block (accel/bvh_pairs.h)
-    wide8,        ///< 8-wide BVH (AVX box test), leaf triangles in SSE blocks of 4
+    pairs,  ///< binary tree, both child boxes per node block (accel/bvh_pairs.h): the reference
+    wide8,  ///< 8-wide BVH (accel/bvh_wide.h, AVX box test), leaf triangles in SSE blocks of 4
 };
 
 /// The layout used unless --layout says otherwise (render, view, bench, bvh).

@@ -35,18 +35,16 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 }
 
 /// Whether camera rays are traced as packets: the path integrator (which can
-/// take a first hit) over a block layout (wide4, wide8) without cut-outs, unless
-/// SAHARA_PACKETS=0, with the AVX-512 kernel or the AVX2 wide8 kernel
+/// take a first hit) over the block layout (wide8) without cut-outs, unless
+/// SAHARA_PACKETS=0, with the AVX-512 kernel or the AVX2 kernel
 /// (packet_wide8.cpp), which trace camera rays faster than single rays. The
-/// AVX2 kernel on wide4 and the SSE2 kernel are slower than single rays, so
-/// they stay for tests and bench.
+/// SSE2 kernel is slower than single rays, so it stays for tests and bench.
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
     if (!packets_enabled() || scene.render.integrator != IntegratorType::path || !accel ||
         !layout_has_blocks(accel->layout()) || !accel->uses_tree() || accel->has_cutouts())
         return false;
-    const PacketSimd simd = active_packet_simd();
-    return simd == PacketSimd::avx512 || (simd == PacketSimd::avx2 && accel->layout() == BvhLayout::wide8);
+    return active_simd_path() != SimdPath::sse2;
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4

@@ -93,22 +93,14 @@ const char* bvh_layout_name(BvhLayout layout) {
     switch (layout) {
         case BvhLayout::pairs:
             return "pairs";
-        case BvhLayout::wide4_slots:
-            return "wide4-slots";
         case BvhLayout::wide8:
-            return "wide8";
-        case BvhLayout::wide4:
             break;
     }
-    return "wide4";
+    return "wide8";
 }
 
 bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
-    if (text == "wide4")
-        out = BvhLayout::wide4;
-    else if (text == "wide4-slots")
-        out = BvhLayout::wide4_slots;
-    else if (text == "pairs")
+    if (text == "pairs")
         out = BvhLayout::pairs;
     else if (text == "wide8")
         out = BvhLayout::wide8;
@@ -144,20 +136,11 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     layout_ = options.layout;
     if (layout_ == BvhLayout::pairs)
         pairs_ = make_bvh_pairs(bvh_);
-    else {
-        // Merging leaves only pays where a leaf is tested in blocks.
-        const WideCollapse wc = layout_has_blocks(layout_) ? options.collapse : WideCollapse{};
-        if (layout_ == BvhLayout::wide8)
-            wide8_ = make_bvh_wide<8>(bvh_, wc);
-        else
-            wide_ = make_bvh4(bvh_, wc);
-    }
+    else
+        wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
     if (layout_has_blocks(layout_)) {
-        // The tree and the blocks are all the block layouts keep (plus others_).
-        if (layout_ == BvhLayout::wide8)
-            make_leaf_blocks(wide8_, ids, tris);
-        else
-            make_leaf_blocks(wide_, ids, tris);
+        // The tree and the blocks are all the block layout keeps (plus others_).
+        make_leaf_blocks(wide8_, ids, tris);
     } else {
         slots_.resize(slots);
         for (size_t s = 0; s < slots; ++s) slots_[s] = Slot{tris[s], ids[s]};
@@ -247,13 +230,13 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
-    // The block layouts keep only the tree, the blocks (vertices and triangle ids) and the
+    // The block layout keeps only the tree, the blocks (vertices and triangle ids) and the
     // ids of other kinds.
     if (layout_has_blocks(layout_))
-        return (layout_ == BvhLayout::wide8 ? wide8_.bytes() : wide_.bytes()) +
-               blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) + other;
-    return (layout_ == BvhLayout::pairs ? pairs_.bytes() : wide_.bytes()) +
-           bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) + other;
+        return wide8_.bytes() + blocks_.size() * sizeof(TriangleBlock4) + others_.size() * sizeof(uint32_t) +
+               other;
+    return pairs_.bytes() + bvh_.prim_indices.size() * sizeof(uint32_t) + slots_.size() * sizeof(Slot) +
+           other;
 }
 
 /// Tests sphere, box or quadric `id` for a hit in (ray.tmin, tmax); sets its t and u.
@@ -292,40 +275,24 @@ bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
 
 template <bool kAnyHit, bool kCutouts, class Counters>
 bool Accelerator::trace_layout(Ray& ray, Hit& hit, Counters& counters) const {
-    if (layout_ != BvhLayout::pairs) {
-        // The wide layouts: one traversal body compiled three times (SSE2, AVX2, AVX-512),
-        // each in its own file (trace_wide.inl).
+    if (layout_ == BvhLayout::wide8) {
+        // One traversal body compiled three times (SSE2, AVX2, AVX-512), each in its own
+        // file (trace_wide.inl).
         const SimdPath path = active_simd_path();
-        const bool blocks = layout_ != BvhLayout::wide4_slots;
-        if (layout_ == BvhLayout::wide8) {
-            if (path == SimdPath::avx512) {
-                // Closest-hit rays pair nodes until their first hit (traverse_wide) where
-                // AcceleratorOptions::node_pairing says so; occlusion rays only on AVX2.
-                if (!kAnyHit && pair_rays_ != PairRays::none &&
-                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
-                    return trace_wide_avx512<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
-                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
-            }
-            if (path == SimdPath::avx2) {
-                if (pair_rays_ != PairRays::none &&
-                    (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
-                    return trace_wide_avx2<kAnyHit, kCutouts, true, true>(wide8_, ray, hit, counters);
-                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide8_, ray, hit, counters);
-            }
-            return trace_wide<kAnyHit, kCutouts, true>(wide8_, ray, hit, counters);
+        if (path == SimdPath::avx512) {
+            // Closest-hit rays pair nodes until their first hit (traverse_wide) where
+            // AcceleratorOptions::node_pairing says so; occlusion rays only on AVX2.
+            if (!kAnyHit && pair_rays_ != PairRays::none &&
+                (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                return trace_wide_avx512<kAnyHit, kCutouts, true>(ray, hit, counters);
+            return trace_wide_avx512<kAnyHit, kCutouts, false>(ray, hit, counters);
         }
-        if (blocks) {
-            if (path == SimdPath::avx512)
-                return trace_wide_avx512<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
-            if (path == SimdPath::avx2)
-                return trace_wide_avx2<kAnyHit, kCutouts, true, false>(wide_, ray, hit, counters);
-            return trace_wide<kAnyHit, kCutouts, true>(wide_, ray, hit, counters);
+        if (path == SimdPath::avx2) {
+            if (pair_rays_ != PairRays::none && (pair_rays_ == PairRays::all || bounds_.contains(ray.origin)))
+                return trace_wide_avx2<kAnyHit, kCutouts, true>(ray, hit, counters);
+            return trace_wide_avx2<kAnyHit, kCutouts, false>(ray, hit, counters);
         }
-        if (path == SimdPath::avx512)
-            return trace_wide_avx512<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
-        if (path == SimdPath::avx2)
-            return trace_wide_avx2<kAnyHit, kCutouts, false, false>(wide_, ray, hit, counters);
-        return trace_wide<kAnyHit, kCutouts, false>(wide_, ray, hit, counters);
+        return trace_wide_sse2<kAnyHit, kCutouts, false>(ray, hit, counters);
     }
     return trace_pairs<kAnyHit, kCutouts>(ray, hit, counters);
 }
@@ -373,7 +340,7 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
     return trace<true>(const_cast<Ray&>(ray), h, counters);  // read only, as in occluded()
 }
 
-/// The block layouts' brute force: every lane of every block, triangles by the scalar test.
+/// The block layout's brute force: every lane of every block, triangles by the scalar test.
 bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const {
     bool found = false;
     for (const TriangleBlock4& b : blocks_)
@@ -399,7 +366,7 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
     return found;
 }
 
-/// Packet fallback for a non-triangle lane of a leaf block (packets run only on the block layouts, without
+/// Packet fallback for a non-triangle lane of a leaf block (packets run only on the block layout, without
 /// cut-outs).
 bool Accelerator::intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const {
     const uint32_t id = others_[other];

@@ -29,6 +29,9 @@ namespace sahara {
 class Scene;
 struct RayPacket;
 struct HitPacket;
+/// One instruction set's traversal entry point for one form (trace_wide.inl).
+template <SimdPath kPath, class Form>
+struct TraceWideEntry;
 
 /// Largest primitive count for which the accelerator skips the SAH build and
 /// tests everything in one root leaf (a flat loop). 0, no separate flat path: the
@@ -47,22 +50,19 @@ enum class NodePairing : uint8_t {
 
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
-    /// wide8 by default: one AVX step tests eight children, and on every ray set it
-    /// takes less time per ray than wide4.
+    /// wide8 by default: one AVX step tests eight children; pairs is the plain binary
+    /// tree, the reference.
     BvhLayout layout = kDefaultBvhLayout;
     BvhBuilder builder = kDefaultBvhBuilder;
     BvhBuildParams params;
-    /// The wide4 layout builds with params.intersection_cost times this and counts
+    /// The wide8 layout builds with params.intersection_cost times this and counts
     /// leaves in whole blocks of four (BvhBuildParams::leaf_block_size): a block
     /// tests four triangles per SSE step, and counting whole blocks keeps the build from
-    /// making 2- and 3-triangle leaves that are mostly padding lanes. 0.25: as fast as
-    /// 0.35-0.5, with the smallest tree and blocks (8% less memory than 0.5).
-    float wide4_leaf_cost_scale = 0.25f;
-    /// The same for the wide8 layout, whose node visits cost less per binary level.
+    /// making 2- and 3-triangle leaves that are mostly padding lanes.
     /// 0.5: instructions per diffuse ray within 0.2% of 1.0 and 5-6% below 0.25, with
     /// the smaller tree of the two best. Blocks of eight (two per AVX step) took 7% more.
     float wide8_leaf_cost_scale = 0.5f;
-    /// How the block layouts collapse the binary tree into the wide one: subtrees of up
+    /// How the block layout collapses the binary tree into the wide one: subtrees of up
     /// to 8 primitives (two blocks, the fast leaf test's limit) may become one leaf, and
     /// a block test costs as much as a node visit (Embree's weights in its SAH report).
     /// Merging helps camera rays and costs the other ray sets nothing; block costs of 0.5
@@ -76,18 +76,18 @@ struct AcceleratorOptions {
     /// bounds usually hit in the first subtree they enter, so the paired node would never
     /// have been visited: automatic pairing leaves them out.
     NodePairing node_pairing = NodePairing::automatic;
-    /// Keep the binary tree after the block layouts have collapsed it (bvh(), for
+    /// Keep the binary tree after the block layout has collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.
     bool keep_binary_tree = false;
 
-    /// `params` as the chosen layout builds with: the block layouts scale the
-    /// intersection cost and count leaves in blocks of four.
+    /// `params` as the chosen layout builds with: the block layout scales the
+    /// intersection cost and counts leaves in blocks of four.
     BvhBuildParams build_params() const {
         BvhBuildParams p = params;
         // A wide BVH's leaf reference holds its count in kLeafCountBits.
         if (layout != BvhLayout::pairs) p.max_leaf_size = std::min(p.max_leaf_size, kMaxWideLeafCount);
         if (layout_has_blocks(layout)) {
-            p.intersection_cost *= layout == BvhLayout::wide8 ? wide8_leaf_cost_scale : wide4_leaf_cost_scale;
+            p.intersection_cost *= wide8_leaf_cost_scale;
             p.leaf_block_size = 4;  // a leaf block tests four triangles at once
         }
         return p;
@@ -108,11 +108,11 @@ class Accelerator {
     bool occluded_counted(const Ray& ray, TraversalCounters& counters) const;
     /// Nearest hits of the active rays of a packet (accel/packet.h); on a hit,
     /// the lane's tmax becomes hit.t. Per ray the answer is intersect()'s up to
-    /// ties between primitives at exactly the same distance. Layouts other than
-    /// wide4 and wide8, scenes with cut-outs and incoherent packets (mixed direction signs
+    /// ties between primitives at exactly the same distance. The pairs layout,
+    /// scenes with cut-outs and incoherent packets (mixed direction signs
     /// or dominant axes) are traced ray by ray.
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
-    /// Tests the non-triangle primitive others_[other] of a block layout alone (packet
+    /// Tests the non-triangle primitive others_[other] of the block layout alone (packet
     /// fallback); on a hit with t in (ray.tmin, ray.tmax) fills `hit` and returns true.
     bool intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const;
     /// The primitive id of a block lane (not padding).
@@ -123,7 +123,7 @@ class Accelerator {
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
 
     Bounds3 bounds() const { return bounds_; }
-    /// The binary tree; empty for the block layouts unless AcceleratorOptions::keep_binary_tree.
+    /// The binary tree; empty for the block layout unless AcceleratorOptions::keep_binary_tree.
     const Bvh& bvh() const { return bvh_; }
     /// False when the scene was small enough for the flat loop.
     bool uses_tree() const { return uses_tree_; }
@@ -131,12 +131,9 @@ class Accelerator {
     /// inside bounds()). The SSE2 path never does.
     bool pairs_nodes() const { return pair_rays_ != PairRays::none; }
     BvhLayout layout() const { return layout_; }
-    /// The 4-wide tree (empty unless the layout is wide4 or wide4-slots; with the
-    /// wide4 layout a leaf's child index is its first TriangleBlock4, not its first slot).
-    const Bvh4& bvh4() const { return wide_; }
     /// The 8-wide tree (empty unless the layout is wide8; a leaf's child index is its first block).
     const Bvh8& bvh8() const { return wide8_; }
-    /// Leaf triangle blocks of the wide4 and wide8 layouts (empty for the other layouts).
+    /// Leaf triangle blocks of the wide8 layout (empty for pairs).
     const auto& leaf_blocks() const { return blocks_; }
     /// Elapsed build time (BVH, pair layout, leaf-ordered primitive copies).
     double build_ms() const { return build_ms_; }
@@ -159,19 +156,21 @@ class Accelerator {
     bool trace_layout(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, class Counters>
     bool trace_pairs(Ray& ray, Hit& hit, Counters& counters) const;
-    /// The wide-tree traversal (trace_wide.inl) and its entry point per instruction set
-    /// (trace_wide_sse2.cpp, trace_wide_avx2.cpp, trace_wide_avx512.cpp).
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
-              class Counters>
-    bool trace_wide_body(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
-    bool trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
-    __attribute__((target("avx2"))) bool trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
-                                                         Counters& counters) const;
-    template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
+    /// The wide8 traversal (trace_wide.inl) and its entry point per instruction set, each
+    /// compiled in its own file (trace_wide_sse2.cpp, trace_wide_avx2.cpp,
+    /// trace_wide_avx512.cpp), which emits every form trace_layout calls (TraceForm).
+    template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, class Counters>
+    bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
+    bool trace_wide_sse2(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
+    __attribute__((target("avx2"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
+    template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
     __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
-        const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const;
+        Ray& ray, Hit& hit, Counters& counters) const;
+    /// Names the entry points above for the files that emit them (trace_wide.inl).
+    template <SimdPath, class>
+    friend struct TraceWideEntry;
     /// Packets over the wide8 tree with the single-ray box and leaf tests (packet_wide8.cpp).
     __attribute__((target("avx2"))) void trace_packet8_avx2(const RayPacket& p, HitPacket& out) const;
     template <bool kAnyHit, bool kCutouts, bool kAvx>
@@ -206,11 +205,10 @@ class Accelerator {
 
     Bvh bvh_;         ///< the binary tree (see bvh())
     BvhPairs pairs_;  ///< the same tree in pair layout (layout_ == pairs)
-    Bvh4 wide_;       ///< the same tree collapsed to 4-wide nodes (wide4 layouts)
     Bvh8 wide8_;      ///< the same tree collapsed to 8-wide nodes (wide8 layout)
     std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>>
-        blocks_;  ///< wide4/wide8 layouts: each leaf's slots in blocks of four
-    BvhLayout layout_ = BvhLayout::wide4;
+        blocks_;  ///< wide8 layout: each leaf's slots in blocks of four
+    BvhLayout layout_ = kDefaultBvhLayout;
     /// Which closest-hit rays pair nodes (NodePairing resolved for this tree).
     enum class PairRays : uint8_t { none, inside, all };
     PairRays pair_rays_ = PairRays::none;
@@ -220,9 +218,9 @@ class Accelerator {
         TriangleVerts tri;  ///< 36 bytes; zero for other kinds
         uint32_t id;        ///< make_prim_id(kind, index); 4 bytes, total 40
     };
-    std::vector<Slot> slots_;  ///< wide4-slots and pairs layouts, in leaf order: slot s holds primitive
+    std::vector<Slot> slots_;  ///< pairs layout, in leaf order: slot s holds primitive
                                ///< bvh_.prim_indices[s]
-    /// wide4/wide8 layouts: ids of the non-triangle lanes (a triangle lane holds its id itself).
+    /// wide8 layout: ids of the non-triangle lanes (a triangle lane holds its id itself).
     std::vector<uint32_t> others_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
     std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)

@@ -74,16 +74,6 @@ namespace packet_sse2 {
 #pragma GCC pop_options
 
 #pragma GCC push_options
-#pragma GCC target("avx2")
-#pragma GCC optimize("fp-contract=off")
-namespace packet_avx2 {
-#define SAHARA_PACKET_ISA 256
-#include "scene/packet_kernel.inc"
-#undef SAHARA_PACKET_ISA
-}  // namespace packet_avx2
-#pragma GCC pop_options
-
-#pragma GCC push_options
 #pragma GCC target("avx512f")
 #pragma GCC optimize("fp-contract=off")
 namespace packet_avx512 {
@@ -95,55 +85,9 @@ namespace packet_avx512 {
 
 namespace {
 
-std::atomic<int> g_forced_simd{-1};
 std::atomic<int> g_packets_override{-1};
 
 }  // namespace
-
-bool cpu_supports_packet_simd(PacketSimd path) {
-    switch (path) {
-        case PacketSimd::avx512:
-            return __builtin_cpu_supports("avx512f");
-        case PacketSimd::avx2:
-            return __builtin_cpu_supports("avx2");
-        case PacketSimd::sse2:
-            break;
-    }
-    return true;
-}
-
-namespace {
-
-PacketSimd widest_supported(PacketSimd want) {
-    if (want == PacketSimd::avx512 && !cpu_supports_packet_simd(want)) want = PacketSimd::avx2;
-    if (want == PacketSimd::avx2 && !cpu_supports_packet_simd(want)) want = PacketSimd::sse2;
-    return want;
-}
-
-}  // namespace
-
-PacketSimd active_packet_simd() {
-    const int forced = g_forced_simd.load(std::memory_order_relaxed);
-    if (forced >= 0) return PacketSimd(forced);
-    static const PacketSimd from_env = [] {
-        const char* env = std::getenv("SAHARA_SIMD");
-        PacketSimd want = PacketSimd::avx512;
-        if (env && std::strcmp(env, "sse2") == 0) want = PacketSimd::sse2;
-        if (env && std::strcmp(env, "avx2") == 0) want = PacketSimd::avx2;
-        return widest_supported(want);
-    }();
-    return from_env;
-}
-
-void force_packet_simd(PacketSimd path) {
-    g_forced_simd.store(int(widest_supported(path)), std::memory_order_relaxed);
-}
-
-void clear_forced_packet_simd() { g_forced_simd.store(-1, std::memory_order_relaxed); }
-
-const char* packet_simd_name(PacketSimd path) {
-    return path == PacketSimd::avx512 ? "avx512" : path == PacketSimd::avx2 ? "avx2" : "sse2";
-}
 
 bool packets_enabled() {
     const int o = g_packets_override.load(std::memory_order_relaxed);
@@ -164,11 +108,9 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     c.rays = &packet;
     c.blocks = blocks_.data();
     c.accel = this;
-    // Other layouts, scenes with cut-outs (the alpha test is single-ray only),
+    // The pairs layout, scenes with cut-outs (the alpha test is single-ray only),
     // mixed directions and near-empty packets: single rays.
-    const bool wide8 = layout_ == BvhLayout::wide8;
-    const bool tree_empty = wide8 ? wide8_.empty : wide_.empty;
-    if (!layout_has_blocks(layout_) || tree_empty || has_cutouts() || std::popcount(packet.active) < 2 ||
+    if (!layout_has_blocks(layout_) || wide8_.empty || has_cutouts() || std::popcount(packet.active) < 2 ||
         !packet_eligible(packet, c)) {
         for (uint32_t m = packet.active; m; m &= m - 1) {
             const int i = std::countr_zero(m);
@@ -181,17 +123,16 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
         }
         return;
     }
-    switch (active_packet_simd()) {
-        case PacketSimd::avx512:
-            wide8 ? packet_avx512::trace_packet(c, wide8_, hits)
-                  : packet_avx512::trace_packet(c, wide_, hits);
+    switch (active_simd_path()) {
+        case SimdPath::avx512:
+            packet_avx512::trace_packet(c, wide8_, hits);
             break;
-        case PacketSimd::avx2:
-            // 8-wide nodes: one AVX box test per ray and child set beats 16 rays per box in two halves.
-            wide8 ? trace_packet8_avx2(packet, hits) : packet_avx2::trace_packet(c, wide_, hits);
+        case SimdPath::avx2:
+            // One AVX box test per ray and child set beats 16 rays per box in two halves.
+            trace_packet8_avx2(packet, hits);
             break;
-        case PacketSimd::sse2:
-            wide8 ? packet_sse2::trace_packet(c, wide8_, hits) : packet_sse2::trace_packet(c, wide_, hits);
+        case SimdPath::sse2:
+            packet_sse2::trace_packet(c, wide8_, hits);
             break;
     }
     for (uint32_t m = packet.active; m; m &= m - 1) {

@@ -273,8 +273,7 @@ Scene build_scene(const SceneDesc& desc) {
             soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
     }
     scene.build_accelerator();
-    const char* force = std::getenv("SAHARA_FORCE_ALL_FEATURES");
-    scene.prepare_lighting(force != nullptr && force[0] == '1');
+    scene.prepare_lighting(false);
     return scene;
 }
 

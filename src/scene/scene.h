@@ -59,7 +59,7 @@ struct SceneFeatures {
     bool has_textures = false;           ///< checker or image colour sources
     bool has_metal = false, has_rough_metal = false, has_dielectric = false;
     bool lambertian_only = true;  ///< no metal, no dielectric
-    bool forced_all = false;      ///< everything on (SAHARA_FORCE_ALL_FEATURES=1), for measurements
+    bool forced_all = false;      ///< everything on (prepare_lighting(true)), for measurements
 };
 
 /// Something that light sampling can pick: a light, an emissive primitive, or the envmap.

@@ -1,24 +1,27 @@
 #pragma once
-// The wide-BVH traversal body of Accelerator (trace_wide_body), compiled once per
+// The wide8 traversal body of Accelerator (trace_wide_body), compiled once per
 // instruction set in a translation unit of its own: trace_wide_sse2.cpp,
 // trace_wide_avx2.cpp and trace_wide_avx512.cpp. Each of those holds only its entry
-// point and explicit instantiations, so an edit elsewhere in the accelerator cannot
-// change the code GCC makes for the hot loop, and with it the loop's speed. Include only
-// from those files.
+// point and the table that emits its forms (trace_form_table), so an edit elsewhere in
+// the accelerator cannot change the code GCC makes for the hot loop, and with it the
+// loop's speed. Include only from those files.
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
 #include "scene/accelerator.h"
 #include "accel/bvh_wide.h"
 #include "scene/leaf_blocks.inl"
 
 namespace sahara {
 
-/// The wide-BVH traversal; trace_wide_avx2 is the same code compiled for AVX2
+/// The wide8 traversal; trace_wide_avx2 is the same code compiled for AVX2
 /// (both inline this body, so each gets its own instruction selection; an
 /// 8-wide node is tested in one AVX step there, as two SSE halves otherwise), and
 /// trace_wide_avx512 for AVX-512 (kAvx512: its node step compresses the hit children).
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, bool kAvx, bool kAvx512, bool kPairNodes,
-          class Counters>
-__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const BvhWide<N>& tree, Ray& ray,
-                                                                        Hit& hit, Counters& counters) const {
+template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, class Counters>
+__attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit,
+                                                                        Counters& counters) const {
     // The triangle constants (axes and shear): a closest-hit ray that starts inside the
     // scene's bounds (a bounce) makes them before the first node, where the out-of-order
     // core overlaps them with the box tests. Other rays make them at their first leaf, as
@@ -41,20 +44,14 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
         if (bounds_.contains(ray.origin)) triangle_ray();
     Hit best;
     const bool found = traverse_wide<kAnyHit, kAvx, kAvx512, kPairNodes>(
-        tree, br,
+        wide8_, br,
         [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
             float& tmax) __attribute__((always_inline)) {
-            if constexpr (kBlocks)
-                return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count,
-                                                                 next_first, next_count, paired, tmax, best);
-            else
-                return LeafResult::slow;  // slots: every kind through the full test
+            return test_blocks_fast<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, next_first,
+                                                             next_count, paired, tmax, best);
         },
         [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
-            if constexpr (kBlocks)
-                return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
-            else
-                return test_slots<kAnyHit, kCutouts>(ray, triangle_ray(), first, count, tmax, best);
+            return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
         },
         counters);
     if (found && !kAnyHit) {
@@ -64,13 +61,26 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(const Bv
     return found;
 }
 
-/// Calls M(kAnyHit, kCutouts, Counters) for every combination Accelerator::trace_layout
-/// instantiates; each ISA's file defines M as the explicit instantiations of its entry point.
-#define SAHARA_FOR_EACH_TRACE_FORM(M)                                        \
-    M(false, false, NoTraversalCounters)                                     \
-    M(false, true, NoTraversalCounters)                                      \
-    M(true, false, NoTraversalCounters) M(true, true, NoTraversalCounters)   \
-        M(false, false, TraversalCounters) M(false, true, TraversalCounters) \
-            M(true, false, TraversalCounters) M(true, true, TraversalCounters)
+/// One form of the traversal, by index: bit 0 kAnyHit, bit 1 kCutouts, bit 2 counted
+/// (TraversalCounters), bit 3 kPairNodes. Forms [0, kTraceForms) are every combination
+/// Accelerator::trace_layout calls; the SSE2 path, which never pairs nodes, only the first half.
+template <unsigned kForm>
+struct TraceForm {
+    static constexpr bool kAnyHit = (kForm & 1) != 0;
+    static constexpr bool kCutouts = (kForm & 2) != 0;
+    using Counters = std::conditional_t<(kForm & 4) != 0, TraversalCounters, NoTraversalCounters>;
+    static constexpr bool kPairNodes = (kForm & 8) != 0;
+};
+inline constexpr unsigned kTraceForms = 16;
+inline constexpr unsigned kUnpairedTraceForms = 8;
+
+/// The addresses of instruction set kPath's entry point for forms [0, kCount)
+/// (TraceWideEntry<kPath, Form>::ptr). Each ISA's file keeps them in a [[gnu::used]]
+/// constant, which makes the compiler emit every form there; the other files only
+/// declare the entry points and call them.
+template <SimdPath kPath, unsigned... kForms>
+constexpr auto trace_form_table(std::integer_sequence<unsigned, kForms...>) {
+    return std::tuple{TraceWideEntry<kPath, TraceForm<kForms>>::ptr...};
+}
 
 }  // namespace sahara

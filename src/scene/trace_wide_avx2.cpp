@@ -1,26 +1,22 @@
-// The wide-BVH traversal compiled for AVX2 (see trace_wide.inl).
+// The wide8 traversal compiled for AVX2 (see trace_wide.inl).
 #include "scene/trace_wide.inl"
 
 namespace sahara {
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, bool kPairNodes, int N, class Counters>
-__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(const BvhWide<N>& tree, Ray& ray, Hit& hit,
+template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
                                                                   Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, true, false, kPairNodes>(tree, ray, hit, counters);
+    return trace_wide_body<kAnyHit, kCutouts, true, false, kPairNodes>(ray, hit, counters);
 }
 
-// Every form trace_layout calls: the 8-wide tree with and without node pairing, the 4-wide ones with and
-// without blocks.
-#define SAHARA_INSTANTIATE(kAny, kCut, Ctr)                                                               \
-    template bool Accelerator::trace_wide_avx2<kAny, kCut, true, true, 8, Ctr>(const BvhWide<8>&, Ray&,   \
-                                                                               Hit&, Ctr&) const;         \
-    template bool Accelerator::trace_wide_avx2<kAny, kCut, true, false, 8, Ctr>(const BvhWide<8>&, Ray&,  \
-                                                                                Hit&, Ctr&) const;        \
-    template bool Accelerator::trace_wide_avx2<kAny, kCut, true, false, 4, Ctr>(const BvhWide<4>&, Ray&,  \
-                                                                                Hit&, Ctr&) const;        \
-    template bool Accelerator::trace_wide_avx2<kAny, kCut, false, false, 4, Ctr>(const BvhWide<4>&, Ray&, \
-                                                                                 Hit&, Ctr&) const;
-SAHARA_FOR_EACH_TRACE_FORM(SAHARA_INSTANTIATE)
-#undef SAHARA_INSTANTIATE
+template <class Form>
+struct TraceWideEntry<SimdPath::avx2, Form> {
+    static constexpr auto ptr = &Accelerator::trace_wide_avx2<Form::kAnyHit, Form::kCutouts, Form::kPairNodes,
+                                                              typename Form::Counters>;
+};
+
+// Every form trace_layout calls on this path.
+[[gnu::used]] constexpr auto kTraceWideAvx2Forms =
+    trace_form_table<SimdPath::avx2>(std::make_integer_sequence<unsigned, kTraceForms>{});
 
 }  // namespace sahara

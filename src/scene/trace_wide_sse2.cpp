@@ -1,22 +1,22 @@
-// The wide-BVH traversal compiled for the baseline (SSE2) target (see trace_wide.inl).
+// The wide8 traversal compiled for the baseline (SSE2) target (see trace_wide.inl).
 #include "scene/trace_wide.inl"
 
 namespace sahara {
 
-template <bool kAnyHit, bool kCutouts, bool kBlocks, int N, class Counters>
-bool Accelerator::trace_wide(const BvhWide<N>& tree, Ray& ray, Hit& hit, Counters& counters) const {
-    return trace_wide_body<kAnyHit, kCutouts, kBlocks, N, false, false, false>(tree, ray, hit, counters);
+// The SSE2 path never pairs nodes (kPairNodes is always false here).
+template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
+bool Accelerator::trace_wide_sse2(Ray& ray, Hit& hit, Counters& counters) const {
+    return trace_wide_body<kAnyHit, kCutouts, false, false, false>(ray, hit, counters);
 }
 
-// Every form trace_layout calls: the 8-wide tree and the 4-wide ones with and without blocks.
-#define SAHARA_INSTANTIATE(kAny, kCut, Ctr)                                                               \
-    template bool Accelerator::trace_wide<kAny, kCut, true, 8, Ctr>(const BvhWide<8>&, Ray&, Hit&, Ctr&)  \
-        const;                                                                                            \
-    template bool Accelerator::trace_wide<kAny, kCut, true, 4, Ctr>(const BvhWide<4>&, Ray&, Hit&, Ctr&)  \
-        const;                                                                                            \
-    template bool Accelerator::trace_wide<kAny, kCut, false, 4, Ctr>(const BvhWide<4>&, Ray&, Hit&, Ctr&) \
-        const;
-SAHARA_FOR_EACH_TRACE_FORM(SAHARA_INSTANTIATE)
-#undef SAHARA_INSTANTIATE
+template <class Form>
+struct TraceWideEntry<SimdPath::sse2, Form> {
+    static constexpr auto ptr = &Accelerator::trace_wide_sse2<Form::kAnyHit, Form::kCutouts, Form::kPairNodes,
+                                                              typename Form::Counters>;
+};
+
+// Every form trace_layout calls on this path.
+[[gnu::used]] constexpr auto kTraceWideSse2Forms =
+    trace_form_table<SimdPath::sse2>(std::make_integer_sequence<unsigned, kUnpairedTraceForms>{});
 
 }  // namespace sahara

@@ -113,20 +113,17 @@ void check_wide_valid(const Accelerator& acc, const BvhWide<N>& t) {
     CHECK(std::all_of(node_uses.begin(), node_uses.end(), [](int u) { return u == 1; }));
 }
 
-/// check_wide_valid on the tree of the accelerator's layout.
-void check_bvh4_valid(const Accelerator& acc) {
-    if (acc.layout() == BvhLayout::wide8) {
-        CHECK(acc.bvh4().empty);
+/// check_wide_valid on the wide8 tree (the pairs layout has none).
+void check_wide8_valid(const Accelerator& acc) {
+    if (acc.layout() == BvhLayout::wide8)
         check_wide_valid(acc, acc.bvh8());
-    } else {
+    else
         CHECK(acc.bvh8().empty);
-        check_wide_valid(acc, acc.bvh4());
-    }
 }
 
 bool same_t(float a, float b) { return std::fabs(a - b) <= 1e-6f * std::max(std::fabs(a), std::fabs(b)); }
 
-/// Rays on which `acc` (BVH4) disagrees with the brute-force loop, for intersect and occluded.
+/// Rays on which `acc` disagrees with the brute-force loop, for intersect and occluded.
 int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
     int bad = 0;
     for (const Ray& r0 : rays) {
@@ -141,7 +138,7 @@ int disagreements(const Accelerator& acc, const std::vector<Ray>& rays) {
     return bad;
 }
 
-/// The wide layouts on `paths`: valid trees, brute-force answers; `reinsert` adds the
+/// Both layouts on `paths`: valid trees, brute-force answers; `reinsert` adds the
 /// wide8 layout over the reinsertion builder's tree. The wide8 tree is also traced with
 /// node pairing for every closest-hit ray (the AVX-512 path).
 void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert,
@@ -157,10 +154,10 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert,
         NodePairing pairing;
     };
     for (auto [layout, builder, pairing] :
-         {Config{BvhLayout::wide4, BvhBuilder::binned, NodePairing::automatic},
+         {Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::automatic},
           Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::never},
           Config{BvhLayout::wide8, BvhBuilder::binned, NodePairing::always},
-          Config{BvhLayout::wide4_slots, BvhBuilder::binned, NodePairing::automatic},
+          Config{BvhLayout::pairs, BvhBuilder::binned, NodePairing::automatic},
           Config{BvhLayout::wide8, BvhBuilder::reinsert, NodePairing::always}}) {
         if (builder == BvhBuilder::reinsert && !reinsert) continue;
         AcceleratorOptions opt;
@@ -170,7 +167,7 @@ void check_mesh(const TriangleMesh& mesh, uint32_t seed, bool reinsert,
         const Accelerator acc(scene, opt);
         REQUIRE(acc.layout() == layout);
         if (pairing != NodePairing::automatic) CHECK(acc.pairs_nodes() == (pairing == NodePairing::always));
-        check_bvh4_valid(acc);
+        check_wide8_valid(acc);
         for (SimdPath path : paths) {
             force_simd_path(path);
             INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " builder ",
@@ -197,26 +194,26 @@ Ray random_slab_test_ray(std::mt19937& rng, std::uniform_int_distribution<int>& 
 }  // namespace
 
 // One test case per SIMD path, so that a CPU without AVX2 or AVX-512 shows those paths as skipped.
-TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the SSE2 path") {
+TEST_CASE("wide BVH is valid and agrees with brute force on procedural meshes, on the SSE2 path") {
     uint32_t seed = 500;
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::sse2});
 }
 
-TEST_CASE("BVH4 is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
+TEST_CASE("wide BVH is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
           doctest::skip(!cpu_has_avx2())) {
     uint32_t seed = 500;
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx2});
 }
 
 TEST_CASE(
-    "BVH4 is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
+    "wide BVH is valid and agrees with brute force on procedural meshes, on the AVX-512 path "
     "[needs AVX-512]" *
     doctest::skip(!cpu_has_avx512())) {
     uint32_t seed = 500;
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx512});
 }
 
-TEST_CASE("BVH4 is valid and agrees with brute force on real and scan-like meshes, on every SIMD path") {
+TEST_CASE("wide BVH is valid and agrees with brute force on real and scan-like meshes, on every SIMD path") {
     uint32_t seed = 600;
     // (The reinsertion tree on these meshes is checked against brute force in test_bvh.cpp.)
     for (const TriangleMesh& m : realistic_meshes()) check_mesh(m, seed++, false);
@@ -262,14 +259,14 @@ TEST_CASE("node pairing on a deep, lopsided tree agrees with brute force") {
     }
 }
 
-TEST_CASE("BVH4 and pair layouts give the same hits") {
+TEST_CASE("wide8 and pair layouts give the same hits") {
     const TriangleMesh m = make_icosphere(4);  // random rays hit it often, even the few under ASan
     const Scene scene = scene_from_mesh(m);
     AcceleratorOptions wide, pairs;
     pairs.layout = BvhLayout::pairs;
     const Accelerator a(scene, wide), b(scene, pairs);
     CHECK(b.layout() == BvhLayout::pairs);
-    CHECK(b.bvh4().empty);
+    CHECK(b.bvh8().empty);
     int bad = 0, hits = 0;
     for (const Ray& r0 : make_random_rays(mesh_bounds(m), 20000 / kSanitizerDivisor, 77)) {
         Ray ra = r0, rb = r0;
@@ -277,43 +274,13 @@ TEST_CASE("BVH4 and pair layouts give the same hits") {
         const bool fa = a.intersect(ra, ha), fb = b.intersect(rb, hb);
         hits += fa;
         if (fa != fb || (fa && ha.t != hb.t) || a.occluded(r0) != b.occluded(r0)) ++bad;
-        // The wide4 brute force reads the leaf blocks, the pair one the scene's triangles.
+        // The wide8 brute force reads the leaf blocks, the pair one the scene's triangles.
         Ray ba = r0, bb = r0;
         const bool ga = a.intersect_brute_force(ba, ha), gb = b.intersect_brute_force(bb, hb);
         if (ga != gb || (ga && ha.t != hb.t)) ++bad;
     }
     CHECK(bad == 0);
     CHECK(hits > 0);
-}
-
-TEST_CASE("BVH4 box test matches the single-node test, including zero directions on slab planes") {
-    std::mt19937 rng(31);
-    std::uniform_int_distribution<int> coord(-2, 2);  // small integers: origins often exactly on planes
-    std::uniform_real_distribution<float> u(-2.0f, 2.0f);
-    int bad = 0;
-    for (int i = 0; i < 100000 / kSanitizerDivisor; ++i) {
-        BvhNode child[4];
-        Bvh4Node n{};
-        for (int c = 0; c < 4; ++c) {
-            Bounds3 b = Bounds3::of_point(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
-            b.extend(Vec3(float(coord(rng)), float(coord(rng)), float(coord(rng))));
-            if (rng() % 50 == 0) b = Bounds3{};  // empty box
-            child[c].set_box(b);
-            n.lo_x[c] = b.lo.x, n.lo_y[c] = b.lo.y, n.lo_z[c] = b.lo.z;
-            n.hi_x[c] = b.hi.x, n.hi_y[c] = b.hi.y, n.hi_z[c] = b.hi.z;
-        }
-        const BvhRay r(random_slab_test_ray(rng, coord, u));
-        __m128 tv;
-        const int mask = intersect_bvh4(n, Bvh4Ray(r), r.tmin, r.tmax, tv);
-        alignas(16) float t4[4];
-        _mm_store_ps(t4, tv);
-        for (int c = 0; c < 4; ++c) {
-            float t = 0.0f;
-            const bool hit = intersect_bvh_node(child[c], r, t);
-            if (hit != bool(mask & (1 << c)) || (hit && t != t4[c])) ++bad;
-        }
-    }
-    CHECK(bad == 0);
 }
 
 TEST_CASE("BVH8 box test in SSE halves matches the single-node test") {
@@ -538,16 +505,16 @@ TEST_CASE("eight-lane (AVX pair) triangle test is bit-identical to the scalar wa
     check_lane_triangle_tests(true);
 }
 
-TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
+TEST_CASE("wide BVH: mixed primitives, counted traversal and layout names") {
     Scene scene = scene_from_mesh(make_icosphere(2, 0.5f));
     scene.spheres.push_back(Sphere{Vec3(2.0f, 0.0f, 0.0f), 0.4f});
     scene.boxes.push_back(Box{Bounds3{{-2.5f, -0.5f, -0.5f}, {-1.5f, 0.5f, 0.5f}}});
     SimdPathGuard guard;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+    for (BvhLayout layout : {BvhLayout::pairs, BvhLayout::wide8}) {
         AcceleratorOptions opt;
         opt.layout = layout;
         const Accelerator acc(scene, opt);
-        check_bvh4_valid(acc);
+        check_wide8_valid(acc);
         for (SimdPath path : runnable_paths()) {
             force_simd_path(path);
             INFO(std::string(bvh_layout_name(layout)), " ", std::string(simd_path_name(path)));
@@ -563,13 +530,14 @@ TEST_CASE("BVH4: mixed primitives, counted traversal and layout names") {
     BvhLayout layout{};
     CHECK(parse_bvh_layout("pairs", layout));
     CHECK(layout == BvhLayout::pairs);
-    CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide4), layout));
-    CHECK(layout == BvhLayout::wide4);
-    CHECK(parse_bvh_layout("wide4-slots", layout));
-    CHECK(layout == BvhLayout::wide4_slots);
     CHECK(parse_bvh_layout(bvh_layout_name(BvhLayout::wide8), layout));
     CHECK(layout == BvhLayout::wide8);
+    CHECK(std::string(bvh_layout_name(BvhLayout::pairs)) == "pairs");
+    // The removed layouts are refused like any unknown name.
+    CHECK_FALSE(parse_bvh_layout("wide4", layout));
+    CHECK_FALSE(parse_bvh_layout("wide4-slots", layout));
     CHECK_FALSE(parse_bvh_layout("bvh8", layout));
+    CHECK(layout == BvhLayout::wide8);
 }
 
 TEST_CASE("wide tree statistics follow Embree's definitions") {
@@ -686,7 +654,7 @@ TEST_CASE("wide collapse: least SAH cost, as an exhaustive search finds it") {
         Scene scene;
         scene.triangles.positions = mesh.positions;
         scene.triangles.indices = mesh.indices;
-        for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
+        for (BvhLayout layout : {BvhLayout::wide8})
             for (const WideCollapse collapse :
                  {WideCollapse{0, 1.0}, WideCollapse{8, 1.0}, WideCollapse{8, 0.5}}) {
                 INFO(mesh.name, " layout ", std::string(bvh_layout_name(layout)), " merge ",
@@ -700,17 +668,16 @@ TEST_CASE("wide collapse: least SAH cost, as an exhaustive search finds it") {
                 const Bvh& bvh = acc.bvh();
                 REQUIRE(!bvh.nodes[0].is_leaf());
                 std::map<uint32_t, double> memo;
-                const size_t width = layout == BvhLayout::wide8 ? 8 : 4;
+                const size_t width = 8;
                 const double best =
                     least_cost(bvh, 0, width, collapse.merge_leaves_up_to, collapse.block_cost, memo) /
                     double(bvh.nodes[0].box().surface_area());
-                const WideBvhStats s = layout == BvhLayout::wide8 ? compute_wide_bvh_stats(acc.bvh8(), 4)
-                                                                  : compute_wide_bvh_stats(acc.bvh4(), 4);
+                const WideBvhStats s = compute_wide_bvh_stats(acc.bvh8(), 4);
                 CHECK(s.sah_nodes + collapse.block_cost * s.sah_leaves ==
                       doctest::Approx(best).epsilon(1e-5));
                 if (collapse.merge_leaves_up_to == 0) CHECK(s.leaves == (bvh.nodes.size() + 1) / 2);
                 merged = merged || s.leaves < (bvh.nodes.size() + 1) / 2;
-                check_bvh4_valid(acc);
+                check_wide8_valid(acc);
             }
     }
     CHECK(merged);
@@ -723,7 +690,7 @@ TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused
     const Scene scene = scene_from_mesh(m);
     const std::vector<Ray> rays = make_random_rays(mesh_bounds(m), 4000 / kSanitizerDivisor, 91);
     SimdPathGuard guard;
-    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::wide4, BvhLayout::wide4_slots}) {
+    for (BvhLayout layout : {BvhLayout::wide8}) {
         AcceleratorOptions opt;
         opt.layout = layout;
         opt.params.max_leaf_size = 1000;
@@ -732,17 +699,14 @@ TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused
         opt.flat_loop_max_prims = 0;
         CHECK(opt.build_params().max_leaf_size == kMaxWideLeafCount);
         const Accelerator acc(scene, opt);
-        check_bvh4_valid(acc);
+        check_wide8_valid(acc);
         uint32_t largest = 0;
         auto largest_leaf = [&](const auto& tree) {
             for (const auto& n : tree.nodes)
                 for (int c = 0; c < std::decay_t<decltype(n)>::kWidth; ++c)
                     largest = std::max(largest, n.leaf_count(c));
         };
-        if (layout == BvhLayout::wide8)
-            largest_leaf(acc.bvh8());
-        else
-            largest_leaf(acc.bvh4());
+        largest_leaf(acc.bvh8());
         INFO("layout ", std::string(bvh_layout_name(layout)), " largest leaf ", largest);
         CHECK(largest > 32);  // the count's top bit is used
         CHECK(largest <= kMaxWideLeafCount);

@@ -373,10 +373,14 @@ TEST_CASE("render --layout picks the traversal structure the scene's tree is bui
     const Scene pairs = build_scene(d);
     REQUIRE(pairs.accelerator() != nullptr);
     CHECK(pairs.accelerator()->layout() == BvhLayout::pairs);
-    parse_render_args({"--layout", "wide4-slots"}).overrides.apply(d.render);
-    CHECK(build_scene(d).accelerator()->layout() == BvhLayout::wide4_slots);
+    parse_render_args({"--layout", "wide8"}).overrides.apply(d.render);
+    CHECK(build_scene(d).accelerator()->layout() == BvhLayout::wide8);
     CHECK(build_scene(default_scene()).accelerator()->layout() == BvhLayout::wide8);
     CHECK_THROWS_AS(parse_render_args({"--layout", "wide16"}), UsageError);
+    // The removed layouts are usage errors that name the accepted ones.
+    for (const char* removed : {"wide4", "wide4-slots"})
+        CHECK_THROWS_WITH_AS(parse_render_args({"--layout", removed}),
+                             doctest::Contains("expected wide8|pairs"), UsageError);
     CHECK_THROWS_AS(parse_render_args({"--layout"}), UsageError);
 }
 

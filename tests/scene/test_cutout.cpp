@@ -125,8 +125,7 @@ struct SimdGuard {
 
 std::vector<SimdPath> simd_paths() { return runnable_simd_paths(); }
 
-constexpr BvhLayout kLayouts[] = {BvhLayout::wide4, BvhLayout::wide8, BvhLayout::wide4_slots,
-                                  BvhLayout::pairs};
+constexpr BvhLayout kLayouts[] = {BvhLayout::wide8, BvhLayout::pairs};
 
 /// 4 standard deviations of a binomial fraction with probability p over n trials.
 double four_sigma(double p, int n) { return 4.0 * std::sqrt(p * (1.0 - p) / double(n)); }

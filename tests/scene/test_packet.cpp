@@ -22,17 +22,10 @@ using namespace sahara::test;
 
 namespace {
 
-/// Restores the automatic packet path when a test ends.
-struct PacketSimdGuard {
-    ~PacketSimdGuard() { clear_forced_packet_simd(); }
+/// Restores the automatic SIMD path when a test ends.
+struct SimdPathGuard {
+    ~SimdPathGuard() { clear_forced_simd_path(); }
 };
-
-std::vector<PacketSimd> runnable_packet_paths() {
-    std::vector<PacketSimd> paths;
-    for (PacketSimd p : {PacketSimd::sse2, PacketSimd::avx2, PacketSimd::avx512})
-        if (cpu_supports_packet_simd(p)) paths.push_back(p);
-    return paths;
-}
 
 /// An icosphere, a grid of small spheres in front of it, and a box.
 Scene mixed_scene() {
@@ -116,14 +109,14 @@ AcceleratorOptions with_layout(BvhLayout layout) {
 namespace {
 
 /// Coherent camera tiles traced as packets on `path` agree with single rays.
-void check_camera_tiles(PacketSimd path) {
-    PacketSimdGuard guard;
+void check_camera_tiles(SimdPath path) {
+    SimdPathGuard guard;
     const Scene scene = mixed_scene();
     const int n = kSanitized ? 32 : 96;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8}) {
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs}) {
         const Accelerator acc(scene, with_layout(layout));
-        force_packet_simd(path);
-        const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+        force_simd_path(path);
+        const std::string name = std::string(simd_path_name(path)) + " " + bvh_layout_name(layout);
         CAPTURE(name);
         Agreement a;
         for (const Vec3& eye : {Vec3(0.3f, 0.2f, 4.0f), Vec3(-3.0f, 2.0f, -3.0f), Vec3(0.0f, 0.0f, 5.0f)})
@@ -138,30 +131,30 @@ void check_camera_tiles(PacketSimd path) {
 
 // One test case per SIMD path, so that a CPU without AVX2 or AVX-512 shows those paths as skipped.
 TEST_CASE("packets agree with single rays: coherent camera tiles, on the SSE2 path") {
-    check_camera_tiles(PacketSimd::sse2);
+    check_camera_tiles(SimdPath::sse2);
 }
 
 TEST_CASE("packets agree with single rays: coherent camera tiles, on the AVX2 path [needs AVX2]" *
-          doctest::skip(!cpu_supports_packet_simd(PacketSimd::avx2))) {
-    check_camera_tiles(PacketSimd::avx2);
+          doctest::skip(!cpu_has_avx2())) {
+    check_camera_tiles(SimdPath::avx2);
 }
 
 TEST_CASE("packets agree with single rays: coherent camera tiles, on the AVX-512 path [needs AVX-512]" *
-          doctest::skip(!cpu_supports_packet_simd(PacketSimd::avx512))) {
-    check_camera_tiles(PacketSimd::avx512);
+          doctest::skip(!cpu_has_avx512())) {
+    check_camera_tiles(SimdPath::avx512);
 }
 
 TEST_CASE("packets agree with single rays: incoherent rays, tmax limits, inactive lanes, axis rays") {
-    PacketSimdGuard guard;
+    SimdPathGuard guard;
     const Scene scene = mixed_scene();
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     const int packets = kSanitized ? 150 : 2000;
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
-        for (PacketSimd path : runnable_packet_paths()) {
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs})
+        for (SimdPath path : runnable_simd_paths()) {
             const Accelerator acc(scene, with_layout(layout));
-            force_packet_simd(path);
-            const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+            force_simd_path(path);
+            const std::string name = std::string(simd_path_name(path)) + " " + bvh_layout_name(layout);
             CAPTURE(name);
             Agreement a;
             for (int k = 0; k < packets; ++k) {
@@ -203,7 +196,7 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
     // grid line. Each packet starts on a grid line x = k / 8 and mixes rays with a
     // signed-zero x direction (inverse +-inf, 0 * inf = NaN in that slab) with rays
     // slightly tilted the same way, so the packet's frustum meets 0 * inf at its corners.
-    PacketSimdGuard guard;
+    SimdPathGuard guard;
     Scene scene;
     const int n = 16;
     for (int y = 0; y <= n; ++y)
@@ -218,11 +211,11 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
     scene.triangles.material.assign(scene.triangles.indices.size() / 3, 0);
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (BvhLayout layout : {BvhLayout::wide4, BvhLayout::wide8})
-        for (PacketSimd path : runnable_packet_paths()) {
+    for (BvhLayout layout : {BvhLayout::wide8, BvhLayout::pairs})
+        for (SimdPath path : runnable_simd_paths()) {
             const Accelerator acc(scene, with_layout(layout));
-            force_packet_simd(path);
-            const std::string name = std::string(packet_simd_name(path)) + " " + bvh_layout_name(layout);
+            force_simd_path(path);
+            const std::string name = std::string(simd_path_name(path)) + " " + bvh_layout_name(layout);
             CAPTURE(name);
             Agreement a;
             for (int k = -8; k <= 8; ++k)
@@ -245,7 +238,7 @@ TEST_CASE("packets agree with single rays that run inside box planes (zero direc
 TEST_CASE(
     "packets on a 70k-triangle scan-like mesh and on the pairs layout (ray-by-ray fallback) agree "
     "with single rays") {
-    PacketSimdGuard guard;
+    SimdPathGuard guard;
     // Big, bumpy, with holes and slivers: deep trees and ragged packet frusta, as on a real scan.
     const TriangleMesh mesh = make_scan_mesh_70k();
     const Scene scene = scene_from_mesh(mesh);
@@ -255,9 +248,9 @@ TEST_CASE(
     const Vec3 c = wide.bounds().center();
     const float r = length(wide.bounds().extent());
     const int n = kSanitized ? 24 : 128;
-    for (PacketSimd path : runnable_packet_paths()) {
-        force_packet_simd(path);
-        const std::string name = packet_simd_name(path);
+    for (SimdPath path : runnable_simd_paths()) {
+        force_simd_path(path);
+        const std::string name = simd_path_name(path);
         CAPTURE(name);
         Agreement a, b;
         for (RayPacket p : camera_packets(Vec3(0.4f, 0.3f, 1.0f) * (2.0f * r), n, 0.5f)) {
@@ -272,11 +265,16 @@ TEST_CASE(
     }
 }
 
-TEST_CASE("packet SIMD path names and the SAHARA_PACKETS switch") {
-    CHECK(std::strcmp(packet_simd_name(PacketSimd::avx512), "avx512") == 0);
-    CHECK(std::strcmp(packet_simd_name(PacketSimd::avx2), "avx2") == 0);
-    CHECK(std::strcmp(packet_simd_name(PacketSimd::sse2), "sse2") == 0);
-    CHECK(cpu_supports_packet_simd(PacketSimd::sse2));
+TEST_CASE("SIMD path names, forcing a path and the SAHARA_PACKETS switch") {
+    CHECK(std::strcmp(simd_path_name(SimdPath::avx512), "avx512") == 0);
+    CHECK(std::strcmp(simd_path_name(SimdPath::avx2), "avx2") == 0);
+    CHECK(std::strcmp(simd_path_name(SimdPath::sse2), "sse2") == 0);
+    // One path for single rays and packets: forcing one and clearing it again.
+    const SimdPath automatic = active_simd_path();
+    force_simd_path(SimdPath::sse2);
+    CHECK(active_simd_path() == SimdPath::sse2);
+    clear_forced_simd_path();
+    CHECK(active_simd_path() == automatic);
     const bool was = packets_enabled();
     set_packets_enabled(false);
     CHECK_FALSE(packets_enabled());
