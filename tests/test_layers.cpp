@@ -75,7 +75,8 @@ std::vector<BadInclude> bad_includes(const fs::path& src) {
             bad.push_back({name + ":" + std::to_string(number), line});
         }
     }
-    std::sort(bad.begin(), bad.end(), [](const BadInclude& a, const BadInclude& b) { return a.where < b.where; });
+    std::sort(bad.begin(), bad.end(),
+              [](const BadInclude& a, const BadInclude& b) { return a.where < b.where; });
     return bad;
 }
 

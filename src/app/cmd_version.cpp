@@ -103,8 +103,8 @@ std::string codec_line() {
 
 std::string version_report() {
     const std::vector<std::pair<const char*, std::string>> parts = {
-        {"OpenMP", openmp_line()}, {"SIMD", simd_line()},  {"Embree", embree_line()},
-        {"MPI", mpi_line()},       {"SDL2", sdl_line()},   {"image codec", codec_line()},
+        {"OpenMP", openmp_line()}, {"SIMD", simd_line()}, {"Embree", embree_line()},
+        {"MPI", mpi_line()},       {"SDL2", sdl_line()},  {"image codec", codec_line()},
     };
     std::string text = "sahara " SAHARA_VERSION "\n";
     for (const auto& [name, value] : parts) {

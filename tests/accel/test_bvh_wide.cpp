@@ -199,8 +199,9 @@ TEST_CASE("wide BVH is valid and agrees with brute force on procedural meshes, o
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::sse2});
 }
 
-TEST_CASE("wide BVH is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
-          doctest::skip(!cpu_has_avx2())) {
+TEST_CASE(
+    "wide BVH is valid and agrees with brute force on procedural meshes, on the AVX2 path [needs AVX2]" *
+    doctest::skip(!cpu_has_avx2())) {
     uint32_t seed = 500;
     for (const TriangleMesh& m : procedural()) check_mesh(m, seed++, true, {SimdPath::avx2});
 }

@@ -55,7 +55,8 @@ Run run_sahara(const std::string& args, const UsageDir& dir, const std::string& 
 
 /// Checks that `sahara ARGS` fails with exit code 2 and exactly one stderr line
 /// naming `culprit` and pointing at `sahara COMMAND --help`.
-void check_one_line_usage_error(const std::string& args, const std::string& command, const std::string& culprit) {
+void check_one_line_usage_error(const std::string& args, const std::string& command,
+                                const std::string& culprit) {
     UsageDir dir("err");
     const Run r = run_sahara(args, dir);
     INFO("sahara " << args << "\nstderr:\n" << r.err);

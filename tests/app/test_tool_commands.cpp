@@ -213,15 +213,16 @@ TEST_CASE("bench command compares with Embree: default, robust and ISA-capped mo
     CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
     CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
     // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.
-    const auto robust = run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1",
-                                                         "--ray-set", "diffuse", "--embree-robust", "--json"});
+    const auto robust =
+        run_captured(run_bench_command, {"bench", mesh, "--size", "32", "--repeat", "1", "--ray-set",
+                                         "diffuse", "--embree-robust", "--json"});
     REQUIRE(robust.first == 0);
     CHECK(robust.second.find("\"embree_mode\":\"robust\"") != std::string::npos);
     CHECK(robust.second.find("\"embree_mrays_s\"") != std::string::npos);
     CHECK(robust.second.find("\"disagreements\":0") != std::string::npos);
     const auto capped =
-        run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--ray-set", "shadow",
-                                         "--embree-isa", "sse2", "--json"});
+        run_captured(run_bench_command, {"bench", mesh, "--size", "16", "--repeat", "1", "--ray-set",
+                                         "shadow", "--embree-isa", "sse2", "--json"});
     REQUIRE(capped.first == 0);
     CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
     CHECK(capped.second.find("\"disagreements\":0") != std::string::npos);
