@@ -70,6 +70,8 @@ const char* material_type_name(MaterialType t) {
             return "dielectric";
         case MaterialType::emissive:
             return "emissive";
+        case MaterialType::pbr:
+            return "pbr";
     }
     return "?";
 }

@@ -50,15 +50,17 @@ struct ColorSource {
     int texture = -1;            ///< index into SceneDesc::textures
 };
 
-enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive };
+enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr };
 
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
-    ColorSource albedo;                                            ///< lambertian and metal
-    float roughness = 0.0f;                                        ///< metal
-    float ior = 1.5f;                                              ///< dielectric
-    ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};  ///< emissive (front side)
+    ColorSource albedo;        ///< lambertian and metal; pbr: base colour (factor x texture)
+    float roughness = 0.0f;    ///< metal; pbr: perceptual roughness (alpha = roughness^2)
+    float ior = 1.5f;          ///< dielectric; pbr: ior of the dielectric layer (F0 0.04 at 1.5)
+    /// emissive: radiance of the front side; pbr: emission (factor x texture x
+    /// strength) added to what the surface reflects.
+    ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};
     /// Lambertian only: radiance it also emits, from both sides. Not light-sampled
     /// (found by BSDF sampling only); meant for analytic scenes such as the closed
     /// glowing sphere whose radiance is emission / (1 - albedo).
@@ -67,6 +69,19 @@ struct MaterialDesc {
     float alpha = 1.0f;
     int alpha_texture = -1;
     std::optional<float> alpha_cutoff;  ///< set: MASK; unset with alpha < 1 or texture: stochastic
+
+    // --- pbr only: glTF 2.0 metallic-roughness (see docs/scene-format.md) ---
+    float metallic = 1.0f;
+    int metallic_roughness_texture = -1;  ///< G scales roughness, B scales metallic
+    int normal_texture = -1;              ///< tangent-space normal map
+    float normal_scale = 1.0f;
+    bool vertex_colors = false;           ///< base colour also times the mesh's COLOR_0
+    float transmission = 0.0f;            ///< KHR_materials_transmission
+    int transmission_texture = -1;        ///< R scales transmission
+    /// KHR_materials_volume: light inside decays to attenuation_color after this distance.
+    float attenuation_distance = kInfinity;
+    Rgb attenuation_color{1.0f, 1.0f, 1.0f};
+    bool double_sided = true;  ///< false: back faces are invisible
 };
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.

@@ -182,6 +182,8 @@ MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext&
             else
                 m.radiance.color = Rgb(1.0f);
             break;
+        case MaterialType::pbr:  // not in the list above yet
+            break;
     }
     o.finish();
     return m;

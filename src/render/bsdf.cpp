@@ -110,6 +110,7 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
     b.ng = si.ng;
     switch (m.type) {
         case MaterialType::lambertian:
+        case MaterialType::pbr:  // the glTF BSDF is not in yet: its diffuse base only
             b.kind = BsdfKind::lambertian;
             b.albedo = eval_color(m.albedo, textures, si.p, si.uv);
             break;

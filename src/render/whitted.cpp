@@ -62,7 +62,8 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     if (depth >= max_depth) return radiance;  // the next ray (shadow or secondary) would exceed max_depth
     const Vec3 wo = -ray.dir;
     switch (m.type) {
-        case MaterialType::lambertian: {
+        case MaterialType::lambertian:
+        case MaterialType::pbr: {  // the glTF BSDF is not in yet: its diffuse base only
             const Rgb albedo = eval_color(m.albedo, scene.textures, si.p, si.uv);
             radiance += albedo * eval_background(scene.background, si.ns);  // ambient
             radiance += direct_lights(scene, si, albedo, ray.time);
