@@ -139,7 +139,13 @@ struct TriangleMesh {
     std::string name;  ///< source file and element, for messages and stats
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;           ///< empty, or one per position
-    std::vector<Vec2> uvs;               ///< empty, or one per position
+    std::vector<Vec2> uvs;               ///< empty, or one per position (texCoord set 0)
+    std::vector<Vec2> uvs1;              ///< empty, or one per position (texCoord set 1)
+    std::vector<Rgb> colors;             ///< empty, or one per position (glTF COLOR_0, linear)
+    std::vector<float> color_alphas;     ///< empty, or one per position (COLOR_0's alpha)
+    /// empty, or one per position: xyz the tangent, w (+1/-1) the sign of the
+    /// bitangent (mirrored UVs), as glTF's TANGENT attribute.
+    std::vector<std::array<float, 4>> tangents;
     std::vector<uint32_t> indices;       ///< 3 per triangle, counter-clockwise = front
     std::vector<uint32_t> material_ids;  ///< empty (all use `material`) or one per triangle
     uint32_t material = 0;
