@@ -82,6 +82,7 @@ struct MaterialDesc {
     float attenuation_distance = kInfinity;
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
     bool double_sided = true;  ///< false: back faces are invisible
+    bool thin_walled = false;  ///< transmission without refraction (no volume behind the surface)
 };
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "render/bsdf_pbr.h"
 #include "scene/texture.h"
 
 namespace sahara {
@@ -31,39 +32,7 @@ bool refract(const Vec3& wo, const Vec3& n, float eta, Vec3* wt) {
     return true;
 }
 
-float ggx_d(const Vec3& wm, float alpha) {
-    const float cos2 = wm.z * wm.z;
-    if (cos2 <= 0.0f) return 0.0f;
-    const float sin2 = std::max(0.0f, 1.0f - cos2);
-    const float a2 = alpha * alpha;
-    const float denom = cos2 * a2 + sin2;  // = cos^2 * a2 * (1 + tan^2 / a2)
-    return a2 / (kPi * denom * denom);
-}
-
-float ggx_lambda(const Vec3& w, float alpha) {
-    const float cos2 = w.z * w.z;
-    if (cos2 <= 0.0f) return 0.0f;
-    const float tan2 = std::max(0.0f, 1.0f - cos2) / cos2;
-    return 0.5f * (std::sqrt(1.0f + alpha * alpha * tan2) - 1.0f);
-}
-
 namespace {
-
-/// Visible-normal sampling of GGX: Heitz, "Sampling the GGX Distribution of
-/// Visible Normals" (JCGT 2018). Stretch wo to the unit-roughness
-/// configuration, sample the projected hemisphere, unstretch.
-Vec3 sample_ggx_vndf(const Vec3& wo, float alpha, Vec2 u) {
-    const Vec3 vh = normalize(Vec3(alpha * wo.x, alpha * wo.y, wo.z));
-    const float lensq = vh.x * vh.x + vh.y * vh.y;
-    const Vec3 t1 = lensq > 0 ? Vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : Vec3(1, 0, 0);
-    const Vec3 t2 = cross(vh, t1);
-    const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-    const float p1 = r * std::cos(phi);
-    const float s = 0.5f * (1.0f + vh.z);
-    const float p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * r * std::sin(phi);
-    const Vec3 nh = t1 * p1 + t2 * p2 + vh * std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2));
-    return normalize(Vec3(alpha * nh.x, alpha * nh.y, std::max(1e-7f, nh.z)));
-}
 
 /// GGX reflection with Smith's height-correlated G2 and Schlick Fresnel on F0.
 Rgb eval_ggx(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
@@ -109,8 +78,10 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
     b.frame = Frame(si.ns);
     b.ng = si.ng;
     switch (m.type) {
+        case MaterialType::pbr:
+            make_pbr_bsdf(b, m, si, textures);
+            break;
         case MaterialType::lambertian:
-        case MaterialType::pbr:  // the glTF BSDF is not in yet: its diffuse base only
             b.kind = BsdfKind::lambertian;
             b.albedo = eval_color(m.albedo, textures, si.p, si.uv);
             break;
@@ -132,6 +103,12 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
 
 Rgb eval_bsdf(const Bsdf& b, const Vec3& wo_w, const Vec3& wi_w, float* pdf) {
     *pdf = 0;
+    if (b.kind == BsdfKind::pbr) {
+        // Reflection or transmission as the true surface says; the shading frame must agree.
+        const Vec3 wi = b.frame.to_local(wi_w);
+        if ((dot(wi_w, b.ng) > 0) != (wi.z > 0)) return Rgb(0.0f);
+        return eval_pbr(b, b.frame.to_local(wo_w), wi, pdf);
+    }
     // Reflection only: wi must leave on the same side of the true surface as wo.
     if (dot(wi_w, b.ng) <= 0) return Rgb(0.0f);
     const Vec3 wi = b.frame.to_local(wi_w);
@@ -178,6 +155,10 @@ bool sample_bsdf(const Bsdf& b, const Vec3& wo_w, Vec2 u, float u_lobe, BsdfSamp
             s.delta = false;
             break;
         }
+        case BsdfKind::pbr:
+            if (!sample_pbr(b, wo, u, u_lobe, s)) return false;
+            s.wi = b.frame.to_world(s.wi);
+            return s.transmit ? dot(s.wi, b.ng) < 0 : dot(s.wi, b.ng) > 0;
         case BsdfKind::dielectric:
             if (!sample_dielectric(b, wo, u_lobe, s)) return false;
             s.wi = b.frame.to_world(s.wi);

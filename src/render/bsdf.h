@@ -1,16 +1,17 @@
 #pragma once
 /// Scattering at a surface point: Lambertian, metal (perfect mirror or GGX
-/// microfacet) and dielectric (glass). A closed set dispatched by a switch.
+/// microfacet), dielectric (glass) and the glTF material (render/bsdf_pbr.h). A closed set dispatched by a switch.
 /// Conventions: wo and wi are unit world directions pointing away from the
 /// surface (wo towards the previous vertex); eval returns f * |cos(theta_i)|.
 #include <vector>
 
 #include "math/sampling.h"
+#include "render/ggx.h"
 #include "scene/scene.h"
 
 namespace sahara {
 
-enum class BsdfKind : uint8_t { lambertian, mirror, ggx, dielectric, none };
+enum class BsdfKind : uint8_t { lambertian, mirror, ggx, dielectric, pbr, none };
 
 /// Metal roughness below this is treated as a perfect mirror (GGX with a
 /// tinier alpha is numerically a delta anyway).
@@ -19,11 +20,17 @@ inline constexpr float kMinGgxAlpha = 1e-3f;
 /// A BSDF instantiated at one surface point.
 struct Bsdf {
     BsdfKind kind = BsdfKind::none;
-    Rgb albedo{0.0f};            ///< Lambertian reflectance, or the metal's F0
+    Rgb albedo{0.0f};            ///< Lambertian reflectance, the metal's F0, or pbr's base colour
     float alpha = 0;             ///< GGX roughness parameter (= roughness^2)
     float eta = 1;               ///< ior on the far side / ior on the side of wo (dielectric)
     Frame frame{Vec3(0, 0, 1)};  ///< around the shading normal
     Vec3 ng;                     ///< geometric normal on the side of wo
+    // pbr only (render/bsdf_pbr.h)
+    float roughness = 0;     ///< perceptual roughness, for the albedo tables
+    float metallic = 0;
+    float f0 = 0.04f;        ///< dielectric layer's reflectance at normal incidence
+    float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
+    bool thin = false;       ///< thin-walled: transmission without refraction
 
     bool is_delta() const { return kind == BsdfKind::mirror || kind == BsdfKind::dielectric; }
 };
@@ -61,10 +68,5 @@ inline Vec3 reflect(const Vec3& w, const Vec3& n) { return n * (2.0f * dot(w, n)
 /// Refraction of wo (on the side n points to) into the far side; eta = n_t / n_i.
 /// False under total internal reflection.
 bool refract(const Vec3& wo, const Vec3& n, float eta, Vec3* wt);
-
-/// GGX (Trowbridge-Reitz) microfacet density of the local half vector wm.
-float ggx_d(const Vec3& wm, float alpha);
-/// Smith's Lambda for GGX, in local coordinates.
-float ggx_lambda(const Vec3& w, float alpha);
 
 }  // namespace sahara

@@ -4,6 +4,7 @@
 #include "math/sampling.h"
 #include "render/background.h"
 #include "render/bsdf.h"
+#include "render/bsdf_pbr.h"
 #include "render/lights.h"
 #include "scene/texture.h"
 
@@ -148,6 +149,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         }
         if constexpr (kEmission)
             radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
+        if constexpr (!kLambertOnly)
+            if (mat.type == MaterialType::pbr) radiance += beta * pbr_emission(mat, si, scene.textures);
         if (depth == max_depth) break;
 
         const Vec3 wo = -ray.dir;
@@ -255,6 +258,8 @@ Rgb inspect(const Scene& scene, Ray ray) {
             return Rgb(1.0f);
         case MaterialType::emissive:
             return eval_color(m.radiance, scene.textures, si.p, si.uv);
+        case MaterialType::pbr:
+            return pbr_base_color(m, si, scene.textures);
         default:
             return eval_color(m.albedo, scene.textures, si.p, si.uv);
     }

@@ -3,6 +3,7 @@
 #include "geometry/spawn.h"
 #include "render/background.h"
 #include "render/bsdf.h"
+#include "render/bsdf_pbr.h"
 #include "render/integrator.h"
 #include "scene/texture.h"
 
@@ -51,6 +52,20 @@ Rgb branch(const Scene& scene, const SurfaceInteraction& si, const Vec3& dir, bo
     return trace(scene, next, depth + 1, max_depth, weight);
 }
 
+/// The glTF material as a preview: its diffuse base lit like Lambert, plus a
+/// mirror reflection weighted by the specular colour (roughness ignored).
+Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const MaterialDesc& m, const Vec3& wo,
+                float time, int depth, int max_depth, float weight) {
+    const Bsdf b = make_bsdf(m, si, scene.textures);
+    const Rgb diffuse = b.albedo * (1.0f - b.metallic);
+    Rgb radiance = diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
+    const Rgb f = fresnel_schlick(b.albedo * b.metallic + Rgb(b.f0 * (1.0f - b.metallic)), dot(wo, si.ns));
+    const Vec3 wr = reflect(wo, si.ns);
+    if (dot(wr, si.ng) > 0)
+        radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));
+    return radiance;
+}
+
 Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     Hit hit;
     if (!scene.intersect(ray, hit)) return eval_background(scene.background, ray.dir);
@@ -58,12 +73,16 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     const MaterialDesc& m = scene.materials[si.material];
     if (m.type == MaterialType::emissive)
         return si.front_face ? eval_color(m.radiance, scene.textures, si.p, si.uv) : Rgb(0.0f);
-    Rgb radiance = m.type == MaterialType::lambertian ? m.emission : Rgb(0.0f);
+    Rgb radiance = m.type == MaterialType::lambertian ? m.emission
+                   : m.type == MaterialType::pbr      ? pbr_emission(m, si, scene.textures)
+                                                      : Rgb(0.0f);
     if (depth >= max_depth) return radiance;  // the next ray (shadow or secondary) would exceed max_depth
     const Vec3 wo = -ray.dir;
     switch (m.type) {
-        case MaterialType::lambertian:
-        case MaterialType::pbr: {  // the glTF BSDF is not in yet: its diffuse base only
+        case MaterialType::pbr:
+            radiance += whitted_pbr(scene, si, m, wo, ray.time, depth, max_depth, weight);
+            break;
+        case MaterialType::lambertian: {
             const Rgb albedo = eval_color(m.albedo, scene.textures, si.p, si.uv);
             radiance += albedo * eval_background(scene.background, si.ns);  // ambient
             radiance += direct_lights(scene, si, albedo, ray.time);

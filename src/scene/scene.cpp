@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "scene/accelerator.h"
+#include "scene/tangents.h"
 #include "accel/packet.h"
 #include "base/counters.h"
 
@@ -97,6 +98,21 @@ Vec2 sphere_uv(const Vec3& n) {
     return {u, v};
 }
 
+/// The glTF material's inputs: second UV set, vertex colour, tangent.
+void interact_triangle_attributes(const TriangleSoup& soup, uint32_t i0, uint32_t i1, uint32_t i2, float b0,
+                                  float b1, float b2, SurfaceInteraction& si) {
+    if (!soup.uvs1.empty()) {
+        const Vec2 &a = soup.uvs1[i0], &b = soup.uvs1[i1], &c = soup.uvs1[i2];
+        si.uv1 = {a.x * b0 + b.x * b1 + c.x * b2, a.y * b0 + b.y * b1 + c.y * b2};
+    }
+    if (!soup.colors.empty()) si.color = soup.colors[i0] * b0 + soup.colors[i1] * b1 + soup.colors[i2] * b2;
+    if (!soup.tangents.empty()) {
+        const auto &a = soup.tangents[i0], &b = soup.tangents[i1], &c = soup.tangents[i2];
+        si.tangent = Vec3(a[0], a[1], a[2]) * b0 + Vec3(b[0], b[1], b[2]) * b1 + Vec3(c[0], c[1], c[2]) * b2;
+        si.tangent_sign = a[3] < 0 ? -1.0f : 1.0f;
+    }
+}
+
 void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, SurfaceInteraction& si) {
     const uint32_t i0 = soup.indices[3 * i], i1 = soup.indices[3 * i + 1], i2 = soup.indices[3 * i + 2];
     const float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
@@ -115,7 +131,51 @@ void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, Sur
     } else {
         si.uv = {b1, b2};
     }
+    interact_triangle_attributes(soup, i0, i1, i2, b0, b1, b2, si);
     si.material = soup.material[i];
+}
+
+/// Whether a mesh uses a normal-mapped material (and so needs tangents).
+bool uses_normal_map(const SceneDesc& desc, const TriangleMesh& m) {
+    auto mapped = [&](uint32_t id) { return id < desc.materials.size() && desc.materials[id].normal_texture >= 0; };
+    if (m.material_ids.empty()) return mapped(m.material);
+    return std::any_of(m.material_ids.begin(), m.material_ids.end(), mapped);
+}
+
+/// Appends `values` for a mesh, or `fill` per position when it has none; the
+/// whole array stays empty while no mesh has any.
+template <class T>
+void append_attribute(std::vector<T>& out, const std::vector<T>& values, size_t positions, size_t total,
+                      const T& fill) {
+    if (values.size() == positions)
+        out.insert(out.end(), values.begin(), values.end());
+    else
+        out.resize(total, fill);
+}
+
+/// The meshes' second UV set, vertex colours and tangents, merged in the order
+/// build_scene merges positions (tangents generated where a normal map needs them).
+void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
+    bool any_uv1 = false, any_colors = false, any_tangents = false;
+    std::vector<std::vector<std::array<float, 4>>> tangents(desc.meshes.size());
+    for (size_t k = 0; k < desc.meshes.size(); ++k) {
+        const TriangleMesh& m = desc.meshes[k];
+        any_uv1 |= !m.uvs1.empty();
+        any_colors |= !m.colors.empty();
+        if (m.tangents.size() == m.positions.size() && !m.tangents.empty())
+            tangents[k] = m.tangents;
+        else if (uses_normal_map(desc, m))
+            tangents[k] = generate_tangents(m);
+        any_tangents |= !tangents[k].empty();
+    }
+    size_t total = 0;
+    for (size_t k = 0; k < desc.meshes.size(); ++k) {
+        const size_t n = desc.meshes[k].positions.size();
+        total += n;
+        if (any_uv1) append_attribute(soup.uvs1, desc.meshes[k].uvs1, n, total, Vec2{0, 0});
+        if (any_colors) append_attribute(soup.colors, desc.meshes[k].colors, n, total, Rgb(1.0f));
+        if (any_tangents) append_attribute(soup.tangents, tangents[k], n, total, std::array<float, 4>{0, 0, 0, 1});
+    }
 }
 
 Vec3 box_normal(const Bounds3& b, const Vec3& p) {
@@ -252,6 +312,7 @@ Scene build_scene(const SceneDesc& desc) {
         any_uvs |= !m.uvs.empty();
     }
     TriangleSoup& soup = scene.triangles;
+    merge_material_inputs(desc, soup);
     for (const TriangleMesh& m : desc.meshes) {
         const uint32_t base = uint32_t(soup.positions.size());
         soup.positions.insert(soup.positions.end(), m.positions.begin(), m.positions.end());

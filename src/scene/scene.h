@@ -2,6 +2,7 @@
 /// The runtime scene: primitives in flat arrays, one acceleration structure
 /// over all bounded primitives, unbounded planes tested beside it, plus the
 /// camera, materials, lights and background the integrators need.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -21,6 +22,10 @@ struct SurfaceInteraction {
     Vec3 ng;  ///< geometric normal, unit, facing against the incoming ray
     Vec3 ns;  ///< shading normal, unit, same hemisphere as ng
     Vec2 uv;
+    Vec2 uv1;                      ///< the second UV set (glTF TEXCOORD_1), or zero
+    Rgb color{1.0f, 1.0f, 1.0f};   ///< interpolated vertex colour (glTF COLOR_0), white without
+    Vec3 tangent{0.0f, 0.0f, 0.0f};  ///< interpolated tangent for normal maps; zero: none
+    float tangent_sign = 1;        ///< cross(normal, tangent) * sign points along increasing v
     uint32_t material = 0;
     bool front_face = true;  ///< the ray hit the outward (front) side
 };
@@ -30,6 +35,9 @@ struct TriangleSoup {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;  ///< empty or per position
     std::vector<Vec2> uvs;      ///< empty or per position
+    std::vector<Vec2> uvs1;     ///< empty or per position (second UV set)
+    std::vector<Rgb> colors;    ///< empty or per position (vertex colours)
+    std::vector<std::array<float, 4>> tangents;  ///< empty or per position (xyz, bitangent sign)
     std::vector<uint32_t> indices;
     std::vector<uint32_t> material;  ///< per triangle
     size_t size() const { return indices.size() / 3; }
@@ -58,7 +66,8 @@ struct SceneFeatures {
     bool has_lens = false;               ///< thin-lens depth of field
     bool has_textures = false;           ///< checker or image colour sources
     bool has_metal = false, has_rough_metal = false, has_dielectric = false;
-    bool lambertian_only = true;  ///< no metal, no dielectric
+    bool has_pbr = false;         ///< glTF metallic-roughness materials
+    bool lambertian_only = true;  ///< no metal, no dielectric, no pbr
     bool forced_all = false;      ///< everything on (prepare_lighting(true)), for measurements
 };
 

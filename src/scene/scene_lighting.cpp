@@ -92,14 +92,16 @@ void add_area_emitter(std::vector<uint32_t>& map, size_t count, Emitter::Kind ki
 void collect_features(const Scene& s, SceneFeatures& f) {
     for (const MaterialDesc& m : s.materials) {
         f.has_emitters |= (m.type == MaterialType::emissive && mean_color(m.radiance) > 0) ||
-                          (m.type == MaterialType::lambertian && max_component(m.emission) > 0);
+                          (m.type == MaterialType::lambertian && max_component(m.emission) > 0) ||
+                          (m.type == MaterialType::pbr && mean_color(m.radiance) > 0);
+        f.has_pbr |= m.type == MaterialType::pbr;
         f.has_metal |= m.type == MaterialType::metal;
         f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
         f.has_dielectric |= m.type == MaterialType::dielectric;
         f.has_textures |=
             m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
     }
-    f.lambertian_only = !f.has_metal && !f.has_dielectric;
+    f.lambertian_only = !f.has_metal && !f.has_dielectric && !f.has_pbr;
     const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
     for (const Sphere& sp : s.spheres) f.has_motion |= shutter && sp.velocity != Vec3(0.0f);
     f.has_lens = s.camera.aperture > 0;
@@ -109,7 +111,7 @@ void force_all(SceneFeatures& f) {
     f.has_lights = f.has_emitters = f.has_area_lights = f.has_envmap = true;
     f.has_delta_lights_only = false;
     f.has_motion = f.has_lens = f.has_textures = true;
-    f.has_metal = f.has_rough_metal = f.has_dielectric = true;
+    f.has_metal = f.has_rough_metal = f.has_dielectric = f.has_pbr = true;
     f.lambertian_only = false;
     f.forced_all = true;
 }

@@ -1,0 +1,237 @@
+#include "render/bsdf_pbr.h"
+
+#include <cmath>
+
+#include "render/ggx_albedo.h"
+#include "scene/texture.h"
+
+namespace sahara {
+
+namespace {
+
+float mean(const Rgb& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+Rgb lerp(const Rgb& a, const Rgb& b, float t) { return a * (1.0f - t) + b * t; }
+
+/// Kulla-Conty's Fresnel factor of the compensation lobe: the part of the
+/// energy that multiple bounces between microfacets keep, given F_avg.
+float multiscatter_fresnel(float f_avg, float e_avg) {
+    return f_avg * f_avg * e_avg / (1.0f - f_avg * (1.0f - e_avg));
+}
+Rgb multiscatter_fresnel(const Rgb& f_avg, float e_avg) {
+    return {multiscatter_fresnel(f_avg.x, e_avg), multiscatter_fresnel(f_avg.y, e_avg),
+            multiscatter_fresnel(f_avg.z, e_avg)};
+}
+
+/// Hemispherical average of Schlick's Fresnel: F0 + (1 - F0) / 21.
+float schlick_average(float f0) { return f0 + (1.0f - f0) / 21.0f; }
+
+/// Everything the lobes need that depends on the material only, from the tables.
+struct PbrTerms {
+    float e_avg = 1, one_minus_e_avg = 0;
+    Rgb spec_ms{0.0f};         ///< F_ms mixed by metallic (dielectric: scalar F0, metal: base colour)
+    float dielectric_ms = 0;   ///< F_ms of the dielectric layer alone
+    float dielectric_avg = 0;  ///< Ed_avg: the dielectric layer's average albedo
+    Rgb f0{0.04f};             ///< Schlick F0 of the specular lobe, mixed by metallic
+    Rgb diffuse{0.0f};         ///< Lambertian base weight (1 - metallic)(1 - transmission) base
+};
+
+PbrTerms pbr_terms(const Bsdf& b, const GgxAlbedo& avg) {
+    PbrTerms t;
+    t.e_avg = avg.e;
+    t.one_minus_e_avg = 1.0f - avg.e;
+    const Rgb base = b.albedo;
+    t.f0 = lerp(Rgb(b.f0), base, b.metallic);
+    t.dielectric_ms = multiscatter_fresnel(schlick_average(b.f0), avg.e);
+    const Rgb metal_avg = base + (Rgb(1.0f) - base) * (1.0f / 21.0f);
+    t.spec_ms = lerp(Rgb(t.dielectric_ms), multiscatter_fresnel(metal_avg, avg.e), b.metallic);
+    t.dielectric_avg = b.f0 * avg.e + (1.0f - b.f0) * avg.e_schlick + t.one_minus_e_avg * t.dielectric_ms;
+    t.diffuse = base * ((1.0f - b.metallic) * (1.0f - b.transmission));
+    return t;
+}
+
+/// Ed(mu): albedo of the dielectric layer (single and multiple scattering).
+float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
+    return b.f0 * e.e + (1.0f - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
+}
+
+/// Single-scattering GGX reflection, f cos.
+Rgb eval_specular(const Bsdf& b, const PbrTerms& t, const Vec3& wo, const Vec3& wi) {
+    const Vec3 wm = normalize(wo + wi);
+    const float lo = ggx_lambda(wo, b.alpha), li = ggx_lambda(wi, b.alpha);
+    const float g2 = 1.0f / (1.0f + lo + li);
+    return fresnel_schlick(t.f0, std::abs(dot(wo, wm))) * (ggx_d(wm, b.alpha) * g2 / (4.0f * wo.z));
+}
+
+/// The half vector of a refraction from wo (outside, +z) to wi (below), facing +z.
+Vec3 refraction_half_vector(const Vec3& wo, const Vec3& wi, float eta) {
+    Vec3 wm = normalize(wi * eta + wo);
+    return wm.z < 0 ? -wm : wm;
+}
+
+/// Rough refraction (Walter et al. 2007), f |cos| and its sampling density.
+/// A thin wall transmits like a reflection mirrored through the surface:
+/// the light leaves on the far side without bending.
+Rgb eval_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
+    *pdf = 0;
+    const float lo = ggx_lambda(wo, b.alpha), li = ggx_lambda(wi, b.alpha);
+    const Rgb tint = b.albedo * ((1.0f - b.metallic) * b.transmission);
+    if (b.thin) {
+        const Vec3 wr(wi.x, wi.y, -wi.z);
+        const Vec3 wm = normalize(wo + wr);
+        *pdf = ggx_reflection_pdf(wo, wr, b.alpha);
+        const float fresnel_t = 1.0f - fresnel_schlick(Rgb(b.f0), dot(wo, wm)).x;
+        return tint * (fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) / (4.0f * wo.z));
+    }
+    const Vec3 wm = refraction_half_vector(wo, wi, b.eta);
+    const float o_m = dot(wo, wm), i_m = dot(wi, wm);
+    if (o_m <= 0 || i_m >= 0) return Rgb(0.0f);  // not a refraction through this microfacet
+    const float denom = (i_m + o_m / b.eta) * (i_m + o_m / b.eta);
+    const float fresnel_t = 1.0f - fresnel_dielectric(o_m, b.eta);
+    *pdf = ggx_vndf_pdf(wo, wm, b.alpha) * std::abs(i_m) / denom;
+    // Radiance is compressed by eta^2 entering the denser side, as for `dielectric`.
+    const float f = fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) /
+                    (b.eta * b.eta);
+    return tint * f;
+}
+
+/// A transmitted direction for the visible normal wm; false if there is none.
+bool sample_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wm, Vec3* wi) {
+    if (b.thin) {
+        const Vec3 wr = reflect(wo, wm);
+        *wi = Vec3(wr.x, wr.y, -wr.z);
+        return wr.z > 0;
+    }
+    return refract(wo, wm, b.eta, wi) && wi->z < 0;
+}
+
+/// The UVs a texture reads: set 0 or 1 (glTF texCoord).
+Vec2 texcoord(const SurfaceInteraction& si, const std::vector<TextureDesc>& textures, int texture) {
+    return texture >= 0 && textures[size_t(texture)].texcoord == 1 ? si.uv1 : si.uv;
+}
+
+/// The shading normal bent by a tangent-space normal map (glTF: +Y towards
+/// increasing v, xy scaled by normal_scale). The map describes the front
+/// side; a back face sees the same bumps from behind, so the frame is built
+/// on the front side and the result turned around.
+Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+    if (length_squared(si.tangent) <= 0) return si.ns;
+    const Vec3 n_front = si.front_face ? si.ns : -si.ns;
+    const Vec3 t0 = si.tangent - n_front * dot(n_front, si.tangent);
+    if (length_squared(t0) <= 1e-12f) return si.ns;
+    const Vec3 t = normalize(t0);
+    const Vec3 bt = cross(n_front, t) * si.tangent_sign;
+    const Rgb c = sample_texture_rgb(textures[size_t(m.normal_texture)],
+                                     texcoord(si, textures, m.normal_texture));
+    const float x = (2.0f * c.x - 1.0f) * m.normal_scale, y = (2.0f * c.y - 1.0f) * m.normal_scale;
+    const float z = 2.0f * c.z - 1.0f;
+    const Vec3 n = t * x + bt * y + n_front * z;
+    if (!(length_squared(n) > 0)) return si.ns;
+    const Vec3 ns = si.front_face ? normalize(n) : -normalize(n);
+    return dot(ns, si.ng) > 0 ? ns : si.ns;  // a map must not turn the surface away from the viewer's side
+}
+
+}  // namespace
+
+Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+    return eval_color(m.albedo, textures, si.p, texcoord(si, textures, m.albedo.texture)) * si.color;
+}
+
+Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+    return eval_color(m.radiance, textures, si.p, texcoord(si, textures, m.radiance.texture));
+}
+
+void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                   const std::vector<TextureDesc>& textures) {
+    b.kind = BsdfKind::pbr;
+    b.albedo = pbr_base_color(m, si, textures);
+    float roughness = m.roughness, metallic = m.metallic, transmission = m.transmission;
+    if (m.metallic_roughness_texture >= 0) {
+        const Rgb c = sample_texture_rgb(textures[size_t(m.metallic_roughness_texture)],
+                                         texcoord(si, textures, m.metallic_roughness_texture));
+        roughness *= c.y;
+        metallic *= c.z;
+    }
+    if (m.transmission_texture >= 0)
+        transmission *= sample_texture_rgb(textures[size_t(m.transmission_texture)],
+                                           texcoord(si, textures, m.transmission_texture))
+                            .x;
+    b.roughness = std::clamp(roughness, 0.0f, 1.0f);
+    b.alpha = pbr_alpha(b.roughness);
+    b.metallic = std::clamp(metallic, 0.0f, 1.0f);
+    b.transmission = std::clamp(transmission, 0.0f, 1.0f);
+    const float r = (m.ior - 1.0f) / (m.ior + 1.0f);
+    b.f0 = r * r;
+    b.thin = m.thin_walled;
+    b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
+    if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m, si, textures));
+}
+
+PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, table.average(b.roughness));
+    const GgxAlbedo e = table.at(wo.z, b.roughness);
+    PbrLobeWeights w;
+    const float f0 = mean(t.f0);
+    w.specular = f0 * e.e + (1.0f - f0) * e.e_schlick;
+    w.cosine = mean(t.spec_ms) * (1.0f - e.e) + mean(t.diffuse) * (1.0f - dielectric_albedo(b, t, e));
+    w.transmit = (1.0f - b.metallic) * b.transmission * mean(b.albedo) * (1.0f - f0);
+    const float sum = w.specular + w.cosine + w.transmit;
+    if (!(sum > 0)) return {};
+    w.specular /= sum;
+    w.cosine /= sum;
+    w.transmit /= sum;
+    return w;
+}
+
+Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
+    *pdf = 0;
+    if (wo.z <= 0 || wi.z == 0) return Rgb(0.0f);
+    const PbrLobeWeights p = pbr_lobe_weights(b, wo);
+    if (wi.z < 0) {
+        if (p.transmit <= 0) return Rgb(0.0f);
+        float pdf_t = 0;
+        const Rgb f = eval_transmission(b, wo, wi, &pdf_t);
+        *pdf = p.transmit * pdf_t;
+        return f;
+    }
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, table.average(b.roughness));
+    const GgxAlbedo eo = table.at(wo.z, b.roughness), ei = table.at(wi.z, b.roughness);
+    Rgb f = eval_specular(b, t, wo, wi);
+    const float cos_pi = wi.z * kInvPi;
+    if (t.one_minus_e_avg > 1e-6f)
+        f += t.spec_ms * ((1.0f - eo.e) * (1.0f - ei.e) / t.one_minus_e_avg * cos_pi);
+    const float diffuse_scale =
+        (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) / (1.0f - t.dielectric_avg);
+    f += t.diffuse * (diffuse_scale * cos_pi);
+    *pdf = p.specular * ggx_reflection_pdf(wo, wi, b.alpha) + p.cosine * cos_pi;
+    return f;
+}
+
+bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s) {
+    if (wo.z <= 0) return false;
+    const PbrLobeWeights p = pbr_lobe_weights(b, wo);
+    Vec3 wi;
+    if (u_lobe < p.specular) {
+        wi = reflect(wo, sample_ggx_vndf(wo, b.alpha, u));
+        if (wi.z <= 0) return false;
+    } else if (u_lobe < p.specular + p.cosine) {
+        wi = sample_cosine_hemisphere(u);
+    } else {
+        if (p.transmit <= 0) return false;
+        if (!sample_transmission(b, wo, sample_ggx_vndf(wo, b.alpha, u), &wi)) return false;
+    }
+    float pdf = 0;
+    const Rgb f = eval_pbr(b, wo, wi, &pdf);
+    if (!(pdf > 0)) return false;
+    s.wi = wi;
+    s.pdf = pdf;
+    s.weight = f / pdf;
+    s.delta = false;
+    s.transmit = wi.z < 0;
+    s.eta_scale = s.transmit ? b.eta * b.eta : 1.0f;
+    return true;
+}
+
+}  // namespace sahara

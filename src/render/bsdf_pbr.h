@@ -1,0 +1,51 @@
+#pragma once
+/// The glTF 2.0 metallic-roughness BRDF (the specification's appendix "BRDF
+/// implementation"): a dielectric GGX layer (Schlick Fresnel, F0 from the ior)
+/// over a Lambertian base, mixed by `metallic` with a GGX conductor whose F0 is
+/// the base colour; alpha = roughness^2, Smith height-correlated G2.
+///
+/// Beyond the specification, energy lost by the single-scattering microfacet
+/// model is restored (Kulla and Conty 2017): a compensation lobe
+///   f_ms = F_ms (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)),
+///   F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)),
+/// and the Lambertian base is scaled by (1 - Ed(mu_o)) (1 - Ed(mu_i)) / (1 - Ed_avg),
+/// Ed being the dielectric layer's albedo, so that light the layer does not
+/// reflect reaches the base and the whole stays reciprocal. A white material
+/// then reflects everything at any roughness, metallic or not.
+///
+/// Transmission (KHR_materials_transmission) replaces that fraction of the
+/// base by a rough dielectric interface (Walter et al. 2007) refracting with
+/// the material's ior, as `dielectric` does for a closed volume.
+///
+/// All directions here are local (shading normal +z); wo.z > 0 is required.
+#include "render/bsdf.h"
+
+namespace sahara {
+
+/// The glTF material's BSDF at `si`: base colour (factor x texture x vertex
+/// colour), metallic-roughness texture (G roughness, B metallic), transmission
+/// texture (R), normal map; each texture reads its own UV set.
+void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                   const std::vector<TextureDesc>& textures);
+
+/// Base colour at si (factor x texture x vertex colour), what the albedo image shows.
+Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+/// Emitted radiance (factor x texture x strength), from either side.
+Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+
+/// The lobes' weights at one wo: the probabilities sample_pbr uses.
+struct PbrLobeWeights {
+    float specular = 0;  ///< single-scattering GGX reflection (visible-normal sampled)
+    float cosine = 0;    ///< diffuse base and multiple-scattering lobe (cosine sampled)
+    float transmit = 0;  ///< rough refraction
+};
+
+PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo);
+
+/// f(wo, wi) |cos_i| and the density sample_pbr gives wi (either hemisphere).
+Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);
+
+/// Picks a lobe by u_lobe, a direction by u; s.wi is local.
+bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s);
+
+}  // namespace sahara

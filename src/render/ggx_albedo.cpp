@@ -1,0 +1,99 @@
+#include "render/ggx_albedo.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/ggx.h"
+
+namespace sahara {
+
+namespace {
+
+/// E and Es at one (mu, alpha) by stratified visible-normal sampling: each
+/// sample's weight f cos / pdf is G2 / G1(wo) times the Fresnel term.
+GgxAlbedo integrate_albedo(float mu, float alpha, int strata) {
+    mu = std::max(mu, 1e-4f);
+    const Vec3 wo(std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+    const double lo = ggx_lambda(wo, alpha);
+    double e = 0, es = 0;
+    for (int i = 0; i < strata; ++i)
+        for (int j = 0; j < strata; ++j) {
+            const Vec2 u{(float(i) + 0.5f) / float(strata), (float(j) + 0.5f) / float(strata)};
+            const Vec3 wm = sample_ggx_vndf(wo, alpha, u);
+            const Vec3 wi = wm * (2.0f * dot(wo, wm)) - wo;
+            if (wi.z <= 0) continue;
+            const double w = (1.0 + lo) / (1.0 + lo + double(ggx_lambda(wi, alpha)));
+            const double m = std::clamp(1.0 - double(dot(wo, wm)), 0.0, 1.0);
+            e += w;
+            es += w * (m * m) * (m * m) * m;
+        }
+    const double n = double(strata) * double(strata);
+    return {float(e / n), float(es / n)};
+}
+
+/// 2 * integral over [0, 1] of f(mu) mu dmu for f linear between equally spaced samples.
+double cosine_average(const std::vector<double>& f) {
+    const double h = 1.0 / double(f.size() - 1);
+    double sum = 0;
+    for (size_t k = 0; k + 1 < f.size(); ++k) {
+        const double a = double(k) * h, b = a + h;
+        const double slope = (f[k + 1] - f[k]) / h;
+        // integral of (f_k + slope (mu - a)) mu over [a, b]
+        sum += f[k] * (b * b - a * a) / 2 + slope * ((b * b * b - a * a * a) / 3 - a * (b * b - a * a) / 2);
+    }
+    return 2 * sum;
+}
+
+/// Linear interpolation position of x in [0, 1] over n equally spaced samples.
+void locate(float x, int n, int* i, float* t) {
+    const float f = std::clamp(x, 0.0f, 1.0f) * float(n - 1);
+    *i = std::min(int(f), n - 2);
+    *t = f - float(*i);
+}
+
+}  // namespace
+
+GgxAlbedoTable::GgxAlbedoTable(int strata) {
+    table_.resize(size_t(kRoughnessSteps) * kMuSteps);
+    avg_.resize(kRoughnessSteps);
+    for (int r = 0; r < kRoughnessSteps; ++r) {
+        const float alpha = pbr_alpha(float(r) / float(kRoughnessSteps - 1));
+        std::vector<double> e(kMuSteps), es(kMuSteps);
+        for (int m = 0; m < kMuSteps; ++m) {
+            const GgxAlbedo a = integrate_albedo(float(m) / float(kMuSteps - 1), alpha, strata);
+            table_[size_t(r) * kMuSteps + size_t(m)] = a;
+            e[size_t(m)] = a.e;
+            es[size_t(m)] = a.e_schlick;
+        }
+        avg_[size_t(r)] = {float(cosine_average(e)), float(cosine_average(es))};
+    }
+}
+
+const GgxAlbedoTable& GgxAlbedoTable::get() {
+    static const GgxAlbedoTable table(48);
+    return table;
+}
+
+GgxAlbedo GgxAlbedoTable::at(float mu, float roughness) const {
+    int i, j;
+    float t, s;
+    locate(roughness, kRoughnessSteps, &i, &t);
+    locate(mu, kMuSteps, &j, &s);
+    auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
+    auto lerp2 = [&](float GgxAlbedo::* f) {
+        const float row0 = (1 - s) * entry(i, j).*f + s * entry(i, j + 1).*f;
+        const float row1 = (1 - s) * entry(i + 1, j).*f + s * entry(i + 1, j + 1).*f;
+        return (1 - t) * row0 + t * row1;
+    };
+    return {lerp2(&GgxAlbedo::e), lerp2(&GgxAlbedo::e_schlick)};
+}
+
+GgxAlbedo GgxAlbedoTable::average(float roughness) const {
+    int i;
+    float t;
+    locate(roughness, kRoughnessSteps, &i, &t);
+    const GgxAlbedo a = avg_[size_t(i)], b = avg_[size_t(i) + 1];
+    return {(1 - t) * a.e + t * b.e, (1 - t) * a.e_schlick + t * b.e_schlick};
+}
+
+}  // namespace sahara

@@ -1,0 +1,49 @@
+#pragma once
+/// Directional albedo of the GGX reflection lobe, for the multiple-scattering
+/// energy compensation of Kulla and Conty ("Revisiting Physically Based
+/// Shading at Imageworks", SIGGRAPH 2017 course). Tabulated once per process
+/// by numerical integration (nothing copied), then looked up bilinearly.
+#include <vector>
+
+namespace sahara {
+
+/// GGX alpha never goes below this in the glTF material: alpha = roughness^2 = 0
+/// would be a delta lobe, and 1e-3 already reflects like a mirror.
+inline constexpr float kMinPbrAlpha = 1e-3f;
+
+/// The single-scattering GGX albedo, split so that Schlick's Fresnel
+/// F = F0 + (1 - F0) (1 - cos)^5 stays linear in F0:
+///   E(mu) F0 + Es(mu) (1 - F0)  with  E = albedo with F = 1,  Es = albedo with F = (1 - cos)^5.
+struct GgxAlbedo {
+    float e = 1, e_schlick = 0;
+};
+
+class GgxAlbedoTable {
+   public:
+    static constexpr int kMuSteps = 64, kRoughnessSteps = 32;
+
+    /// The process-wide table, built on first use (thread-safe).
+    static const GgxAlbedoTable& get();
+
+    /// Albedo for outgoing cosine mu in [0, 1] and perceptual roughness in [0, 1].
+    GgxAlbedo at(float mu, float roughness) const;
+    /// Cosine-weighted hemispherical averages 2 * integral of E(mu) mu dmu of the
+    /// same piecewise-linear functions at() interpolates, so the compensation
+    /// lobe built from them integrates exactly to what the table says is missing.
+    GgxAlbedo average(float roughness) const;
+
+    /// Built by numerical integration with `strata` x `strata` visible-normal samples per entry.
+    explicit GgxAlbedoTable(int strata);
+
+   private:
+    std::vector<GgxAlbedo> table_;  ///< kRoughnessSteps rows of kMuSteps
+    std::vector<GgxAlbedo> avg_;    ///< one per roughness row
+};
+
+/// The alpha the glTF material uses for a perceptual roughness.
+inline float pbr_alpha(float roughness) {
+    const float a = roughness * roughness;
+    return a < kMinPbrAlpha ? kMinPbrAlpha : a;
+}
+
+}  // namespace sahara
