@@ -27,6 +27,9 @@ struct ParseContext {
     uint32_t material(const JsonValue& where) const;
 };
 
+/// The keys of a `pbr` material (scene_parser_pbr.cpp), after "type".
+void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m);
+
 void parse_objects(ParseContext& ctx, const JsonValue& objects);
 void parse_lights(ParseContext& ctx, const JsonValue& lights);
 
