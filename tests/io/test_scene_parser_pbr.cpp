@@ -1,0 +1,101 @@
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "scene_parser_test_util.h"
+
+using namespace sahara;
+using namespace sahara::parser_test;
+
+namespace {
+
+/// The scene's material 1 after parsing `material` (JSON object text) as "m".
+MaterialDesc parse_one(const std::string& material, FakeLoaders* fake = nullptr) {
+    FakeLoaders own;
+    ScratchDir scratch;
+    const SceneDesc d = parse_scene_json(with_objects("[]", R"({"m": )" + material + "}"),
+                                         scratch.dir / "s.json", (fake ? fake : &own)->loaders());
+    REQUIRE(d.materials.size() == 2);
+    return d.materials[1];
+}
+
+}  // namespace
+
+TEST_CASE("scene parser: pbr defaults are glTF's") {
+    const MaterialDesc m = parse_one(R"({"type": "pbr"})");
+    CHECK(m.type == MaterialType::pbr);
+    CHECK(m.albedo.color == Rgb(1.0f));
+    CHECK(m.metallic == 1.0f);
+    CHECK(m.roughness == 1.0f);
+    CHECK(m.ior == 1.5f);
+    CHECK(m.transmission == 0.0f);
+    CHECK(m.double_sided);
+    CHECK(!m.thin_walled);
+    CHECK(m.alpha == 1.0f);
+    CHECK(!m.alpha_cutoff);
+    CHECK(m.radiance.color == Rgb(0.0f));
+}
+
+TEST_CASE("scene parser: every pbr key reaches MaterialDesc") {
+    FakeLoaders fake;
+    const MaterialDesc m = parse_one(R"({"type": "pbr",
+        "base_color": {"texture": "textures/wood.png", "factor": [0.5, 0.25, 1]},
+        "metallic": 0.25, "roughness": 0.75,
+        "metallic_roughness": {"texture": "textures/leaf.png"},
+        "normal_map": {"texture": "textures/leaf.png", "scale": 0.5},
+        "emission": [2, 3, 4], "emission_strength": 2,
+        "transmission": 0.5, "ior": 1.33, "thin_walled": true,
+        "alpha": 0.5, "alpha_mode": "mask", "alpha_cutoff": 0.25,
+        "double_sided": false})",
+                                     &fake);
+    CHECK(m.albedo.kind == ColorSource::Kind::texture);
+    CHECK(m.albedo.color == Rgb(0.5f, 0.25f, 1.0f));
+    CHECK(m.metallic == 0.25f);
+    CHECK(m.roughness == 0.75f);
+    CHECK(m.metallic_roughness_texture >= 0);
+    CHECK(m.normal_texture == m.metallic_roughness_texture);  // one linear image, loaded once
+    CHECK(m.normal_scale == 0.5f);
+    CHECK(m.radiance.color == Rgb(4.0f, 6.0f, 8.0f));
+    CHECK(m.transmission == 0.5f);
+    CHECK(m.ior == doctest::Approx(1.33f));
+    CHECK(m.thin_walled);
+    CHECK(m.alpha == 0.5f);
+    CHECK(m.alpha_cutoff == 0.25f);
+    CHECK(m.alpha_texture == m.albedo.texture);  // glTF: alpha from the base colour texture
+    CHECK(!m.double_sided);
+    // The colour texture is decoded as sRGB, the data maps are linear.
+    REQUIRE(fake.images.size() == 2);
+    CHECK(fake.images[0] == std::pair<std::string, bool>("wood.png", true));
+    CHECK(fake.images[1] == std::pair<std::string, bool>("leaf.png", false));
+}
+
+TEST_CASE("scene parser: pbr alpha modes") {
+    CHECK(parse_one(R"({"type": "pbr", "alpha": 0.3})").alpha == 1.0f);  // opaque ignores alpha
+    const MaterialDesc blend = parse_one(R"({"type": "pbr", "alpha": 0.3, "alpha_mode": "blend"})");
+    CHECK(blend.alpha == 0.3f);
+    CHECK(!blend.alpha_cutoff);
+    const MaterialDesc mask = parse_one(R"({"type": "pbr", "alpha": 0.3, "alpha_mode": "mask"})");
+    CHECK(mask.alpha_cutoff == 0.5f);
+    // A constant alpha above the cutoff cuts nothing: no filter needed.
+    CHECK(!parse_one(R"({"type": "pbr", "alpha_mode": "mask"})").alpha_cutoff);
+}
+
+TEST_CASE("scene parser: bad pbr keys are named with their path") {
+    const auto bad = [](const std::string& material) {
+        return error_of(with_objects("[]", R"({"m": )" + material + "}"));
+    };
+    check_contains(bad(R"({"type": "pbr", "metallic": 1.5})"), {"materials.m.metallic", "[0, 1]"});
+    check_contains(bad(R"({"type": "pbr", "roughness": -0.1})"), {"materials.m.roughness"});
+    check_contains(bad(R"({"type": "pbr", "ior": 0.5})"), {"materials.m.ior"});
+    check_contains(bad(R"({"type": "pbr", "base_color": [1, 2, 0]})"), {"materials.m.base_color"});
+    check_contains(bad(R"({"type": "pbr", "base_color": {"factor": [1, 1, 1]}})"), {"texture"});
+    check_contains(bad(R"({"type": "pbr", "base_color": {"texture": "nope.png"}})"), {"nope.png"});
+    check_contains(bad(R"({"type": "pbr", "normal_map": {"texture": "textures/leaf.png", "scal": 1}})"),
+                   {"scal"});
+    check_contains(bad(R"({"type": "pbr", "alpha_mode": "clip"})"), {"opaque", "mask", "blend"});
+    check_contains(bad(R"({"type": "pbr", "alpha_cutoff": 0.5})"), {"alpha_mode"});
+    check_contains(bad(R"({"type": "pbr", "double_sided": 1})"), {"materials.m.double_sided"});
+    check_contains(bad(R"({"type": "pbr", "albedo": [1, 1, 1]})"), {"albedo"});
+    check_contains(bad(R"({"type": "pbr", "emission": [-1, 0, 0]})"), {"materials.m.emission"});
+    check_contains(bad(R"({"type": "plastic"})"), {"pbr"});
+}
