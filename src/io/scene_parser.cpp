@@ -161,9 +161,9 @@ void parse_alpha(const JsonValue& v, ParseContext& ctx, MaterialDesc& m) {
 MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext& ctx) {
     MaterialDesc m;
     m.name = name;
-    m.type = MaterialType(
-        o.require("type", "\"lambertian\", \"metal\", \"dielectric\", \"emissive\" or \"pbr\"")
-            .one_of({"lambertian", "metal", "dielectric", "emissive", "pbr"}));
+    m.type =
+        MaterialType(o.require("type", "\"lambertian\", \"metal\", \"dielectric\", \"emissive\" or \"pbr\"")
+                         .one_of({"lambertian", "metal", "dielectric", "emissive", "pbr"}));
     switch (m.type) {
         case MaterialType::lambertian:
             if (auto v = o.get("albedo")) m.albedo = parse_color_source(*v, ctx);

@@ -25,7 +25,8 @@ ColorSource parse_pbr_color(const JsonValue& v, ParseContext& ctx, const NumberR
 
 /// {"texture": FILE} plus the extra numeric keys a map allows ("scale" for normal maps).
 int parse_data_texture(const JsonValue& v, ParseContext& ctx, const char* what, float* scale) {
-    if (!v.json().is_object()) v.fail_expected(std::string("{\"texture\": \"file\"") + (scale ? ", \"scale\": s}" : "}"));
+    if (!v.json().is_object())
+        v.fail_expected(std::string("{\"texture\": \"file\"") + (scale ? ", \"scale\": s}" : "}"));
     JsonObject o(v);
     const int tex = ctx.texture(o.require("texture", what), false);  // data, not colour: linear
     if (scale)
@@ -57,7 +58,8 @@ void parse_alpha_mode(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     if (cutoff && mode != mask) cutoff->fail("\"alpha_cutoff\" needs \"alpha_mode\": \"mask\"");
     if (mode == opaque) return;  // glTF OPAQUE: alpha is ignored
     if (alpha) parse_pbr_alpha(*alpha, ctx, m);
-    if (m.alpha_texture < 0 && m.albedo.kind == ColorSource::Kind::texture) m.alpha_texture = m.albedo.texture;
+    if (m.alpha_texture < 0 && m.albedo.kind == ColorSource::Kind::texture)
+        m.alpha_texture = m.albedo.texture;
     if (mode == mask) {
         m.alpha_cutoff = cutoff ? cutoff->number_f(NumberRange::closed(0, 1)) : 0.5f;
         // The filter only runs for cut-out materials: a constant alpha of 1 cuts nothing.
@@ -76,8 +78,8 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     if (auto v = o.get("metallic")) m.metallic = v->number_f(unit);
     if (auto v = o.get("roughness")) m.roughness = v->number_f(unit);
     if (auto v = o.get("metallic_roughness"))
-        m.metallic_roughness_texture =
-            parse_data_texture(*v, ctx, "the metallic-roughness image file (G roughness, B metallic)", nullptr);
+        m.metallic_roughness_texture = parse_data_texture(
+            *v, ctx, "the metallic-roughness image file (G roughness, B metallic)", nullptr);
     if (auto v = o.get("normal_map"))
         m.normal_texture = parse_data_texture(*v, ctx, "the tangent-space normal map file", &m.normal_scale);
     float strength = 1.0f;

@@ -1,8 +1,9 @@
 #pragma once
 /// Scattering at a surface point: Lambertian, metal (perfect mirror or GGX
-/// microfacet), dielectric (glass) and the glTF material (render/bsdf_pbr.h). A closed set dispatched by a switch.
-/// Conventions: wo and wi are unit world directions pointing away from the
-/// surface (wo towards the previous vertex); eval returns f * |cos(theta_i)|.
+/// microfacet), dielectric (glass) and the glTF material (render/bsdf_pbr.h).
+/// A closed set dispatched by a switch. Conventions: wo and wi are unit world
+/// directions pointing away from the surface (wo towards the previous vertex);
+/// eval returns f * |cos(theta_i)|.
 #include <vector>
 
 #include "math/sampling.h"
@@ -26,7 +27,7 @@ struct Bsdf {
     Frame frame{Vec3(0, 0, 1)};  ///< around the shading normal
     Vec3 ng;                     ///< geometric normal on the side of wo
     // pbr only (render/bsdf_pbr.h)
-    float roughness = 0;     ///< perceptual roughness, for the albedo tables
+    float roughness = 0;  ///< perceptual roughness, for the albedo tables
     float metallic = 0;
     float f0 = 0.04f;        ///< dielectric layer's reflectance at normal incidence
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing

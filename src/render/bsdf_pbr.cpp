@@ -114,15 +114,16 @@ Vec2 texcoord(const SurfaceInteraction& si, const std::vector<TextureDesc>& text
 /// increasing v, xy scaled by normal_scale). The map describes the front
 /// side; a back face sees the same bumps from behind, so the frame is built
 /// on the front side and the result turned around.
-Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
+                   const std::vector<TextureDesc>& textures) {
     if (length_squared(si.tangent) <= 0) return si.ns;
     const Vec3 n_front = si.front_face ? si.ns : -si.ns;
     const Vec3 t0 = si.tangent - n_front * dot(n_front, si.tangent);
     if (length_squared(t0) <= 1e-12f) return si.ns;
     const Vec3 t = normalize(t0);
     const Vec3 bt = cross(n_front, t) * si.tangent_sign;
-    const Rgb c = sample_texture_rgb(textures[size_t(m.normal_texture)],
-                                     texcoord(si, textures, m.normal_texture));
+    const Rgb c =
+        sample_texture_rgb(textures[size_t(m.normal_texture)], texcoord(si, textures, m.normal_texture));
     const float x = (2.0f * c.x - 1.0f) * m.normal_scale, y = (2.0f * c.y - 1.0f) * m.normal_scale;
     const float z = 2.0f * c.z - 1.0f;
     const Vec3 n = t * x + bt * y + n_front * z;
@@ -133,11 +134,13 @@ Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si, const st
 
 }  // namespace
 
-Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si,
+                   const std::vector<TextureDesc>& textures) {
     return eval_color(m.albedo, textures, si.p, texcoord(si, textures, m.albedo.texture)) * si.color;
 }
 
-Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures) {
+Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
+                 const std::vector<TextureDesc>& textures) {
     return eval_color(m.radiance, textures, si.p, texcoord(si, textures, m.radiance.texture));
 }
 
@@ -202,8 +205,8 @@ Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)
         f += t.spec_ms * ((1.0f - eo.e) * (1.0f - ei.e) / t.one_minus_e_avg * cos_pi);
-    const float diffuse_scale =
-        (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) / (1.0f - t.dielectric_avg);
+    const float diffuse_scale = (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) /
+                                (1.0f - t.dielectric_avg);
     f += t.diffuse * (diffuse_scale * cos_pi);
     *pdf = p.specular * ggx_reflection_pdf(wo, wi, b.alpha) + p.cosine * cos_pi;
     return f;

@@ -80,7 +80,7 @@ GgxAlbedo GgxAlbedoTable::at(float mu, float roughness) const {
     locate(roughness, kRoughnessSteps, &i, &t);
     locate(mu, kMuSteps, &j, &s);
     auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
-    auto lerp2 = [&](float GgxAlbedo::* f) {
+    auto lerp2 = [&](float GgxAlbedo::*f) {
         const float row0 = (1 - s) * entry(i, j).*f + s * entry(i, j + 1).*f;
         const float row1 = (1 - s) * entry(i + 1, j).*f + s * entry(i + 1, j + 1).*f;
         return (1 - t) * row0 + t * row1;

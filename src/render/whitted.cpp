@@ -58,7 +58,8 @@ Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const Material
                 float time, int depth, int max_depth, float weight) {
     const Bsdf b = make_bsdf(m, si, scene.textures);
     const Rgb diffuse = b.albedo * (1.0f - b.metallic);
-    Rgb radiance = diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
+    Rgb radiance =
+        diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
     const Rgb f = fresnel_schlick(b.albedo * b.metallic + Rgb(b.f0 * (1.0f - b.metallic)), dot(wo, si.ns));
     const Vec3 wr = reflect(wo, si.ns);
     if (dot(wr, si.ng) > 0)

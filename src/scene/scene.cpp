@@ -137,7 +137,9 @@ void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, Sur
 
 /// Whether a mesh uses a normal-mapped material (and so needs tangents).
 bool uses_normal_map(const SceneDesc& desc, const TriangleMesh& m) {
-    auto mapped = [&](uint32_t id) { return id < desc.materials.size() && desc.materials[id].normal_texture >= 0; };
+    auto mapped = [&](uint32_t id) {
+        return id < desc.materials.size() && desc.materials[id].normal_texture >= 0;
+    };
     if (m.material_ids.empty()) return mapped(m.material);
     return std::any_of(m.material_ids.begin(), m.material_ids.end(), mapped);
 }
@@ -174,7 +176,8 @@ void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
         total += n;
         if (any_uv1) append_attribute(soup.uvs1, desc.meshes[k].uvs1, n, total, Vec2{0, 0});
         if (any_colors) append_attribute(soup.colors, desc.meshes[k].colors, n, total, Rgb(1.0f));
-        if (any_tangents) append_attribute(soup.tangents, tangents[k], n, total, std::array<float, 4>{0, 0, 0, 1});
+        if (any_tangents)
+            append_attribute(soup.tangents, tangents[k], n, total, std::array<float, 4>{0, 0, 0, 1});
     }
 }
 

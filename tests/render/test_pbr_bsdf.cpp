@@ -164,7 +164,8 @@ TEST_CASE("pdfs integrate to one: visible normals exactly, pbr to its sampler's 
             for (int i = 0; i < 2 * kN; ++i)
                 for (int j = 0; j < kN; ++j) {
                     float p = 0;
-                    eval_pbr(b, wo, direction(-1.0f + (float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN), &p);
+                    eval_pbr(b, wo,
+                             direction(-1.0f + (float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN), &p);
                     integral += double(p);
                 }
             integral *= 4 * double(kPi) / (2.0 * kN * kN);
@@ -184,8 +185,8 @@ TEST_CASE("pdfs integrate to one: visible normals exactly, pbr to its sampler's 
 }
 
 TEST_CASE("pbr reflection is reciprocal: f(wo, wi) = f(wi, wo)") {
-    for (const MaterialDesc& m : {pbr(Rgb(0.9f, 0.4f, 0.1f), 0.0f, 0.35f), pbr(Rgb(0.9f, 0.4f, 0.1f), 1.0f, 0.6f),
-                                  pbr(Rgb(0.3f), 0.5f, 1.0f)}) {
+    for (const MaterialDesc& m : {pbr(Rgb(0.9f, 0.4f, 0.1f), 0.0f, 0.35f),
+                                  pbr(Rgb(0.9f, 0.4f, 0.1f), 1.0f, 0.6f), pbr(Rgb(0.3f), 0.5f, 1.0f)}) {
         const Bsdf b = bsdf_of(m);
         for (float c1 : {0.9f, 0.5f, 0.15f})
             for (float c2 : {0.8f, 0.3f}) {
@@ -207,7 +208,8 @@ TEST_CASE("GGX albedo table: white metal loses energy without compensation and E
     // The same table at a finer quadrature agrees: the integration has converged.
     const GgxAlbedoTable fine(64);
     for (float mu : {0.1f, 0.5f, 1.0f})
-        for (float r : {0.2f, 0.6f, 1.0f}) CHECK(fine.at(mu, r).e == doctest::Approx(t.at(mu, r).e).epsilon(2e-3));
+        for (float r : {0.2f, 0.6f, 1.0f})
+            CHECK(fine.at(mu, r).e == doctest::Approx(t.at(mu, r).e).epsilon(2e-3));
 }
 
 namespace {
@@ -249,7 +251,8 @@ TEST_CASE("furnace: grey dielectric pbr reflects its base plus the specular laye
         CHECK(predicted > 0.5f);
         CHECK(predicted < 0.53f);
         const Scene scene = pbr_sphere_in_furnace(pbr(Rgb(0.5f), 0.0f, roughness));
-        const Stat s = radiance_stats(scene, Ray{{0, -5, 0}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, scaled(4000), 16);
+        const Stat s =
+            radiance_stats(scene, Ray{{0, -5, 0}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, scaled(4000), 16);
         INFO("roughness " << roughness << " predicted " << predicted << " mean " << s.mean.x);
         CHECK(within(s, Rgb(predicted), 4, 0.003f));
     }

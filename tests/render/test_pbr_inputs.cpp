@@ -83,7 +83,8 @@ TEST_CASE("pbr inputs: vertex colours multiply the base colour") {
 }
 
 TEST_CASE("pbr inputs: metallic-roughness texture scales by G and B, each texture reads its UV set") {
-    std::vector<TextureDesc> textures = {strip({Rgb(0, 0.5f, 0.25f)}), strip({Rgb(1, 0, 0), Rgb(0, 1, 0)}, 1)};
+    std::vector<TextureDesc> textures = {strip({Rgb(0, 0.5f, 0.25f)}),
+                                         strip({Rgb(1, 0, 0), Rgb(0, 1, 0)}, 1)};
     MaterialDesc m = white_pbr();
     m.metallic = 0.8f;
     m.roughness = 0.6f;
@@ -181,7 +182,8 @@ TEST_CASE("pbr inputs: emission adds to what the surface reflects") {
         d.materials.push_back(m);
         d.spheres.push_back({{0, 0, 0}, 1.0f, 1, {0, 0, 0}});
         const Scene scene = build_scene(d);
-        const Stat s = radiance_stats(scene, Ray{{0, -5, 0}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, scaled(2000), 8);
+        const Stat s =
+            radiance_stats(scene, Ray{{0, -5, 0}, {0, 1, 0}, 0.0f, kInfinity, 0.0f}, scaled(2000), 8);
         // White, non-metal: it reflects all of a uniform sky (furnace), plus its glow.
         CHECK(within(s, m.radiance.color + Rgb(sky), 4, 0.01f));
     }
