@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "accel/bvh_wide.h"
+#include "accel/simd_path.h"
 #include "app/cmd_version.h"
 #include "io/image_codec.h"
 
