@@ -40,6 +40,11 @@ enum class LeafResult : uint8_t {
 /// stack entry that would be visited next (next_count 0: none, or an inner node);
 /// when it tests that leaf in the same step it sets `paired`, and the entry is
 /// dropped from the stack.
+///
+/// One long function on purpose (about 260 lines, against the 60 of the rest): the
+/// node step, the child ordering and the leaf calls must sit in one inlined body
+/// with no call in the inner loop (above); split into helpers that GCC does not
+/// inline, the loop would spill the ray constants on every node.
 template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false, int N,
           class Counters, class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
