@@ -140,7 +140,7 @@ __attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(con
 /// not be adjacent: a leaf's two blocks, or two one-block leaves): bit l of the
 /// result (and of `exact_zero`) is lane l & 3 of b0 for l < 4, of b1 otherwise;
 /// t/u/v_out hold 8 lanes. Not always_inline, like WideRay<8, true>::test
-/// (bvh_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
+/// (traverse_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
 __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
     const TriangleRay& tr, const TriangleBlock4* b0, const TriangleBlock4* b1, float tmin, float tmax,
     float t_out[8], float u_out[8], float v_out[8], int& exact_zero) {

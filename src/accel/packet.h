@@ -11,7 +11,7 @@
 /// same distance wins may differ (traversal order differs).
 ///
 /// The instruction set is the single-ray traversal's, active_simd_path()
-/// (accel/bvh_wide.h): AVX-512 (one 16-lane register), AVX2 (the single-ray
+/// (accel/simd_path.h): AVX-512 (one 16-lane register), AVX2 (the single-ray
 /// box and leaf tests per ray, packet_wide8.cpp) or SSE2 (four 4-lane quarters).
 #include <cstdint>
 

@@ -87,6 +87,21 @@ struct BvhArgs {
     bool help = false;
 };
 
+/// Statistics of the wide tree, with the figures Embree's verbose build report
+/// gives for its own tree.
+nlohmann::ordered_json wide_tree_json(const Accelerator& accel) {
+    const uint32_t block = 4;
+    const WideBvhStats w = compute_wide_bvh_stats(accel.bvh8(), block);
+    return {
+        {"nodes", w.nodes},
+        {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
+        {"leaves", w.leaves},
+        {"leaf_block_size", block},
+        {"leaf_block_fill", w.leaf_blocks ? double(w.leaf_primitives) / double(w.leaf_blocks * block) : 0.0},
+        {"sah_nodes", w.sah_nodes},
+        {"sah_leaves", w.sah_leaves}};
+}
+
 nlohmann::ordered_json bvh_report(const BvhArgs& args) {
     const std::string& file = args.file;
     const std::optional<BvhBuilder> chosen = args.builder;
@@ -134,19 +149,7 @@ nlohmann::ordered_json bvh_report(const BvhArgs& args) {
         {"bytes", accel.bytes()},
         {"tree_bytes", s.bytes},
         {"bytes_per_primitive", prims ? double(accel.bytes()) / double(prims) : 0.0}};
-    if (layout != BvhLayout::pairs) {
-        // Embree's verbose build report gives the same figures for its own tree.
-        const uint32_t block = 4;
-        const WideBvhStats w = compute_wide_bvh_stats(accel.bvh8(), block);
-        j["wide"] = {{"nodes", w.nodes},
-                     {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
-                     {"leaves", w.leaves},
-                     {"leaf_block_size", block},
-                     {"leaf_block_fill",
-                      w.leaf_blocks ? double(w.leaf_primitives) / double(w.leaf_blocks * block) : 0.0},
-                     {"sah_nodes", w.sah_nodes},
-                     {"sah_leaves", w.sah_leaves}};
-    }
+    if (layout != BvhLayout::pairs) j["wide"] = wide_tree_json(accel);
     j["rays"]["primary"] = work_json(count_work(accel, rays.primary), rays.primary.size());
     j["rays"]["diffuse"] = work_json(count_work(accel, rays.diffuse), rays.diffuse.size());
     j["rays"]["shadow"] = work_json(count_work(accel, rays.shadow, true), rays.shadow.size());

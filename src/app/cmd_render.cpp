@@ -196,8 +196,10 @@ void print_stats(const RenderJob& job, const RenderResult& r) {
 
 /// The bvh-cost inspection image: one primary ray per pixel, no sampling.
 int write_bvh_cost(const RenderArgs& a, const Scene& scene) {
-    const BvhCostImage img = render_bvh_cost(scene, scene.render.width, scene.render.height,
-                                             a.threads > 0 ? a.threads : omp_get_max_threads());
+    BvhCostImage img = render_bvh_cost(scene, scene.render.width, scene.render.height,
+                                       a.threads > 0 ? a.threads : omp_get_max_threads());
+    if (const std::string warning = draw_bvh_cost_legend(img, a.output); !warning.empty())
+        log_warning(a.output + ": " + warning);
     write_image(a.output, img.width, img.height, img.rgb,
                 {{"integrator", "bvh-cost"}, {"version", SAHARA_VERSION}});
     if (!a.quiet)
@@ -207,17 +209,40 @@ int write_bvh_cost(const RenderArgs& a, const Scene& scene) {
     return 0;
 }
 
+/// The --reference image as RGB floats (empty without one); its size must be the film's.
+std::vector<float> read_reference(const RenderArgs& a, const Film& film) {
+    std::vector<float> reference;
+    if (!a.reference) return reference;
+    const auto img = read_image(*a.reference, false);
+    if (img->width != film.width() || img->height != film.height())
+        throw input_error(*a.reference, "", "reference size differs from the render");
+    for (size_t i = 0; i < img->rgba.size(); i += 4)
+        reference.insert(reference.end(), &img->rgba[i], &img->rgba[i + 3]);
+    return reference;
+}
+
+/// The lines after a render: the summary `line`, the automatic exposure, the
+/// clipped pixels and, for an unfinished render, how to resume it.
+void print_job_summary(const RenderJob& job, const std::string& line, std::optional<float> exposure,
+                       size_t clipped, bool unfinished) {
+    const fs::path out(job.args.output);
+    std::fprintf(stderr, "%s\n", line.c_str());
+    if (exposure)
+        std::fprintf(stderr, "sahara: automatic exposure %+.2f stops (set one with --exposure)\n",
+                     double(*exposure));
+    if (clipped > 0)
+        std::fprintf(stderr, "sahara: %zu pixels (%.2f%%) clipped by the '%s' tone curve\n", clipped,
+                     100.0 * double(clipped) / (double(job.film.width()) * double(job.film.height())),
+                     std::string(tonemap_name(job.scene.render.tonemap)).c_str());
+    if (unfinished)
+        std::fprintf(stderr, "sahara: resume with --resume %s\n",
+                     (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());
+}
+
 /// Renders, writes the output (and the resumable partial file if needed), reports.
 int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     const RenderArgs& a = job.args;
-    std::vector<float> reference;
-    if (a.reference) {
-        const auto img = read_image(*a.reference, false);
-        if (img->width != job.film.width() || img->height != job.film.height())
-            throw input_error(*a.reference, "", "reference size differs from the render");
-        for (size_t i = 0; i < img->rgba.size(); i += 4)
-            reference.insert(reference.end(), &img->rgba[i], &img->rgba[i + 3]);
-    }
+    const std::vector<float> reference = read_reference(a, job.film);
     if (a.preview)
         job.preview = Preview::open(job.film.width(), job.film.height(), job.scene.render.exposure,
                                     job.scene.render.tonemap);
@@ -257,19 +282,7 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
         job.preview->show_final(job.film, line.substr(8));
         if (a.preview_dump) job.preview->dump(*a.preview_dump);
     }
-    if (!a.quiet) {
-        std::fprintf(stderr, "%s\n", line.c_str());
-        if (exposure)
-            std::fprintf(stderr, "sahara: automatic exposure %+.2f stops (set one with --exposure)\n",
-                         double(*exposure));
-        if (clipped > 0)
-            std::fprintf(stderr, "sahara: %zu pixels (%.2f%%) clipped by the '%s' tone curve\n", clipped,
-                         100.0 * double(clipped) / (double(job.film.width()) * double(job.film.height())),
-                         std::string(tonemap_name(job.scene.render.tonemap)).c_str());
-        if (unfinished)
-            std::fprintf(stderr, "sahara: resume with --resume %s\n",
-                         (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());
-    }
+    if (!a.quiet) print_job_summary(job, line, exposure, clipped, unfinished);
     if (result.nonfinite > 0)
         log_warning(std::to_string(result.nonfinite) + " non-finite samples were discarded");
     if (a.stats) print_stats(job, result);

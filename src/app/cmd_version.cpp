@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "accel/bvh_wide.h"
+#include "accel/simd_path.h"
 #include "io/image_codec.h"
 
 #if SAHARA_HAVE_EMBREE

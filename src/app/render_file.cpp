@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "io/plot.h"
 #include "math/rng.h"
 #include "render/tonemap.h"
 
@@ -171,6 +172,22 @@ double resume_film(const std::filesystem::path& file, const Scene& scene, Film& 
     if (const std::string* nf = find_key(meta, "nonfinite_samples")) film.add_nonfinite(std::stoull(*nf));
     const std::string* secs = find_key(meta, "render_seconds");
     return secs ? std::atof(secs->c_str()) : 0.0;
+}
+
+std::string draw_bvh_cost_legend(BvhCostImage& image, const std::filesystem::path& file) {
+    std::vector<PlotText> texts;
+    for (const LegendLabel& label : image.labels) {
+        PlotText t;
+        t.role = "legend";
+        t.text = label.text;
+        t.at = {double(label.x), double(label.y)};
+        t.size = label.size;
+        t.color = {0, 0, 0};
+        t.anchor = label.right_aligned ? TextAnchor::end : TextAnchor::start;
+        t.baseline = TextBaseline::hanging;
+        texts.push_back(t);
+    }
+    return draw_texts(image.width, image.height, image.rgb, texts, file.string());
 }
 
 }  // namespace sahara

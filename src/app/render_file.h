@@ -8,6 +8,7 @@
 #include <string>
 
 #include "io/image_io.h"
+#include "render/bvh_cost.h"
 #include "render/film.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -26,6 +27,12 @@ ImageMetadata render_metadata(const Scene& scene, const Film& film, const Render
 /// (temporary + rename). Returns how many pixels the tone curve clipped.
 size_t write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
                     const ImageMetadata& metadata, std::optional<float> exposure = std::nullopt);
+
+/// Draws the legend labels of a bvh-cost image into its pixels with a TrueType
+/// font (through the image codec; render draws no text). Returns a warning
+/// (empty: none), e.g. that no font was found and the legend has no text.
+/// Throws InputError naming `file` if the codec cannot be loaded.
+std::string draw_bvh_cost_legend(BvhCostImage& image, const std::filesystem::path& file);
 
 /// Loads the state of a sahara EXR into `film` after checking that it was
 /// rendered with the same scene and settings. Returns the render seconds the

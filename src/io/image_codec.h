@@ -15,6 +15,7 @@
 namespace sahara {
 
 struct PlotDrawing;  // io/plot.h
+struct PlotText;     // io/plot.h
 
 /// Decoded pixels: `channels` floats per pixel, row 0 at the top.
 struct DecodedPixels {
@@ -57,9 +58,14 @@ struct ImageCodecApi {
     /// Draws a laid-out plot into a PNG (lines, boxes, TrueType text). Without
     /// a usable font the PNG is written without text and `warning` says why.
     std::string (*draw_plot)(const std::string& file, const PlotDrawing& drawing, std::string& warning);
+    /// Draws horizontal `texts` (no superscripts) over width x height linear RGB
+    /// floats, at their own size, with the first usable of `fonts`. Without one
+    /// the pixels stay as they are and `warning` says why.
+    std::string (*draw_texts)(int width, int height, float* rgb, const std::vector<PlotText>& texts,
+                              const std::vector<std::string>& fonts, std::string& warning);
 };
 
-inline constexpr int kImageCodecVersion = 2;
+inline constexpr int kImageCodecVersion = 3;
 /// The plugin's one exported symbol: `extern "C" const ImageCodecApi* sahara_image_codec_api()`.
 inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
 /// The plugin's file name. It is looked for relative to the executable, never at

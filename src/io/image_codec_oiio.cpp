@@ -252,6 +252,14 @@ bool draw_text_with_superscript(OIIO::ImageBuf& canvas, const PlotText& t, const
                             t.superscript, sup_size, font, rgb(t.color));
 }
 
+/// Why texts are missing when no font of `fonts` was found; `what` names the image.
+std::string no_font_warning(const std::vector<std::string>& fonts, const std::string& what) {
+    std::string tried;
+    for (const std::string& f : fonts) tried += (tried.empty() ? "" : ", ") + f;
+    return "no TrueType font found (tried " + tried +
+           "; Debian: apt-get install fonts-dejavu-core): " + what + " has no text";
+}
+
 bool draw_text(OIIO::ImageBuf& canvas, const PlotText& t, const std::string& font, PlotColor background) {
     if (t.vertical) return draw_vertical_text(canvas, t, font, background);
     if (!t.superscript.empty()) return draw_text_with_superscript(canvas, t, font);
@@ -265,11 +273,7 @@ std::string draw_plot(const std::string& file, const PlotDrawing& d, std::string
         OIIO::ImageSpec(d.width * kSupersample, d.height * kSupersample, 3, OIIO::TypeDesc::FLOAT));
     IBA::fill(canvas, rgb(d.background));
     const std::string font = usable_font(d.fonts);
-    std::string tried;
-    for (const std::string& f : d.fonts) tried += (tried.empty() ? "" : ", ") + f;
-    if (font.empty())
-        warning = "no TrueType font found (tried " + tried +
-                  "; Debian: apt-get install fonts-dejavu-core): the PNG plot has no text";
+    if (font.empty()) warning = no_font_warning(d.fonts, "the PNG plot");
     bool text_failed = false;
     for (const PlotItem& item : d.items) {
         if (const auto* path = std::get_if<PlotPath>(&item))
@@ -288,8 +292,28 @@ std::string draw_plot(const std::string& file, const PlotDrawing& d, std::string
     return std::string("cannot draw the plot: ") + e.what();
 }
 
-constexpr ImageCodecApi kApi{kImageCodecVersion, decode,   encode, read_attributes,
-                             read_u32_channels,  draw_plot};
+std::string draw_texts(int width, int height, float* pixels, const std::vector<PlotText>& texts,
+                       const std::vector<std::string>& fonts, std::string& warning) try {
+    if (width <= 0 || height <= 0) return "image size out of range";
+    const std::string font = usable_font(fonts);
+    if (font.empty()) {
+        warning = no_font_warning(fonts, "the image");
+        return "";
+    }
+    // Drawn straight into the caller's pixels: the buffer is wrapped, not copied.
+    OIIO::ImageBuf canvas(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT), pixels);
+    for (const PlotText& t : texts)
+        if (!IBA::render_text(canvas, int(std::lround(t.at.x)), int(std::lround(t.at.y)), t.text,
+                              int(std::lround(t.size)), font, rgb(t.color), align_x(t.anchor),
+                              align_y(t.baseline)))
+            warning = "some texts could not be drawn with the font " + font;
+    return "";
+} catch (const std::exception& e) {
+    return std::string("cannot draw text: ") + e.what();
+}
+
+constexpr ImageCodecApi kApi{kImageCodecVersion, decode,    encode,    read_attributes,
+                             read_u32_channels,  draw_plot, draw_texts};
 
 }  // namespace
 }  // namespace sahara

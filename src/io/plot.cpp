@@ -180,13 +180,17 @@ void add_legend(PlotDrawing& d, const LogLogPlot& plot, const Frame& f) {
 
 }  // namespace
 
+std::vector<std::string> text_fonts() {
+    // DejaVu Sans is Debian's default sans face (fonts-dejavu-core); the others
+    // are common substitutes on other systems.
+    return {"DejaVuSans", "LiberationSans-Regular", "FreeSans", "Arial"};
+}
+
 PlotDrawing layout_loglog_plot(const LogLogPlot& plot, int width, int height) {
     PlotDrawing d;
     d.width = width;
     d.height = height;
-    // DejaVu Sans is Debian's default sans face (fonts-dejavu-core); the others
-    // are common substitutes on other systems.
-    d.fonts = {"DejaVuSans", "LiberationSans-Regular", "FreeSans", "Arial"};
+    d.fonts = text_fonts();
     d.font_family = "'DejaVu Sans', Verdana, 'Liberation Sans', Arial, sans-serif";
     Frame f{90, 50, double(width) - 30, double(height) - 70, 0, 1, 0, 1};
     decade_range(plot, false, f.x_lo, f.x_hi);
@@ -328,6 +332,18 @@ std::string write_plot_png(const std::string& file, const PlotDrawing& drawing) 
     const ImageCodecApi& codec = image_codec(file);
     std::string warning;
     write_via_temporary(file, [&](const std::string& tmp) { return codec.draw_plot(tmp, drawing, warning); });
+    return warning;
+}
+
+std::string draw_texts(int width, int height, std::vector<float>& rgb, const std::vector<PlotText>& texts,
+                       const std::string& file_for_errors) {
+    if (rgb.size() != size_t(width) * size_t(height) * 3)
+        throw input_error(file_for_errors, "", "the pixels do not match the image size");
+    const ImageCodecApi& codec = image_codec(file_for_errors);
+    std::string warning;
+    if (const std::string why = codec.draw_texts(width, height, rgb.data(), texts, text_fonts(), warning);
+        !why.empty())
+        throw input_error(file_for_errors, "", why);
     return warning;
 }
 

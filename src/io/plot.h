@@ -100,6 +100,17 @@ void write_plot_svg(const std::string& file, const PlotDrawing& drawing);
 /// none), e.g. that no font was found and the PNG has no text. Throws InputError.
 std::string write_plot_png(const std::string& file, const PlotDrawing& drawing);
 
+/// TrueType fonts for texts in images, by name or path, the first one found is used.
+std::vector<std::string> text_fonts();
+
+/// Draws horizontal `texts` (no superscripts) over width x height linear RGB
+/// pixels (row 0 at the top) through the image codec, at their own size.
+/// Returns a warning (empty: none), e.g. that no font was found and the pixels
+/// are unchanged. Throws InputError naming `file_for_errors` if the codec
+/// cannot be loaded or the text cannot be drawn.
+std::string draw_texts(int width, int height, std::vector<float>& rgb, const std::vector<PlotText>& texts,
+                       const std::string& file_for_errors);
+
 /// A tick label: `text`, then `superscript` as an exponent ("10" "-5": 10^-5).
 struct TickLabel {
     std::string text, superscript;

@@ -4,9 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "scene/accelerator.h"
 #include "render/camera.h"
-#include "render/raster.h"
 
 namespace sahara {
 
@@ -14,6 +12,8 @@ namespace {
 
 /// Height of the legend strip in pixels (bar + labels).
 constexpr int kLegendHeight = 44;
+/// Font size of the legend's labels in pixels (they sit under the bar).
+constexpr int kLabelSize = 14;
 
 }  // namespace
 
@@ -30,15 +30,7 @@ Rgb heat_color(float t) {
     return lerp(x - float(i), stops[i], stops[i + 1]);
 }
 
-double bvh_ray_cost(const Scene& scene, const Ray& ray) {
-    const Accelerator* accel = scene.accelerator();
-    if (!accel) return 0;
-    TraversalCounters c;
-    Ray r = ray;
-    Hit hit;
-    accel->intersect_counted(r, hit, c);
-    return double(c.nodes_visited + c.prims_tested);
-}
+double bvh_ray_cost(const Scene& scene, const Ray& ray) { return double(scene.traversal_steps(ray)); }
 
 BvhCostImage render_bvh_cost(const Scene& scene, int width, int height, int threads) {
     const Camera camera(scene.camera, width, height);
@@ -58,21 +50,27 @@ BvhCostImage render_bvh_cost(const Scene& scene, int width, int height, int thre
     out.mean_cost = cost.empty() ? 0 : sum / double(cost.size());
     const double scale = out.max_cost > 0 ? 1.0 / out.max_cost : 0.0;
 
-    Raster r(width, height + kLegendHeight, Rgb(1.0f));
+    out.rgb.assign(size_t(width) * size_t(height + kLegendHeight) * 3, 1.0f);  // white
+    auto set = [&](int x, int y, Rgb c) {
+        float* p = &out.rgb[(size_t(y) * size_t(width) + size_t(x)) * 3];
+        p[0] = c.x, p[1] = c.y, p[2] = c.z;
+    };
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            r.set(x, y, heat_color(float(cost[size_t(y) * size_t(width) + size_t(x)] * scale)));
+            set(x, y, heat_color(float(cost[size_t(y) * size_t(width) + size_t(x)] * scale)));
     // Legend: the colour bar from 0 to the maximum cost, with its end values.
     const int bar_x0 = 8, bar_x1 = std::max(bar_x0 + 1, width - 8), bar_y0 = height + 6, bar_y1 = height + 20;
-    for (int x = bar_x0; x < bar_x1; ++x)
-        r.fill_rect(x, bar_y0, x + 1, bar_y1, heat_color(float(x - bar_x0) / float(bar_x1 - bar_x0 - 1)));
-    const Rgb ink(0.0f);
-    r.text(bar_x0, bar_y1 + 4, "0", ink, 2);
-    const std::string max_label = std::to_string(int(std::lround(out.max_cost))) + " NODES+PRIMS";
-    r.text(std::max(bar_x0, bar_x1 - text_width(max_label, 2)), bar_y1 + 4, max_label, ink, 2);
+    // Columns bar_x0..bar_x1 and rows bar_y0..bar_y1, both ends included; the
+    // last column repeats the colour of the one before it.
+    for (int x = bar_x0; x <= std::min(bar_x1, width - 1); ++x) {
+        const Rgb c = heat_color(float(std::min(x, bar_x1 - 1) - bar_x0) / float(bar_x1 - bar_x0 - 1));
+        for (int y = bar_y0; y <= bar_y1; ++y) set(x, y, c);
+    }
+    out.labels.push_back({"0", bar_x0, bar_y1 + 4, kLabelSize, false});
+    out.labels.push_back(
+        {std::to_string(std::lround(out.max_cost)) + " nodes+prims", bar_x1, bar_y1 + 4, kLabelSize, true});
     out.width = width;
     out.height = height + kLegendHeight;
-    out.rgb = std::move(r.rgb);
     return out;
 }
 

@@ -1,6 +1,5 @@
 #include "render/features.h"
 
-#include "scene/accelerator.h"
 #include "render/integrator.h"
 
 namespace sahara {
@@ -41,8 +40,8 @@ std::string describe_features(const Scene& scene) {
     if (f.has_metal) s += f.has_rough_metal ? ", metal (GGX)" : ", metal (mirror)";
     if (f.has_dielectric) s += ", dielectric";
     if (f.has_textures) s += "; textures";
-    if (const Accelerator* a = scene.accelerator(); a && a->has_cutouts())
-        s += "; cut-outs (" + std::to_string(a->alpha_filter().size()) + " alpha-tested triangles)";
+    if (const size_t cutouts = scene.cutout_triangle_count())
+        s += "; cut-outs (" + std::to_string(cutouts) + " alpha-tested triangles)";
     if (f.has_motion) s += "; motion blur";
     if (f.has_lens) s += "; depth of field";
     return s;

@@ -14,7 +14,7 @@
 
 #include "scene/alpha_filter.h"
 #include "accel/bvh.h"
-#include "accel/bvh_wide.h"
+#include "accel/traverse_wide.h"
 #include "accel/bvh4_leaf.h"
 #include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"

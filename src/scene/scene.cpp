@@ -8,6 +8,7 @@
 #include "scene/accelerator.h"
 #include "scene/tangents.h"
 #include "accel/packet.h"
+#include "accel/simd_path.h"
 #include "base/counters.h"
 
 namespace sahara {
@@ -82,6 +83,26 @@ bool Scene::occluded(const Ray& ray) const {
     Ray r = ray;
     Hit h;
     return intersect_planes(planes, r, h);
+}
+
+uint64_t Scene::traversal_steps(const Ray& ray) const {
+    if (!accel_) return 0;
+    TraversalCounters counters;
+    Ray r = ray;
+    Hit hit;
+    accel_->intersect_counted(r, hit, counters);
+    return counters.nodes_visited + counters.prims_tested;
+}
+
+bool Scene::packets_pay_off() const {
+    if (!packets_enabled() || !accel_ || !layout_has_blocks(accel_->layout()) || !accel_->uses_tree() ||
+        accel_->has_cutouts())
+        return false;
+    return active_simd_path() != SimdPath::sse2;
+}
+
+size_t Scene::cutout_triangle_count() const {
+    return accel_ && accel_->has_cutouts() ? accel_->alpha_filter().size() : 0;
 }
 
 }  // namespace sahara

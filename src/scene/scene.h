@@ -97,6 +97,21 @@ class Scene {
     /// Shading data for an accepted hit.
     SurfaceInteraction interact(const Ray& ray, const Hit& hit) const;
 
+    // What render asks about the acceleration structure, so that it never sees
+    // the Accelerator itself (tests/test_layers.cpp keeps it that way).
+    /// The work of intersect() on a copy of `ray`, as BVH nodes visited plus
+    /// primitives tested (planes, tested beside the tree, do not count); 0
+    /// before build_accelerator(). For the bvh-cost image.
+    uint64_t traversal_steps(const Ray& ray) const;
+    /// Whether intersect_packet() traces camera rays faster than single rays
+    /// here: packets are enabled (accel/packet.h), the tree has the block
+    /// layout (wide8) without cut-outs, and the instruction set is AVX2 or
+    /// AVX-512 (the SSE2 packet kernel is slower than single rays).
+    bool packets_pay_off() const;
+    /// Triangles whose hits pass the alpha test (cut-outs); 0 when traversal
+    /// runs without it.
+    size_t cutout_triangle_count() const;
+
     /// Bounds of all bounded primitives (planes excluded).
     Bounds3 bounds() const { return bounds_; }
     size_t primitive_count() const;

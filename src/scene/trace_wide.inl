@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "scene/accelerator.h"
-#include "accel/bvh_wide.h"
+#include "accel/traverse_wide.h"
 #include "scene/leaf_blocks.inl"
 
 namespace sahara {

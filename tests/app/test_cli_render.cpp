@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "app/cmd_info.h"
+#include "cli_test_util.h"
 #include "scene/accelerator.h"
 #include "app/render_args.h"
 #include "geometry/sphere.h"
@@ -27,47 +28,9 @@ extern char** environ;
 
 using namespace sahara;
 namespace fs = std::filesystem;
+using namespace sahara::test;
 
 namespace {
-
-/// A fresh directory per test, removed afterwards.
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("sahara_cli_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
-
-struct RunResult {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Runs `sahara ARGS` through the shell, capturing stdout and stderr.
-RunResult run_sahara(const std::string& args, const TempDir& dir) {
-    const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = std::string(SAHARA_EXE) + " " + args + " >" + out + " 2>" + err;
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
 
 /// Starts `sahara args...` without a shell; returns its pid.
 pid_t spawn_sahara(const std::vector<std::string>& args, const std::string& err_file) {
@@ -124,7 +87,7 @@ const std::string kSmall = " --width 24 --height 16 ";
 
 TEST_CASE("cli: --help and --version") {
     TempDir dir("help");
-    RunResult r = run_sahara("render --help", dir);
+    CliRun r = run_sahara("render --help", dir);
     CHECK(r.code == 0);
     CHECK(r.out.find("usage: sahara render") != std::string::npos);
     CHECK(r.out.find("--resume") != std::string::npos);
@@ -135,7 +98,7 @@ TEST_CASE("cli: --help and --version") {
 
 TEST_CASE("cli: a bad flag exits 2 with a pointer to the usage") {
     TempDir dir("badflag");
-    RunResult r = run_sahara("render --no-such-flag", dir);
+    CliRun r = run_sahara("render --no-such-flag", dir);
     CHECK(r.code == 2);
     CHECK(r.err.find("unknown option '--no-such-flag'") != std::string::npos);
     CHECK(r.err.find("(see 'sahara render --help')") != std::string::npos);
@@ -147,7 +110,7 @@ TEST_CASE("cli: a bad flag exits 2 with a pointer to the usage") {
 TEST_CASE("cli: a missing output directory exits 2 and writes nothing") {
     TempDir dir("nodir");
     const std::string out = dir / "missing/sub/out.png";
-    const RunResult r = run_sahara("render" + kSmall + "--spp 1 -o " + out, dir);
+    const CliRun r = run_sahara("render" + kSmall + "--spp 1 -o " + out, dir);
     CHECK(r.code == 2);
     CHECK(r.err.find("does not exist") != std::string::npos);
     CHECK_FALSE(fs::exists(out));
@@ -156,7 +119,7 @@ TEST_CASE("cli: a missing output directory exits 2 and writes nothing") {
 TEST_CASE("cli: OpenImageIO is loaded only by commands that read or write an image") {
     // The glibc loader lists every library it opens under LD_DEBUG=files.
     TempDir dir("codec");
-    RunResult r = run_sahara("info", dir);  // the default scene has no image textures
+    CliRun r = run_sahara("info", dir);  // the default scene has no image textures
     CHECK(r.code == 0);
     r = run_sahara("--version", dir);
     CHECK(r.code == 0);
@@ -169,7 +132,7 @@ TEST_CASE("cli: OpenImageIO is loaded only by commands that read or write an ima
         CHECK(std::system(cmd.c_str()) == 0);
         std::string all;
         for (const auto& e : fs::directory_iterator(dir.path))
-            if (e.path().filename().string().rfind("ld.txt", 0) == 0) all += slurp(e.path());
+            if (e.path().filename().string().rfind("ld.txt", 0) == 0) all += read_text(e.path());
         CHECK_FALSE(all.empty());
         return all.find("libOpenImageIO") != std::string::npos;
     };
@@ -187,7 +150,7 @@ TEST_CASE("cli: a missing image codec exits 2 before rendering and writes nothin
     const int status = std::system(cmd.c_str());
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 2);
-    const std::string err = slurp(dir / "err.txt");
+    const std::string err = read_text(dir / "err.txt");
     CHECK(err.find(out + ": the image codec plugin is missing") != std::string::npos);
     CHECK(err.find("no-such-codec.so") != std::string::npos);
     CHECK_FALSE(fs::exists(out));
@@ -223,7 +186,7 @@ TEST_CASE("cli: metadata is readable back from PNG and EXR") {
 TEST_CASE("cli: 32 spp then --resume to 64 spp equals 64 spp in one run, bit for bit") {
     TempDir dir("resume");
     REQUIRE(run_sahara("render" + kSmall + "--spp 32 -o " + (dir / "half.exr"), dir).code == 0);
-    const RunResult r = run_sahara(
+    const CliRun r = run_sahara(
         "render" + kSmall + "--spp 64 --resume " + (dir / "half.exr") + " -o " + (dir / "resumed.exr"), dir);
     REQUIRE(r.code == 0);
     REQUIRE(run_sahara("render" + kSmall + "--spp 64 -o " + (dir / "full.exr"), dir).code == 0);
@@ -235,7 +198,7 @@ TEST_CASE("cli: 32 spp then --resume to 64 spp equals 64 spp in one run, bit for
 TEST_CASE("cli: --resume refuses a file rendered with other settings") {
     TempDir dir("resume_bad");
     REQUIRE(run_sahara("render" + kSmall + "--spp 2 -o " + (dir / "a.exr"), dir).code == 0);
-    RunResult r = run_sahara(
+    CliRun r = run_sahara(
         "render" + kSmall + "--spp 4 --seed 3 --resume " + (dir / "a.exr") + " -o " + (dir / "b.exr"), dir);
     CHECK(r.code == 2);
     CHECK(r.err.find("seed") != std::string::npos);
@@ -261,7 +224,7 @@ TEST_CASE("cli: SIGINT stops, writes the samples done and exits 130") {
     CHECK(read_image(out, false)->width == 24);
     // A PNG cannot be resumed: the exact state goes to a side file.
     CHECK(fs::exists(out + ".partial.exr"));
-    CHECK(slurp(dir / "err.txt").find("interrupted") != std::string::npos);
+    CHECK(read_text(dir / "err.txt").find("interrupted") != std::string::npos);
 }
 
 TEST_CASE("cli: a second SIGINT exits at once and leaves no partial file") {
@@ -285,7 +248,7 @@ TEST_CASE("cli: a second SIGINT exits at once and leaves no partial file") {
 TEST_CASE("cli: --time stops early with a valid image") {
     TempDir dir("time");
     const std::string out = dir / "t.exr";
-    const RunResult r = run_sahara("render" + kSmall + "--spp 1000000 --time 0.3 -o " + out, dir);
+    const CliRun r = run_sahara("render" + kSmall + "--spp 1000000 --time 0.3 -o " + out, dir);
     CHECK(r.code == 0);
     const ImageMetadata meta = read_image_metadata(out);
     CHECK(meta_value(meta, "status") == "time limit");
@@ -314,9 +277,9 @@ TEST_CASE("cli: --checkpoint writes the image while the render runs") {
 TEST_CASE("cli: --target-error reports its estimate, --reference the true error") {
     TempDir dir("adaptive");
     REQUIRE(run_sahara("render" + kSmall + "--spp 256 --seed 99 -o " + (dir / "ref.exr"), dir).code == 0);
-    const RunResult r = run_sahara("render" + kSmall + "--spp 256 --target-error 0.05 --reference " +
-                                       (dir / "ref.exr") + " -o " + (dir / "a.exr"),
-                                   dir);
+    const CliRun r = run_sahara("render" + kSmall + "--spp 256 --target-error 0.05 --reference " +
+                                    (dir / "ref.exr") + " -o " + (dir / "a.exr"),
+                                dir);
     CHECK(r.code == 0);
     CHECK(r.err.find("est. error") != std::string::npos);
     CHECK(r.err.find("true error") != std::string::npos);
@@ -325,7 +288,7 @@ TEST_CASE("cli: --target-error reports its estimate, --reference the true error"
 
 TEST_CASE("cli: --stats prints grouped statistics") {
     TempDir dir("stats");
-    const RunResult r = run_sahara("render" + kSmall + "--spp 2 --stats -o " + (dir / "s.png"), dir);
+    const CliRun r = run_sahara("render" + kSmall + "--spp 2 --stats -o " + (dir / "s.png"), dir);
     CHECK(r.code == 0);
     for (const char* s : {"Statistics:", "Render", "Camera rays", "768", "BVH", "Memory", "Time", "Write"})
         CHECK_MESSAGE(r.err.find(s) != std::string::npos, s);

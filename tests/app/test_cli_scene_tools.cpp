@@ -11,46 +11,14 @@
 #include <string>
 
 #include "accel/embree_reference.h"
+#include "cli_test_util.h"
 #include "io/scene_parser.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
+using namespace sahara::test;
 
 namespace {
-
-/// A fresh directory per test, removed afterwards.
-struct ToolDir {
-    fs::path path;
-    explicit ToolDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("sahara_tools_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~ToolDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-};
-
-struct ToolRun {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Runs `sahara ARGS` through the shell, capturing stdout and stderr.
-ToolRun run_tool(const std::string& args, const ToolDir& dir) {
-    const fs::path out = dir.path / "stdout.txt", err = dir.path / "stderr.txt";
-    const std::string cmd = std::string(SAHARA_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_text(out), read_text(err)};
-}
 
 std::string scene_path(const char* name) { return std::string(SAHARA_SOURCE_DIR) + "/scenes/" + name; }
 
@@ -64,14 +32,14 @@ size_t triangle_count(const SceneDesc& d) {
 }  // namespace
 
 TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree skipped") {
-    ToolDir dir("showcase");
+    TempDir dir("showcase");
     const std::string file = scene_path("showcase.json");
     const SceneDesc desc = parse_scene_file(file);
     REQUIRE(!desc.spheres.empty());
     const size_t tris = triangle_count(desc);
     REQUIRE(tris > 0);
 
-    const ToolRun bvh = run_tool("bvh " + file + " --size 32 --json", dir);
+    const CliRun bvh = run_sahara("bvh " + file + " --size 32 --json", dir);
     REQUIRE(bvh.code == 0);
     const auto j = nlohmann::json::parse(bvh.out);
     CHECK(j["input"] == "scene");
@@ -88,7 +56,7 @@ TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree sk
     CHECK(j["rays"]["shadow"]["count"] == 32 * 32);
     CHECK(j["rays"]["shadow"]["nodes_visited"].get<double>() > 0.0);
 
-    const ToolRun bench = run_tool("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
+    const CliRun bench = run_sahara("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
     REQUIRE(bench.code == 0);
     const auto b = nlohmann::json::parse(bench.out);
     CHECK(b["primitives"] == tris + desc.spheres.size());
@@ -104,7 +72,7 @@ TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree sk
     }
     CHECK(b["rays"]["primary"]["hit_rate"].get<double>() > 0.5);  // showcase: a floor fills the view
 
-    const ToolRun text = run_tool("bench " + file + " --size 16 --repeat 1 --ray-set primary", dir);
+    const CliRun text = run_sahara("bench " + file + " --size 16 --repeat 1 --ray-set primary", dir);
     CHECK(text.code == 0);
     CHECK(text.out.find(EmbreeReference::available()
                             ? "skipped: scene has"
@@ -112,11 +80,11 @@ TEST_CASE("bvh and bench on a scene file with spheres: counts by kind, Embree sk
 }
 
 TEST_CASE("bvh on a scene with quadrics and a plane: the plane stays outside the tree") {
-    ToolDir dir("quadrics");
+    TempDir dir("quadrics");
     const std::string file = scene_path("quadrics.json");
     const SceneDesc desc = parse_scene_file(file);
     REQUIRE(!desc.planes.empty());
-    const ToolRun bvh = run_tool("bvh " + file + " --size 16 --json", dir);
+    const CliRun bvh = run_sahara("bvh " + file + " --size 16 --json", dir);
     REQUIRE(bvh.code == 0);
     const auto j = nlohmann::json::parse(bvh.out);
     CHECK(j["primitives_by_kind"]["quadrics"] == desc.quadrics.size());
@@ -124,7 +92,7 @@ TEST_CASE("bvh on a scene with quadrics and a plane: the plane stays outside the
     CHECK(j["planes_outside_tree"] == desc.planes.size());
     CHECK(j["primitives"] ==
           desc.quadrics.size() + desc.spheres.size() + desc.boxes.size() + triangle_count(desc));
-    const ToolRun text = run_tool("bvh " + file + " --size 16", dir);
+    const CliRun text = run_sahara("bvh " + file + " --size 16", dir);
     CHECK(text.code == 0);
     CHECK(text.out.find("not in the tree") != std::string::npos);
 }
@@ -138,13 +106,13 @@ struct SceneBench {
 
 /// `sahara bench` on the Cornell box scene (triangles only), parsed.
 SceneBench bench_triangle_only_scene() {
-    ToolDir dir("cornell");
+    TempDir dir("cornell");
     const std::string file = scene_path("cornell-box.json");
     SceneBench r{parse_scene_file(file), {}};
     REQUIRE(r.desc.spheres.empty());
     REQUIRE(r.desc.boxes.empty());
     REQUIRE(r.desc.quadrics.empty());
-    const ToolRun bench = run_tool("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
+    const CliRun bench = run_sahara("bench " + file + " --json --size 64 --repeat 1 --threads 2", dir);
     REQUIRE(bench.code == 0);
     r.bench = nlohmann::json::parse(bench.out);
     return r;
@@ -171,28 +139,28 @@ TEST_CASE("bench on a triangle-only scene compares with Embree [needs Embree]" *
 }
 
 TEST_CASE("bvh and bench reject a broken scene file with exit 2, naming the file") {
-    ToolDir dir("broken");
+    TempDir dir("broken");
     const fs::path broken = dir.path / "broken-scene.json";
     std::ofstream(broken) << "{ \"format\": \"scene/1\", \"objects\": [ { \"type\": \"sphere\", \"radius\": ";
     for (const char* cmd : {"bvh", "bench"}) {
         INFO(cmd);
-        const ToolRun r = run_tool(std::string(cmd) + " " + broken.string() + " --size 8", dir);
+        const CliRun r = run_sahara(std::string(cmd) + " " + broken.string() + " --size 8", dir);
         CHECK(r.code == 2);
         CHECK(r.err.find("broken-scene.json") != std::string::npos);
-        const ToolRun missing = run_tool(std::string(cmd) + " " + (dir.path / "absent.json").string(), dir);
+        const CliRun missing = run_sahara(std::string(cmd) + " " + (dir.path / "absent.json").string(), dir);
         CHECK(missing.code == 2);
         CHECK(missing.err.find("absent.json") != std::string::npos);
     }
-    const ToolRun bad_sphere = [&] {
+    const CliRun bad_sphere = [&] {
         const fs::path f = dir.path / "negative-radius.json";
         std::ofstream(f) << R"({ "format": "scene/1", "objects": [ { "type": "sphere", "center": [0, 0, 0],
                                  "radius": -1 } ] })";
-        return run_tool("bvh " + f.string(), dir);
+        return run_sahara("bvh " + f.string(), dir);
     }();
     CHECK(bad_sphere.code == 2);
     CHECK(bad_sphere.err.find("negative-radius.json") != std::string::npos);
-    const ToolRun trace =
-        run_tool("trace " + scene_path("workshop.json") + " --rays x.rays --hits x.hits", dir);
+    const CliRun trace =
+        run_sahara("trace " + scene_path("workshop.json") + " --rays x.rays --hits x.hits", dir);
     CHECK(trace.code == 2);
     CHECK(trace.err.find("meshes only") != std::string::npos);
 }

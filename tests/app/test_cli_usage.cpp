@@ -10,55 +10,22 @@
 #include <sstream>
 #include <string>
 
-#include "accel/bvh_wide.h"
+#include "accel/simd_path.h"
+#include "cli_test_util.h"
 #include "app/cmd_version.h"
 #include "io/image_codec.h"
 
 namespace fs = std::filesystem;
+using namespace sahara::test;
 
 namespace {
-
-/// A fresh directory per test case, removed afterwards.
-struct UsageDir {
-    fs::path path;
-    explicit UsageDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("sahara_usage_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~UsageDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-};
-
-struct Run {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string read_text(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Runs `[ENV] sahara ARGS` through the shell from `dir`, capturing stdout and stderr.
-Run run_sahara(const std::string& args, const UsageDir& dir, const std::string& env = "") {
-    const fs::path out = dir.path / "stdout.txt", err = dir.path / "stderr.txt";
-    const std::string cmd = "cd " + dir.path.string() + " && " + env + " " + SAHARA_EXE + " " + args + " >" +
-                            out.string() + " 2>" + err.string();
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_text(out), read_text(err)};
-}
 
 /// Checks that `sahara ARGS` fails with exit code 2 and exactly one stderr line
 /// naming `culprit` and pointing at `sahara COMMAND --help`.
 void check_one_line_usage_error(const std::string& args, const std::string& command,
                                 const std::string& culprit) {
-    UsageDir dir("err");
-    const Run r = run_sahara(args, dir);
+    TempDir dir("err");
+    const CliRun r = run_sahara(args, dir);
     INFO("sahara " << args << "\nstderr:\n" << r.err);
     CHECK(r.code == 2);
     CHECK(r.out.empty());
@@ -114,10 +81,10 @@ TEST_CASE("cli usage: an option means one thing in every command") {
 }
 
 TEST_CASE("cli usage: --help still prints the whole text on stdout") {
-    UsageDir dir("help");
+    TempDir dir("help");
     for (const char* command : {"render", "view", "info", "bvh", "bench", "trace", "converge"}) {
         CAPTURE(command);
-        const Run r = run_sahara(std::string(command) + " --help", dir);
+        const CliRun r = run_sahara(std::string(command) + " --help", dir);
         CHECK(r.code == 0);
         CHECK(r.out.find(std::string("usage: sahara ") + command) != std::string::npos);
         CHECK(r.err.empty());
@@ -125,8 +92,8 @@ TEST_CASE("cli usage: --help still prints the whole text on stdout") {
 }
 
 TEST_CASE("cli: --version names the version and every optional part") {
-    UsageDir dir("version");
-    const Run r = run_sahara("--version", dir);
+    TempDir dir("version");
+    const CliRun r = run_sahara("--version", dir);
     CHECK(r.code == 0);
     CHECK(r.out.rfind("sahara " SAHARA_VERSION "\n", 0) == 0);
     for (const char* part : {"OpenMP:", "SIMD:", "Embree:", "MPI:", "SDL2:", "image codec:"})
@@ -143,9 +110,9 @@ TEST_CASE("cli: --version names the version and every optional part") {
 }
 
 TEST_CASE("cli: --version reports a missing plugin and a narrowed SIMD path") {
-    UsageDir dir("version_env");
+    TempDir dir("version_env");
     const std::string missing = (dir.path / "no-codec.so").string();
-    const Run r = run_sahara("--version", dir, "SAHARA_IMAGE_CODEC=" + missing + " SAHARA_SIMD=sse2");
+    const CliRun r = run_sahara("--version", dir, "SAHARA_IMAGE_CODEC=" + missing + " SAHARA_SIMD=sse2");
     CHECK(r.code == 0);
     CHECK(r.out.find("plugin not found (looked for " + missing + ")") != std::string::npos);
     if (sahara::best_simd_path() != sahara::SimdPath::sse2)

@@ -12,18 +12,12 @@
 #include "app/cmd_converge.h"
 #include "base/error.h"
 #include "io/image_io.h"
+#include "cli_test_util.h"
 #include "io/plot.h"
 
 using namespace sahara;
 
 namespace {
-
-std::string read_file(const std::string& file) {
-    std::ifstream in(file, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 /// Every <tag ...> element of `xml`, start tag to end tag (or "/>").
 std::vector<std::string> elements(const std::string& xml, const std::string& tag) {
@@ -281,7 +275,7 @@ TEST_CASE("converge: end to end on a tiny default scene writes CSV, plots and re
     }
     REQUIRE(rows.size() == 2);
 
-    const std::string svg = read_file(prefix + ".svg");
+    const std::string svg = sahara::test::read_text(prefix + ".svg");
     CHECK(well_formed(svg));
     const AxisMap x = axis_from_ticks(svg, "tick-x", "x"), y = axis_from_ticks(svg, "tick-y", "y");
     int series = 0;

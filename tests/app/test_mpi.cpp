@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "app/mpi_session.h"
+#include "cli_test_util.h"
 #include "app/mpi_work.h"
 #include "app/render_args.h"
 #include "io/image_io.h"
@@ -33,6 +34,7 @@ extern char** environ;
 
 using namespace sahara;
 namespace fs = std::filesystem;
+using namespace sahara::test;
 
 namespace {
 
@@ -41,27 +43,6 @@ constexpr int kSlow = 4;  // sanitizers: fewer samples, same code paths
 #else
 constexpr int kSlow = 1;
 #endif
-
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("sahara_mpi_" + std::to_string(::getpid()) + "_" + name)) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::string meta_value(const std::string& file, const std::string& key) {
     for (const auto& [k, v] : read_image_metadata(file))
@@ -122,7 +103,7 @@ int run(const std::string& args, int ranks, const std::string& err_file, double 
     const std::string cmd = (ranks > 0 ? mpirun(ranks) : "") + SAHARA_EXE + " " + args + " 2>" + err_file;
     Job job(cmd);
     const int code = job.wait(timeout);
-    if (code != 0) MESSAGE("`" << cmd << "` exited " << code << ":\n" << slurp(err_file));
+    if (code != 0) MESSAGE("`" << cmd << "` exited " << code << ":\n" << read_text(err_file));
     return code;
 }
 
@@ -269,12 +250,12 @@ TEST_CASE(
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
     REQUIRE(fs::exists(dir / "k.exr"));
     REQUIRE_MESSAGE(job.running(), "the render ended before the kill; make it longer");
-    const pid_t rank1 = pid_t(std::stoi(slurp(dir / "rank-1.pid")));
+    const pid_t rank1 = pid_t(std::stoi(read_text(dir / "rank-1.pid")));
     REQUIRE(::kill(rank1, SIGKILL) == 0);
     const int code = job.wait(60);
     REQUIRE_MESSAGE(code != -1, "the job hung after a rank died");
     CHECK(code != 0);
-    const std::string log = slurp(err);
+    const std::string log = read_text(err);
     INFO(log);
     CHECK(log.find("rank 1") != std::string::npos);  // mpirun's report, or rank 0's warning
     CHECK(meta_value(dir / "k.exr", "status") == "interrupted");

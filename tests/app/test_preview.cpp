@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/preview.h"
+#include "cli_test_util.h"
 #include "io/image_io.h"
 #include "render/tonemap.h"
 
@@ -64,9 +65,8 @@ constexpr bool kHaveSdl2 = false;
 
 TEST_CASE("preview: the window's last frame equals the written image (offscreen driver) [needs SDL2]" *
           doctest::skip(!kHaveSdl2)) {
-    const fs::path dir = fs::temp_directory_path() / ("sahara_preview_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const sahara::test::TempDir tmp("preview");
+    const fs::path& dir = tmp.path;
     const fs::path out = dir / "p.png", dump = dir / "frame.ppm";
     // Leak checking is off for this child only: video drivers keep allocations until exit.
     const std::string cmd = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0 " +
@@ -87,13 +87,11 @@ TEST_CASE("preview: the window's last frame equals the written image (offscreen 
         for (size_t c = 0; c < 3; ++c)
             mismatches += frame[i * 3 + c] != (unsigned char)std::lround(img->rgba[i * 4 + c] * 255.0f);
     CHECK(mismatches == 0);
-    fs::remove_all(dir);
 }
 
 TEST_CASE("preview: without a display the render still runs, with a warning") {
-    const fs::path dir = fs::temp_directory_path() / ("sahara_nodisplay_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const sahara::test::TempDir tmp("nodisplay");
+    const fs::path& dir = tmp.path;
     const std::string cmd = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER " +
                             std::string(SAHARA_EXE) + " render --width 16 --height 8 --spp 2 --preview -o " +
                             (dir / "n.png").string() + " 2>" + (dir / "err.txt").string();
@@ -102,5 +100,4 @@ TEST_CASE("preview: without a display the render still runs, with a warning") {
     std::ifstream err(dir / "err.txt");
     const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
     CHECK(text.find("warning: --preview") != std::string::npos);
-    fs::remove_all(dir);
 }

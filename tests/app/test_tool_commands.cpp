@@ -14,6 +14,7 @@
 #include "app/bench_rays.h"
 #include "app/commands.h"
 #include "app/ray_batch.h"
+#include "cli_test_util.h"
 #include "mesh_fixtures.h"
 #include "scene/accelerator.h"
 #include "test_data.h"
@@ -43,13 +44,6 @@ std::pair<int, std::string> run_captured(Fn fn, std::vector<std::string> args) {
     std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::filesystem::remove(path);
     return {code, out};
-}
-
-std::filesystem::path temp_dir(const std::string& name) {
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("sahara_" + name + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir;
 }
 
 void write_file(const std::filesystem::path& p, const void* data, size_t bytes) {
@@ -94,7 +88,8 @@ TEST_CASE("compare_answers counts hit/miss, t and primitive differences") {
 }
 
 TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
-    const auto dir = temp_dir("trace");
+    const TempDir tmp("trace");
+    const std::filesystem::path& dir = tmp.path;
     const auto obj = dir / "quad.obj", rays_file = dir / "in.rays", hits = dir / "out.hits",
                occl = dir / "out.occl";
     {
