@@ -133,7 +133,6 @@ TEST_CASE("watertight: brute-force triangle loop, rays through vertices of a clo
         const Ray r{o, m.positions[size_t(i) % m.positions.size()] - o};
         const TriangleRay tr(r);
         bool any = false;
-        ShapeHit h{};
         for (const TriangleVerts& t : tris) any |= t.intersect(tr, r.tmin, r.tmax).has_value();
         if (!any) ++escapes;
     }
