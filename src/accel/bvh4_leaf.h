@@ -2,7 +2,7 @@
 /// Wide-BVH leaves as blocks of four triangles in structure-of-arrays form, tested
 /// with SSE four at a time by the watertight test of Woop, Benthin and Wald
 /// ("Watertight Ray/Triangle Intersection", JCGT 2013). Every lane performs
-/// exactly the float operations of intersect_triangle (geometry/triangle.h),
+/// exactly the float operations of TriangleVerts::intersect (geometry/triangle.h),
 /// in the same order and without fused multiply-adds, so the answers are
 /// bit-identical; a lane whose edge function is exactly 0 is redone by the
 /// scalar test (which then falls back to double, as the paper requires).
@@ -49,9 +49,8 @@ __attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRa
         const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
                                  {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                  {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
-        TriangleHit h{};
-        if (intersect_triangle(tr, tri, tmin, tmax, h)) {
-            t_out[shift + l] = h.t, u_out[shift + l] = h.u, v_out[shift + l] = h.v;
+        if (const std::optional<ShapeHit> h = tri.intersect(tr, tmin, tmax)) {
+            t_out[shift + l] = h->t, u_out[shift + l] = h->u, v_out[shift + l] = h->v;
             result |= 1 << (shift + l);
         }
     }
@@ -76,7 +75,7 @@ __attribute__((always_inline)) inline int intersect_triangle_block4_simd(const T
         x[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][kx]), ox), _mm_mul_ps(sx, rz[v]));
         y[v] = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.p[v][ky]), oy), _mm_mul_ps(sy, rz[v]));
     }
-    // u = cx by - cy bx, v = ax cy - ay cx, w = bx ay - by ax (as in intersect_triangle).
+    // u = cx by - cy bx, v = ax cy - ay cx, w = bx ay - by ax (as in TriangleVerts::intersect).
     const __m128 u = _mm_sub_ps(_mm_mul_ps(x[2], y[1]), _mm_mul_ps(y[2], x[1]));
     const __m128 v = _mm_sub_ps(_mm_mul_ps(x[0], y[2]), _mm_mul_ps(y[0], x[2]));
     const __m128 w = _mm_sub_ps(_mm_mul_ps(x[1], y[0]), _mm_mul_ps(y[1], x[0]));

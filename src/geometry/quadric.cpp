@@ -112,11 +112,11 @@ Vec3d Quadric::gradient(const Vec3d& p) const {
             2.0 * k[2] * p.z + k[4] * p.x + k[5] * p.y + k[8]};
 }
 
-QuadricHit Quadric::intersect(const Ray& ray) const {
+std::optional<ShapeHit> Quadric::intersect(const Ray& ray) const {
     Vec3d o = point_to(object_from_world, Vec3d(ray.origin));
     Vec3d d = vector_to(object_from_world, Vec3d(ray.dir));
     const double len = length(d);
-    if (!(len > 0.0) || !std::isfinite(len)) return {};
+    if (!(len > 0.0) || !std::isfinite(len)) return std::nullopt;
     const double inv_len = 1.0 / len;
     d = d * inv_len;  // unit: parameters below are object-frame distances
     // Move the origin to the ray point nearest the object so that the
@@ -130,12 +130,12 @@ QuadricHit Quadric::intersect(const Ray& ray) const {
     const double c = eval(o);
     double roots[2];
     const int n = solve_quadratic(a, b, c, roots);
-    QuadricHit best;
+    std::optional<ShapeHit> best;
     for (int i = 0; i < n; ++i) {  // ascending: the first accepted root is the nearest
         if (!inside_clip(*this, o + d * roots[i])) continue;
         const float t = accept_t(shift + roots[i], inv_len, ray);
         if (t >= 0.0f) {
-            best = {t, QuadricPart::side};
+            best = ShapeHit{t, 0.0f, 0.0f, uint32_t(QuadricPart::side)};
             break;
         }
     }
@@ -147,20 +147,34 @@ QuadricHit Quadric::intersect(const Ray& ray) const {
             const double x = o.x + d.x * tc, y = o.y + d.y * tc;
             if (x * x + y * y > 1.0 + kCapSlack) continue;
             const float t = accept_t(shift + tc, inv_len, ray);
-            if (t >= 0.0f && (!best.hit() || t < best.t))
-                best = {t, side == 0 ? QuadricPart::bottom_cap : QuadricPart::top_cap};
+            if (t >= 0.0f && (!best || t < best->t))
+                best = ShapeHit{t, 0.0f, 0.0f,
+                                uint32_t(side == 0 ? QuadricPart::bottom_cap : QuadricPart::top_cap)};
         }
     }
     return best;
 }
 
-QuadricSurface Quadric::surface(const Ray& ray, const QuadricHit& hit) const {
+/// The BVH keeps only t and the primitive id (geometry/hit.h's 16-byte Hit, one store
+/// per closer hit on the triangle path), so the part of the accepted hit is found again
+/// here, once per shaded quadric hit: in the open interval between the floats next to t,
+/// the only candidates intersect() accepts are those that rounded to t itself, and it
+/// breaks ties among them in the same order as it did over the whole interval.
+ShapeHit Quadric::hit_at(const Ray& ray, float t) const {
+    Ray around = ray;
+    around.tmin = std::nextafter(t, -kInfinity);
+    around.tmax = std::nextafter(t, kInfinity);
+    const std::optional<ShapeHit> h = intersect(around);
+    return ShapeHit{t, 0.0f, 0.0f, h ? h->part : uint32_t(QuadricPart::side)};
+}
+
+QuadricSurface Quadric::surface(const Ray& ray, const ShapeHit& hit) const {
     const Vec3d o = point_to(object_from_world, Vec3d(ray.origin));
     const Vec3d d = vector_to(object_from_world, Vec3d(ray.dir));
     Vec3d p = o + d * double(hit.t);
     Vec3d g;
     QuadricSurface s;
-    if (hit.part == QuadricPart::side) {
+    if (hit.part == uint32_t(QuadricPart::side)) {
         // One Newton step along the gradient projects p back onto f = 0,
         // removing most of the error of origin + t * dir (t is a float).
         g = gradient(p);
@@ -180,7 +194,7 @@ QuadricSurface Quadric::surface(const Ray& ray, const QuadricHit& hit) const {
             s.uv = {0.0f, 0.0f};
         }
     } else {
-        const bool top = hit.part == QuadricPart::top_cap;
+        const bool top = hit.part == uint32_t(QuadricPart::top_cap);
         p.z = top ? clip_hi.z : clip_lo.z;
         g = Vec3d(0.0, 0.0, top ? 1.0 : -1.0);
         s.uv = {float(0.5 + 0.5 * p.x), float(0.5 + 0.5 * p.y)};

@@ -18,7 +18,9 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
+#include "geometry/shape.h"
 #include "math/bounds.h"
 #include "math/ray.h"
 #include "math/transform.h"
@@ -30,13 +32,6 @@ enum class QuadricForm : uint8_t { ellipsoid, cylinder, cone, paraboloid, hyperb
 /// The part of a quadric a ray hit: the curved surface or one of the cap disks.
 enum class QuadricPart : uint8_t { side = 0, bottom_cap = 1, top_cap = 2 };
 
-/// Result of the cheap ray test: t in units of |ray.dir| (negative: miss) and the part.
-struct QuadricHit {
-    float t = -1.0f;
-    QuadricPart part = QuadricPart::side;
-    bool hit() const { return t >= 0.0f; }
-};
-
 /// Shading-independent data at an accepted hit.
 struct QuadricSurface {
     Vec3 p;   ///< world-space point, projected onto the surface
@@ -46,6 +41,8 @@ struct QuadricSurface {
 };
 
 struct Quadric {
+    static constexpr bool kBounded = true;
+
     QuadricForm form = QuadricForm::general;
     /// Object-frame coefficients A..J (order as in the file comment).
     std::array<double, 10> coeffs{};
@@ -61,10 +58,14 @@ struct Quadric {
 
     /// World-space bounds of the clipped surface (and caps).
     Bounds3 bounds() const { return world_bounds; }
-    /// Nearest hit in (ray.tmin, ray.tmax); t < 0 when there is none.
-    QuadricHit intersect(const Ray& ray) const;
+    /// Nearest hit in (ray.tmin, ray.tmax); its part is a QuadricPart.
+    std::optional<ShapeHit> intersect(const Ray& ray) const;
+    bool occluded(const Ray& ray) const { return intersect(ray).has_value(); }
+    /// The hit intersect() returned at distance t along `ray` (same origin and direction),
+    /// its part included; for a primitive id and t kept without the part.
+    ShapeHit hit_at(const Ray& ray, float t) const;
     /// Point, outward normal, UV and side for a hit returned by intersect().
-    QuadricSurface surface(const Ray& ray, const QuadricHit& hit) const;
+    QuadricSurface surface(const Ray& ray, const ShapeHit& hit) const;
     /// Outward unit normal at a world point on (or very near) the surface;
     /// points on a cap plane inside the disk get the cap normal.
     Vec3 normal(const Vec3& p_world) const;
@@ -76,6 +77,7 @@ struct Quadric {
     /// Computes object_from_world, world_bounds and solve_origin from the other fields.
     void finalize();
 };
+static_assert(Shape<Quadric>);
 
 // Factories. Each validates its parameters and throws InputError with a
 // message such as "radius: expected a number > 0, got -1" (the scene parser

@@ -6,13 +6,17 @@
 /// roots. In float, centre-relative coordinates of a radius-1e6 sphere are
 /// quantised to ~0.06 units; in double the hit lies within 1e-9 of the surface.
 #include <cmath>
+#include <optional>
 
+#include "geometry/shape.h"
 #include "math/bounds.h"
 #include "math/ray.h"
 
 namespace sahara {
 
 struct Sphere {
+    static constexpr bool kBounded = true;
+
     Vec3 center;
     float radius = 1;
     Vec3 velocity{0, 0, 0};  ///< centre moves by velocity * time (motion blur)
@@ -29,10 +33,14 @@ struct Sphere {
         b.extend(center_at(t1) + r);
         return b;
     }
+    /// Nearest hit in (ray.tmin, ray.tmax) with the centre at ray.time.
+    std::optional<ShapeHit> intersect(const Ray& ray) const;
+    bool occluded(const Ray& ray) const { return intersect(ray).has_value(); }
 };
+static_assert(Shape<Sphere>);
 
 /// Whether the ray's line passes outside the sphere by more than any float error
-/// could account for: a float distance test that lets intersect_sphere skip the
+/// could account for: a float distance test that lets nearest_root skip the
 /// double computation for most rays that reach a sphere's leaf. The line's
 /// distance from the centre is computed with a few float operations, each off by
 /// at most a few ulps of |f| (f = origin - centre, itself off by an ulp of
@@ -49,9 +57,11 @@ inline bool sphere_clearly_missed(const Ray& ray, const Vec3& c, float r) {
     return dot(perp, perp) > reach * reach;  // false for NaN
 }
 
+namespace sphere_detail {
+
 /// Nearest root t in (ray.tmin, ray.tmax) of the ray against a sphere with the
-/// given centre, or a negative value if there is none.
-inline double intersect_sphere(const Ray& ray, const Vec3& center_f, float radius_f) {
+/// given centre, in double, or a negative value if there is none.
+inline double nearest_root(const Ray& ray, const Vec3& center_f, float radius_f) {
     if (sphere_clearly_missed(ray, center_f, radius_f)) return -1;
     const Vec3d o(ray.origin), d_raw(ray.dir), c(center_f);
     const double r = radius_f;
@@ -72,6 +82,14 @@ inline double intersect_sphere(const Ray& ray, const Vec3& center_f, float radiu
     if (t0 > tmin && t0 < tmax) return t0 * inv_len;
     if (t1 > tmin && t1 < tmax) return t1 * inv_len;
     return -1;
+}
+
+}  // namespace sphere_detail
+
+inline std::optional<ShapeHit> Sphere::intersect(const Ray& ray) const {
+    const double t = sphere_detail::nearest_root(ray, center_at(ray.time), radius);
+    if (t < 0.0) return std::nullopt;
+    return ShapeHit{float(t)};
 }
 
 }  // namespace sahara

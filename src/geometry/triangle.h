@@ -11,7 +11,10 @@
 /// sign of the shared edge.
 #include <cmath>
 #include <cstdint>
+#include <optional>
 
+#include "geometry/shape.h"
+#include "math/bounds.h"
 #include "math/ray.h"
 #include "math/vec3.h"
 
@@ -81,22 +84,6 @@ struct TriangleRay {
     }
 };
 
-/// The three vertices of one triangle as plain arrays (indexable by a runtime axis).
-struct TriangleVerts {
-    float p[3][3];
-
-    static TriangleVerts of(const Vec3& a, const Vec3& b, const Vec3& c) {
-        return {{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}}};
-    }
-};
-static_assert(sizeof(TriangleVerts) == 36);
-
-/// Result of a successful triangle test.
-struct TriangleHit {
-    float t;     ///< ray parameter
-    float u, v;  ///< barycentric weights of vertices 1 and 2
-};
-
 namespace detail {
 /// Edge function recomputed in double (only when the float result is exactly 0).
 inline float edge_function_double(float ax, float ay, float bx, float by) {
@@ -104,10 +91,37 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
 }
 }  // namespace detail
 
-/// Watertight test of `ray` (precomputed as `tr`) against one triangle; a hit
-/// needs tmin < t < tmax. Degenerate (zero-area) triangles never hit.
-inline bool intersect_triangle(const TriangleRay& tr, const TriangleVerts& tri, float tmin, float tmax,
-                               TriangleHit& out) {
+/// The triangle shape: its three vertices as plain arrays (indexable by a runtime axis).
+struct TriangleVerts {
+    static constexpr bool kBounded = true;
+
+    float p[3][3];
+
+    static TriangleVerts of(const Vec3& a, const Vec3& b, const Vec3& c) {
+        return {{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}}};
+    }
+    Vec3 vertex(int i) const { return Vec3(p[i][0], p[i][1], p[i][2]); }
+    Bounds3 bounds() const {
+        Bounds3 b;
+        for (int i = 0; i < 3; ++i) b.extend(vertex(i));
+        return b;
+    }
+    /// Nearest hit in (ray.tmin, ray.tmax); u, v are the barycentrics of vertices 1 and 2.
+    std::optional<ShapeHit> intersect(const Ray& ray) const {
+        return intersect(TriangleRay(ray), ray.tmin, ray.tmax);
+    }
+    bool occluded(const Ray& ray) const { return intersect(ray).has_value(); }
+    /// intersect() with the ray's constants computed once per ray (`tr`), as the
+    /// BVH leaves call it, over (tmin, tmax).
+    std::optional<ShapeHit> intersect(const TriangleRay& tr, float tmin, float tmax) const;
+};
+static_assert(sizeof(TriangleVerts) == 36);
+static_assert(Shape<TriangleVerts>);
+
+/// Watertight test of one triangle; a hit needs tmin < t < tmax. Degenerate
+/// (zero-area) triangles never hit.
+inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, float tmin, float tmax) const {
+    const TriangleVerts& tri = *this;
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     // Vertices relative to the ray origin.
     const float a_x = tri.p[0][kx] - tr.org[kx], a_y = tri.p[0][ky] - tr.org[ky],
@@ -129,18 +143,19 @@ inline bool intersect_triangle(const TriangleRay& tr, const TriangleVerts& tri, 
         v = detail::edge_function_double(ax, ay, cx, cy);
         w = detail::edge_function_double(bx, by, ax, ay);
     }
-    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return std::nullopt;
     const float det = u + v + w;
-    if (det == 0.0f) return false;
+    if (det == 0.0f) return std::nullopt;
     // Scaled hit distance, compared against the interval without a division.
     const float t_scaled = u * (tr.sz * a_z) + v * (tr.sz * b_z) + w * (tr.sz * c_z);
     const float abs_det = std::fabs(det);
     const float t_signed = det < 0.0f ? -t_scaled : t_scaled;
-    if (!(t_signed > tmin * abs_det) || !(t_signed < tmax * abs_det)) return false;
+    if (!(t_signed > tmin * abs_det) || !(t_signed < tmax * abs_det)) return std::nullopt;
     const float inv_det = 1.0f / det;
-    out = {t_scaled * inv_det, v * inv_det, w * inv_det};
+    const float t = t_scaled * inv_det;
     // Rounding of the division can push t onto the interval's boundary.
-    return out.t > tmin && out.t < tmax;
+    if (!(t > tmin && t < tmax)) return std::nullopt;
+    return ShapeHit{t, v * inv_det, w * inv_det};
 }
 
 /// Unnormalised geometric normal of the triangle (p0, p1, p2): counter-clockwise is the front.

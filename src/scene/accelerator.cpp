@@ -7,7 +7,6 @@
 #include <chrono>
 #include <limits>
 
-#include "accel/box_intersect.h"
 #include "scene/leaf_blocks.inl"
 #include "scene/scene.h"
 
@@ -53,7 +52,7 @@ PrimitiveList collect_primitives(const Scene& scene) {
         list.set(k++, scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
                  make_prim_id(PrimKind::sphere, i));
     for (uint32_t i = 0; i < scene.boxes.size(); ++i)
-        list.set(k++, scene.boxes[i].box, make_prim_id(PrimKind::box, i));
+        list.set(k++, scene.boxes[i].bounds(), make_prim_id(PrimKind::box, i));
     for (uint32_t i = 0; i < scene.quadrics.size(); ++i)
         list.set(k++, scene.quadrics[i].bounds(), make_prim_id(PrimKind::quadric, i));
     return list;
@@ -110,10 +109,9 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
 }
 
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
-    : spheres_(scene.spheres), quadrics_(scene.quadrics), alpha_(scene) {
+    : spheres_(scene.spheres), boxes_(scene.boxes), quadrics_(scene.quadrics), alpha_(scene) {
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
-    for (const Box& b : scene.boxes) boxes_.push_back(b.box);
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
     const BvhBuildParams params = options.build_params();
@@ -228,7 +226,7 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
 }
 
 size_t Accelerator::bytes() const {
-    const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Bounds3) +
+    const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Box) +
                          quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
     // The block layout keeps only the tree, the blocks (vertices and triangle ids) and the
     // ids of other kinds.
@@ -239,31 +237,35 @@ size_t Accelerator::bytes() const {
            other;
 }
 
-/// Tests sphere, box or quadric `id` for a hit in (ray.tmin, tmax); sets its t and u.
-bool Accelerator::intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const {
+// The kind tag picks the shape's own member (geometry/shape.h): a switch, no virtual
+// call. Triangles are tested by the callers (blocks, slots); planes are never in the tree.
+std::optional<ShapeHit> Accelerator::intersect_other(const Ray& ray, uint32_t id, float tmax) const {
+    Ray r = ray;
+    r.tmax = tmax;
     switch (prim_kind(id)) {
-        case PrimKind::sphere: {
-            const Sphere& sp = spheres_[prim_index(id)];
-            Ray r = ray;
-            r.tmax = tmax;
-            const double ts = intersect_sphere(r, sp.center_at(ray.time), sp.radius);
-            if (ts < 0.0) return false;
-            t = float(ts);
-            return true;
-        }
+        case PrimKind::sphere:
+            return spheres_[prim_index(id)].intersect(r);
         case PrimKind::box:
-            return intersect_box(ray, boxes_[prim_index(id)], ray.tmin, tmax, t);
-        case PrimKind::quadric: {
-            Ray r = ray;
-            r.tmax = tmax;
-            const QuadricHit qh = quadrics_[prim_index(id)].intersect(r);
-            if (!qh.hit()) return false;
-            t = qh.t;
-            u = float(int(qh.part));  // Scene::interact reads the part back from hit.u
-            return true;
-        }
+            return boxes_[prim_index(id)].intersect(r);
+        case PrimKind::quadric:
+            return quadrics_[prim_index(id)].intersect(r);
         default:
-            return false;  // triangles are tested by the caller; planes are never in the tree
+            return std::nullopt;
+    }
+}
+
+bool Accelerator::occluded_other(const Ray& ray, uint32_t id, float tmax) const {
+    Ray r = ray;
+    r.tmax = tmax;
+    switch (prim_kind(id)) {
+        case PrimKind::sphere:
+            return spheres_[prim_index(id)].occluded(r);
+        case PrimKind::box:
+            return boxes_[prim_index(id)].occluded(r);
+        case PrimKind::quadric:
+            return quadrics_[prim_index(id)].occluded(r);
+        default:
+            return false;
     }
 }
 
@@ -347,20 +349,19 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
         for (int l = 0; l < 4; ++l) {
             if (b.slot[l] == TriangleBlock4::kEmptyLane) continue;
             const uint32_t id = lane_prim(b.slot[l]);
-            float t = 0.0f, u = 0.0f, v = 0.0f;
+            std::optional<ShapeHit> h;
             if (prim_kind(id) == PrimKind::triangle) {
                 const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
                                          {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                          {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
-                TriangleHit th;
-                if (!intersect_triangle(tr, tri, ray.tmin, tmax, th)) continue;
-                if (!alpha_.empty() && !keep_triangle_hit(ray, id, th.u, th.v)) continue;
-                t = th.t, u = th.u, v = th.v;
-            } else if (!intersect_other(ray, id, tmax, t, u)) {
-                continue;
+                h = tri.intersect(tr, ray.tmin, tmax);
+                if (h && !alpha_.empty() && !keep_triangle_hit(ray, id, h->u, h->v)) h.reset();
+            } else {
+                h = intersect_other(ray, id, tmax);
             }
-            tmax = t;
-            hit = Hit{t, id, u, v};
+            if (!h) continue;
+            tmax = h->t;
+            hit = Hit{h->t, id, h->u, h->v};
             found = true;
         }
     return found;
@@ -370,9 +371,9 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
 /// cut-outs).
 bool Accelerator::intersect_slot(const Ray& ray, uint32_t other, Hit& hit) const {
     const uint32_t id = others_[other];
-    float t = 0.0f, u = 0.0f;
-    if (!intersect_other(ray, id, ray.tmax, t, u)) return false;
-    hit = Hit{t, id, u, 0.0f};
+    const std::optional<ShapeHit> h = intersect_other(ray, id, ray.tmax);
+    if (!h) return false;
+    hit = Hit{h->t, id, 0.0f, 0.0f};
     return true;
 }
 

@@ -18,6 +18,7 @@
 #include "accel/bvh4_leaf.h"
 #include "accel/bvh_pairs.h"
 #include "accel/bvh_traverse.h"
+#include "geometry/box.h"
 #include "geometry/hit.h"
 #include "geometry/quadric.h"
 #include "geometry/sphere.h"
@@ -184,7 +185,9 @@ class Accelerator {
     template <int N>
     void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                           const std::vector<TriangleVerts>& tris);
-    bool intersect_other(const Ray& ray, uint32_t id, float tmax, float& t, float& u) const;
+    /// Sphere, box or quadric `id` over (ray.tmin, tmax): the shape's intersect() or occluded().
+    std::optional<ShapeHit> intersect_other(const Ray& ray, uint32_t id, float tmax) const;
+    bool occluded_other(const Ray& ray, uint32_t id, float tmax) const;
     bool brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const;
     template <bool kAnyHit, bool kCutouts>
     bool test_slots(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
@@ -223,7 +226,7 @@ class Accelerator {
     /// wide8 layout: ids of the non-triangle lanes (a triangle lane holds its id itself).
     std::vector<uint32_t> others_;
     std::vector<Sphere> spheres_;    ///< copy of Scene::spheres (indexed by sphere index)
-    std::vector<Bounds3> boxes_;     ///< copy of Scene::boxes (indexed by box index)
+    std::vector<Box> boxes_;         ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
     AlphaFilter alpha_;              ///< cut-out triangles (empty: traversal without the alpha test)
     Bounds3 bounds_;

@@ -118,12 +118,13 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
         for (int m = other; m; m &= m - 1) {
             const uint32_t id =
                 others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
-            float t_other = 0.0f, u_other = 0.0f;
-            if (!intersect_other(ray, id, tmax, t_other, u_other)) continue;
-            if constexpr (kAnyHit) return true;
-            tmax = t_other;
-            hit = Hit{t_other, id, u_other, 0.0f};
-            found = true;
+            if constexpr (kAnyHit) {
+                if (occluded_other(ray, id, tmax)) return true;
+            } else if (const std::optional<ShapeHit> h = intersect_other(ray, id, tmax)) {
+                tmax = h->t;
+                hit = Hit{h->t, id, 0.0f, 0.0f};  // a quadric's part: Scene::interact (Quadric::hit_at)
+                found = true;
+            }
         }
         b += pair ? 2 : 1;
     }
@@ -139,23 +140,22 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
     bool found = false;
     for (uint32_t s = first; s < first + count; ++s) {
         const uint32_t id = slots_[s].id;
-        float t = 0.0f, u = 0.0f, v = 0.0f;
-        switch (prim_kind(id)) {
-            case PrimKind::triangle: {
-                TriangleHit th;
-                if (!intersect_triangle(tr, slots_[s].tri, ray.tmin, tmax, th)) continue;
-                if constexpr (kCutouts)
-                    if (!keep_triangle_hit(ray, id, th.u, th.v)) continue;
-                t = th.t, u = th.u, v = th.v;
-                break;
+        std::optional<ShapeHit> h;
+        if (prim_kind(id) == PrimKind::triangle) {
+            h = slots_[s].tri.intersect(tr, ray.tmin, tmax);
+            if constexpr (kCutouts)
+                if (h && !keep_triangle_hit(ray, id, h->u, h->v)) continue;
+        } else {
+            if constexpr (kAnyHit) {
+                if (occluded_other(ray, id, tmax)) return true;
+                continue;
             }
-            default:
-                if (!intersect_other(ray, id, tmax, t, u)) continue;
-                break;
+            h = intersect_other(ray, id, tmax);
         }
+        if (!h) continue;
         if constexpr (kAnyHit) return true;
-        tmax = t;
-        hit = Hit{t, id, u, v};
+        tmax = h->t;
+        hit = Hit{h->t, id, h->u, h->v};
         found = true;
     }
     return found;

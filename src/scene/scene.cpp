@@ -32,19 +32,16 @@ void Scene::build_accelerator() {
 
 namespace {
 
-/// Unbounded planes live outside the tree and are tested linearly.
+/// Unbounded planes (Plane::kBounded is false) live outside the tree and are tested linearly.
 bool intersect_planes(const std::vector<Plane>& planes, Ray& ray, Hit& hit) {
+    static_assert(!Plane::kBounded);
     bool found = false;
     for (uint32_t i = 0; i < planes.size(); ++i) {
-        const Plane& pl = planes[i];
-        float denom = dot(pl.normal, ray.dir);
-        if (denom == 0.0f) continue;
-        float t = dot(pl.point - ray.origin, pl.normal) / denom;
-        if (t > ray.tmin && t < ray.tmax) {
-            ray.tmax = t;
-            hit = Hit{t, make_prim_id(PrimKind::plane, i), 0, 0};
-            found = true;
-        }
+        const std::optional<ShapeHit> h = planes[i].intersect(ray);
+        if (!h) continue;
+        ray.tmax = h->t;
+        hit = Hit{h->t, make_prim_id(PrimKind::plane, i), 0, 0};
+        found = true;
     }
     return found;
 }
@@ -80,9 +77,7 @@ void Scene::intersect_packet(RayPacket& packet, HitPacket& hits) const {
 bool Scene::occluded(const Ray& ray) const {
     count_ray(RayKind::shadow);
     if (accel_ && accel_->occluded(ray)) return true;
-    Ray r = ray;
-    Hit h;
-    return intersect_planes(planes, r, h);
+    return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
 }
 
 uint64_t Scene::traversal_steps(const Ray& ray) const {
@@ -283,9 +278,9 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
             break;
         }
         case PrimKind::quadric: {
-            // The accelerator stores the hit part (side or cap) in hit.u.
+            // Hit has no part field: hit_at finds the part (side or cap) again.
             const Quadric& q = quadrics[idx];
-            const QuadricSurface qs = q.surface(ray, QuadricHit{hit.t, QuadricPart(int(hit.u))});
+            const QuadricSurface qs = q.surface(ray, q.hit_at(ray, hit.t));
             si.p = qs.p;
             si.ng = si.ns = qs.n;
             si.uv = qs.uv;

@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "accel/packet.h"  // RayPacket, HitPacket: the packet interface render uses
+#include "geometry/box.h"
 #include "geometry/hit.h"
+#include "geometry/plane.h"
 #include "geometry/quadric.h"
 #include "geometry/sphere.h"
 #include "math/distribution.h"
@@ -41,16 +43,6 @@ struct TriangleSoup {
     std::vector<uint32_t> indices;
     std::vector<uint32_t> material;  ///< per triangle
     size_t size() const { return indices.size() / 3; }
-};
-
-struct Plane {
-    Vec3 point, normal;
-    uint32_t material = 0;
-};
-
-struct Box {
-    Bounds3 box;
-    uint32_t material = 0;
 };
 
 /// Which rendering machinery a scene needs, decided once at build time so that

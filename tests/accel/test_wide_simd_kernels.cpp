@@ -224,8 +224,9 @@ void check_lane_triangle_tests(bool eight_lanes) {
             const int mask8 =
                 eight_lanes ? intersect_triangle_blocks2_avx(tr, pair, ray.tmin, ray.tmax, t8, u8, v8) : 0;
             for (int l = 0; l < 4; ++l) {
-                TriangleHit h{};
-                const bool hit = intersect_triangle(tr, tri[l], ray.tmin, ray.tmax, h);
+                const std::optional<ShapeHit> found = tri[l].intersect(tr, ray.tmin, ray.tmax);
+                const bool hit = found.has_value();
+                const ShapeHit h = found.value_or(ShapeHit{});
                 ++checked;
                 hits += hit;
                 if (hit != bool(mask & (1 << l)) || (hit && (h.t != t[l] || h.u != u[l] || h.v != v[l])))

@@ -17,15 +17,17 @@ using namespace sahara::test;
 
 namespace {
 
-bool hit_triangle(const Ray& r, const Vec3& a, const Vec3& b, const Vec3& c, TriangleHit& h) {
-    return intersect_triangle(TriangleRay(r), TriangleVerts::of(a, b, c), r.tmin, r.tmax, h);
+bool hit_triangle(const Ray& r, const Vec3& a, const Vec3& b, const Vec3& c, ShapeHit& h) {
+    const std::optional<ShapeHit> hit = TriangleVerts::of(a, b, c).intersect(r);
+    if (hit) h = *hit;
+    return hit.has_value();
 }
 
 }  // namespace
 
 TEST_CASE("triangle hit gives t and barycentrics of vertices 1 and 2") {
     const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-    TriangleHit h{};
+    ShapeHit h{};
     REQUIRE(hit_triangle(Ray{{0.25f, 0.5f, 2}, {0, 0, -2}}, a, b, c, h));
     CHECK(h.t == doctest::Approx(1.0f));
     CHECK(h.u == doctest::Approx(0.25f));
@@ -69,7 +71,7 @@ TEST_CASE("TriangleRay::scattered gives the constructor's axes and shear, ties a
 }
 
 TEST_CASE("degenerate triangles never hit") {
-    TriangleHit h{};
+    ShapeHit h{};
     const Ray r{{0.5f, 0, 1}, {0, 0, -1}};
     CHECK(!hit_triangle(r, {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, h));
     CHECK(!hit_triangle(r, {0.5f, 0, 0}, {0.5f, 0, 0}, {0.5f, 0, 0}, h));
@@ -82,7 +84,7 @@ TEST_CASE("rays aimed at the shared diagonal of a quad hit one of its triangles"
     int lost = 0;
     for (int i = 1; i < 1000; ++i) {
         const float s = float(i) / 1000.0f;
-        TriangleHit h{};
+        ShapeHit h{};
         const Vec3 target(s, s, 0);
         const Ray aimed{target + Vec3(0.3f, -0.7f, 2.0f), target - (target + Vec3(0.3f, -0.7f, 2.0f))};
         if (!hit_triangle(aimed, a, b, c, h) && !hit_triangle(aimed, a, c, d, h)) ++lost;
@@ -131,8 +133,7 @@ TEST_CASE("watertight: brute-force triangle loop, rays through vertices of a clo
         const Ray r{o, m.positions[size_t(i) % m.positions.size()] - o};
         const TriangleRay tr(r);
         bool any = false;
-        TriangleHit h{};
-        for (const TriangleVerts& t : tris) any |= intersect_triangle(tr, t, r.tmin, r.tmax, h);
+        for (const TriangleVerts& t : tris) any |= t.intersect(tr, r.tmin, r.tmax).has_value();
         if (!any) ++escapes;
     }
     CHECK(escapes == 0);

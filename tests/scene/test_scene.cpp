@@ -25,9 +25,9 @@ TEST_CASE("scene: quadrics sit in the BVH beside spheres and give the quadric's 
         float best = kInfinity;
         uint32_t best_q = kNoPrim;
         for (uint32_t q = 0; q < scene.quadrics.size(); ++q) {
-            const QuadricHit qh = scene.quadrics[q].intersect(ray);
-            if (qh.hit() && qh.t < best) {
-                best = qh.t;
+            const std::optional<ShapeHit> qh = scene.quadrics[q].intersect(ray);
+            if (qh && qh->t < best) {
+                best = qh->t;
                 best_q = q;
             }
         }
