@@ -34,11 +34,11 @@ def placement(model):
 
 def scene_with(model):
     return {
-        "render": {"width": 800, "height": 450, "spp": 64, "max_depth": 8, "tonemap": "aces"},
+        "render": {"width": 800, "height": 450, "spp": 64, "max_depth": 8, "tonemap": "aces", "exposure": -0.5},
         "camera": {"position": [0, -7, 2.2], "look_at": [0, 0, 0.9], "up": [0, 0, 1], "vfov": 40},
         "background": {"type": "gradient", "bottom": [1, 1, 1], "top": [0.45, 0.6, 0.9], "up": [0, 0, 1]},
         "materials": {
-            "floor": {"type": "lambertian", "albedo": [0.6, 0.6, 0.6]},
+            "floor": {"type": "lambertian", "albedo": [0.4, 0.4, 0.4]},
             "glass": {"type": "dielectric", "ior": 1.5},
             "steel": {"type": "metal", "albedo": [0.85, 0.85, 0.9], "roughness": 0.1},
         },
@@ -48,7 +48,7 @@ def scene_with(model):
             {"type": "sphere", "center": [-2.2, 0.5, 0.8], "radius": 0.8, "material": "glass"},
             {"type": "sphere", "center": [2.2, 0.5, 0.8], "radius": 0.8, "material": "steel"},
         ],
-        "lights": [{"type": "directional", "direction": [-1, 2, -3], "irradiance": [2.5, 2.4, 2.2]}],
+        "lights": [{"type": "directional", "direction": [-1, 2, -3], "irradiance": [2.0, 1.9, 1.7]}],
     }
 
 

@@ -121,3 +121,10 @@ def test_the_readme_dict_is_the_default_scene(repo):
     names = {}
     exec(code, names)
     assert np.array_equal(names["img"], sahara.render(None, spp=2, width=24, height=18))
+
+
+def test_a_time_limit_returns_what_is_done(workshop):
+    img = sahara.render(workshop, width=64, height=48, spp=1 << 20, time=0.2)
+    assert img.shape == (48, 64, 3) and np.isfinite(img).all()
+    assert not img.stats["complete"]
+    assert img.stats["spp"] < (1 << 20)
