@@ -41,8 +41,7 @@ std::vector<fs::path> candidate_files() {
     if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) return {forced};
     std::vector<fs::path> files;
     // Inside a Python interpreter the executable is python3: the module keeps its plugin beside itself.
-    if (const fs::path own = shared_object_dir(); !own.empty())
-        files.push_back(own / kImageCodecLibrary);
+    if (const fs::path own = shared_object_dir(); !own.empty()) files.push_back(own / kImageCodecLibrary);
     const fs::path dir = executable_dir();
     if (dir.empty()) return files;
     files.push_back(dir / kImageCodecLibrary);

@@ -66,9 +66,8 @@ nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file, c
     // The SAH cost of the tree as built (the block layouts scale the intersection cost).
     const BvhBuildParams built = opt.build_params();
     const BvhStats s = compute_bvh_stats(accel.bvh(), built);
-    const BenchRaySets rays =
-        make_bench_rays(scene, accel, o.width, o.height,
-                        o.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
+    const BenchRaySets rays = make_bench_rays(
+        scene, accel, o.width, o.height, o.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     const size_t prims = accel.primitive_count();
     nlohmann::ordered_json j = {
         {"mesh", file},

@@ -22,6 +22,7 @@ struct BvhReportOptions {
 
 /// Builds the BVH of `scene`'s bounded primitives and reports on it; `file`
 /// names the input in the report.
-nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file, const BvhReportOptions& options);
+nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file,
+                                  const BvhReportOptions& options);
 
 }  // namespace sahara

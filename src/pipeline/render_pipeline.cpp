@@ -30,7 +30,8 @@ void RenderOverrides::apply(RenderSettings& r) const {
 SceneDesc load_scene_source(const std::optional<std::string>& source) {
     if (!source) return default_scene();
     std::string ext = std::filesystem::path(*source).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".obj" || ext == ".gltf" || ext == ".glb")
         return make_view_scene(load_model(*source), ext != ".obj", ViewOptions{}, *source);
     return parse_scene_file(*source);
@@ -45,9 +46,9 @@ Scene prepare_scene(SceneDesc& desc, const RenderOverrides& overrides, std::opti
     return build_scene(desc);
 }
 
-size_t write_rgb_image(const std::filesystem::path& file, int width, int height, const std::vector<float>& rgb,
-                       float exposure, Tonemap tonemap, const ImageMetadata& metadata,
-                       const std::vector<ExtraChannel>& extra) {
+size_t write_rgb_image(const std::filesystem::path& file, int width, int height,
+                       const std::vector<float>& rgb, float exposure, Tonemap tonemap,
+                       const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
     if (is_hdr_output(file)) {
         write_image(file, width, height, rgb, metadata, extra);
         return 0;

@@ -37,13 +37,14 @@ SceneDesc load_scene_source(const std::optional<std::string>& source);
 /// Applies `overrides` to `desc` (and, for an animation frame, shifts the
 /// shutter by `frame`: moving objects move on), then builds the runtime scene
 /// and its BVH.
-Scene prepare_scene(SceneDesc& desc, const RenderOverrides& overrides, std::optional<int> frame = std::nullopt);
+Scene prepare_scene(SceneDesc& desc, const RenderOverrides& overrides,
+                    std::optional<int> frame = std::nullopt);
 
 /// Writes linear RGB pixels (row 0 at the top) to `file`: 8-bit formats get
 /// `exposure` (stops) and the tone curve, then sRGB encoding; HDR formats stay
 /// linear, with `extra` channels. Returns how many pixels the curve clipped.
-size_t write_rgb_image(const std::filesystem::path& file, int width, int height, const std::vector<float>& rgb,
-                       float exposure, Tonemap tonemap, const ImageMetadata& metadata = {},
-                       const std::vector<ExtraChannel>& extra = {});
+size_t write_rgb_image(const std::filesystem::path& file, int width, int height,
+                       const std::vector<float>& rgb, float exposure, Tonemap tonemap,
+                       const ImageMetadata& metadata = {}, const std::vector<ExtraChannel>& extra = {});
 
 }  // namespace sahara

@@ -73,18 +73,20 @@ std::optional<double> real_arg(const py::object& v, const char* name, double lo,
 
 std::optional<std::string> str_arg(const py::object& v, const char* name) {
     if (v.is_none()) return std::nullopt;
-    if (!py::isinstance<py::str>(v)) throw py::type_error(std::string(name) + ": expected a str, got " + type_name(v));
+    if (!py::isinstance<py::str>(v))
+        throw py::type_error(std::string(name) + ": expected a str, got " + type_name(v));
     return v.cast<std::string>();
 }
 
 IntegratorType integrator_from_name(const std::string& name) {
     static const std::pair<const char*, IntegratorType> names[] = {
-        {"path", IntegratorType::path},       {"whitted", IntegratorType::whitted},
-        {"albedo", IntegratorType::albedo},   {"normals", IntegratorType::normals},
-        {"depth", IntegratorType::depth},     {"bvh-cost", IntegratorType::bvh_cost}};
+        {"path", IntegratorType::path},     {"whitted", IntegratorType::whitted},
+        {"albedo", IntegratorType::albedo}, {"normals", IntegratorType::normals},
+        {"depth", IntegratorType::depth},   {"bvh-cost", IntegratorType::bvh_cost}};
     for (const auto& [n, t] : names)
         if (name == n) return t;
-    throw py::value_error("integrator: expected path|whitted|albedo|normals|depth|bvh-cost, got '" + name + "'");
+    throw py::value_error("integrator: expected path|whitted|albedo|normals|depth|bvh-cost, got '" + name +
+                          "'");
 }
 
 Tonemap tonemap_arg(const std::string& name) {
@@ -115,7 +117,8 @@ RenderKwargs parse_kwargs(const py::object& spp, const py::object& width, const 
         try {
             o.seed = py::cast<uint64_t>(py::reinterpret_steal<py::object>(PyNumber_Index(seed.ptr())));
         } catch (const py::cast_error&) {
-            throw py::value_error("seed: expected an integer in [0, 2**64), got " + std::string(py::repr(seed)));
+            throw py::value_error("seed: expected an integer in [0, 2**64), got " +
+                                  std::string(py::repr(seed)));
         }
     }
     if (auto v = str_arg(integrator, "integrator")) o.integrator = integrator_from_name(*v);
@@ -290,7 +293,8 @@ py::object bvh_stats(const PyScene& ps, const py::object& builder, const py::obj
     if (auto name = str_arg(layout, "layout")) {
         BvhLayout l{};
         if (!parse_bvh_layout(*name, l))
-            throw py::value_error("layout: expected " + std::string(kBvhLayoutChoices) + ", got '" + *name + "'");
+            throw py::value_error("layout: expected " + std::string(kBvhLayoutChoices) + ", got '" + *name +
+                                  "'");
         o.layout = l;
     }
     o.width = int(int_arg(width, "width", 1, 32768).value_or(1024));
@@ -309,20 +313,19 @@ py::object bvh_stats(const PyScene& ps, const py::object& builder, const py::obj
 
 }  // namespace
 
-void bind_errors(py::module_& m) {
-    py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
-}
+void bind_errors(py::module_& m) { py::register_exception<InputError>(m, "InputError", PyExc_ValueError); }
 
 void bind_render(py::module_& m) {
-    py::class_<PyScene>(m, "Scene", "A scene loaded and built once (path, dict or None), rendered many times.")
+    py::class_<PyScene>(m, "Scene",
+                        "A scene loaded and built once (path, dict or None), rendered many times.")
         .def(py::init<const py::object&>(), py::arg("scene") = py::none())
         .def(
             "_render",
             [](PyScene& ps, const py::object& spp, const py::object& width, const py::object& height,
                const py::object& seed, const py::object& max_depth, const py::object& threads,
                const py::object& integrator, const py::object& time, bool progress) {
-                return render_scene(
-                    ps, parse_kwargs(spp, width, height, seed, max_depth, threads, integrator, time, progress));
+                return render_scene(ps, parse_kwargs(spp, width, height, seed, max_depth, threads, integrator,
+                                                     time, progress));
             },
             py::kw_only(), py::arg("spp") = py::none(), py::arg("width") = py::none(),
             py::arg("height") = py::none(), py::arg("seed") = py::none(), py::arg("max_depth") = py::none(),

@@ -21,7 +21,8 @@ std::string where(const std::string& what, const std::string& path) {
 }
 
 Json convert(const py::handle& h, const std::string& what, const std::string& path, int depth) {
-    if (depth > kMaxDepth) throw py::value_error(where(what, path) + ": nested too deeply (does it contain itself?)");
+    if (depth > kMaxDepth)
+        throw py::value_error(where(what, path) + ": nested too deeply (does it contain itself?)");
     if (h.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(h)) return h.cast<bool>();
     if (py::isinstance<py::int_>(h)) {
@@ -59,7 +60,9 @@ Json convert(const py::handle& h, const std::string& what, const std::string& pa
 
 }  // namespace
 
-Json json_from_python(const py::handle& value, const std::string& what) { return convert(value, what, "", 0); }
+Json json_from_python(const py::handle& value, const std::string& what) {
+    return convert(value, what, "", 0);
+}
 
 py::object python_from_json(const nlohmann::json& value) {
     return py::module_::import("json").attr("loads")(value.dump());
