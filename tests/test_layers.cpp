@@ -28,7 +28,10 @@ const std::map<std::string, std::set<std::string>>& allowed_includes() {
         {"io", {"math", "base", "geometry", "desc"}},
         {"scene", {"math", "base", "geometry", "accel", "desc"}},
         {"render", {"math", "base", "geometry", "desc", "scene"}},
-        {"app", {"math", "base", "geometry", "accel", "desc", "io", "scene", "render"}},
+        {"pipeline", {"math", "base", "geometry", "accel", "desc", "io", "scene", "render"}},
+        {"app", {"math", "base", "geometry", "accel", "desc", "io", "scene", "render", "pipeline"}},
+        // The Python module binds the library, never the command line.
+        {"python", {"math", "base", "geometry", "accel", "desc", "io", "scene", "render", "pipeline"}},
     };
     return table;
 }

@@ -11,9 +11,9 @@
 #include <tuple>
 
 #include "scene/accelerator.h"
-#include "app/bench_rays.h"
+#include "pipeline/bench_rays.h"
 #include "app/commands.h"
-#include "app/mesh_input.h"
+#include "pipeline/mesh_input.h"
 #include "app/ray_batch.h"
 #include "app/cli_args.h"
 #include "accel/packet.h"

@@ -16,6 +16,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_io.h"
+#include "pipeline/render_pipeline.h"
 #include "render/progress.h"
 #include "render/renderer.h"
 #include "render/bvh_cost.h"
@@ -320,15 +321,9 @@ int render_one(const RenderArgs& a, const std::function<SceneDesc()>& load_scene
         PhaseTimes times;
         auto t = Clock::now();
         SceneDesc desc = load_scene();
-        a.overrides.apply(desc.render);
-        if (a.frame) {
-            // Frame f sees the scene at times f + shutter: moving objects move on.
-            desc.camera.shutter_open += float(*a.frame);
-            desc.camera.shutter_close += float(*a.frame);
-        }
         times.load = seconds_since(t);
         t = Clock::now();
-        const Scene scene = build_scene(desc);
+        const Scene scene = prepare_scene(desc, a.overrides, a.frame);
         times.build = seconds_since(t);
         // One primary ray per pixel: rank 0 alone draws it.
         if (scene.render.integrator == IntegratorType::bvh_cost) return root ? write_bvh_cost(a, scene) : 0;

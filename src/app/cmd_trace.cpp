@@ -14,7 +14,7 @@
 
 #include "scene/accelerator.h"
 #include "app/commands.h"
-#include "app/mesh_input.h"
+#include "pipeline/mesh_input.h"
 #include "app/cli_args.h"
 #include "base/error.h"
 #include "base/pending_file.h"

@@ -87,22 +87,6 @@ std::string frame_output_name(const std::string& pattern, int frame) {
                      "' needs # or %04d where the frame number goes");
 }
 
-void RenderOverrides::apply(RenderSettings& r) const {
-    if (width) r.width = *width;
-    if (height) r.height = *height;
-    if (spp) r.spp = *spp;
-    if (max_depth) r.max_depth = *max_depth;
-    if (seed) r.seed = *seed;
-    if (integrator) r.integrator = *integrator;
-    if (time_limit_s) r.time_limit_s = *time_limit_s;
-    if (target_error) r.target_error = *target_error;
-    if (exposure) r.exposure = *exposure;
-    if (tonemap) r.tonemap = *tonemap;
-    if (sampler) r.sampler = *sampler;
-    if (bvh_builder) r.bvh_builder = *bvh_builder;
-    if (bvh_layout) r.bvh_layout = *bvh_layout;
-}
-
 void parse_render_args(const std::vector<std::string>& args, RenderArgs& r,
                        const std::function<void(CLI::App&)>& extra) {
     CLI::App app;

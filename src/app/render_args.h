@@ -9,23 +9,9 @@
 
 #include "app/cli_args.h"
 #include "desc/scene_desc.h"
+#include "pipeline/render_pipeline.h"  // RenderOverrides
 
 namespace sahara {
-
-/// Render settings given on the command line; each overrides the scene's value.
-struct RenderOverrides {
-    std::optional<int> width, height, spp, max_depth;
-    std::optional<uint64_t> seed;
-    std::optional<IntegratorType> integrator;
-    std::optional<double> time_limit_s, target_error;
-    std::optional<float> exposure;
-    std::optional<Tonemap> tonemap;
-    std::optional<SamplerType> sampler;
-    std::optional<BvhBuilder> bvh_builder;
-    std::optional<BvhLayout> bvh_layout;
-
-    void apply(RenderSettings& r) const;
-};
 
 struct RenderArgs {
     std::optional<std::string> scene;  ///< none: the built-in default scene

@@ -7,7 +7,7 @@
 #include "base/error.h"
 #include "io/plot.h"
 #include "math/rng.h"
-#include "render/tonemap.h"
+#include "pipeline/render_pipeline.h"
 
 namespace sahara {
 
@@ -133,15 +133,10 @@ ImageMetadata render_metadata(const Scene& scene, const Film& film, const Render
 
 size_t write_render(const std::filesystem::path& file, const Scene& scene, const Film& film,
                     const ImageMetadata& metadata, std::optional<float> exposure) {
-    std::vector<float> rgb = film.to_rgb();
-    if (!is_hdr_output(file)) {
-        size_t clipped = 0;
-        rgb = tonemap_image(rgb, exposure.value_or(scene.render.exposure), scene.render.tonemap, &clipped);
-        write_image(file, film.width(), film.height(), rgb, metadata);
-        return clipped;
-    }
-    write_image(file, film.width(), film.height(), rgb, metadata, state_channels(film));
-    return 0;
+    const bool hdr = is_hdr_output(file);
+    return write_rgb_image(file, film.width(), film.height(), film.to_rgb(),
+                           exposure.value_or(scene.render.exposure), scene.render.tonemap, metadata,
+                           hdr ? state_channels(film) : std::vector<ExtraChannel>{});
 }
 
 double resume_film(const std::filesystem::path& file, const Scene& scene, Film& film) {

@@ -26,12 +26,25 @@ fs::path executable_dir() {
     return fs::path(buf).parent_path();
 }
 
+/// The directory of the shared object this code is linked into (the Python
+/// extension module), or empty when it is linked into the executable itself.
+fs::path shared_object_dir() {
+    Dl_info info{};
+    if (::dladdr(reinterpret_cast<void*>(&shared_object_dir), &info) == 0 || !info.dli_fname) return {};
+    const fs::path file(info.dli_fname);
+    if (!file.is_absolute() || file.extension() != ".so") return {};  // the executable: not ours to add
+    return file.parent_path();
+}
+
 /// Where the plugin may be, in the order tried (see kImageCodecLibrary).
 std::vector<fs::path> candidate_files() {
     if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) return {forced};
+    std::vector<fs::path> files;
+    // Inside a Python interpreter the executable is python3: the module keeps its plugin beside itself.
+    if (const fs::path own = shared_object_dir(); !own.empty()) files.push_back(own / kImageCodecLibrary);
     const fs::path dir = executable_dir();
-    if (dir.empty()) return {};
-    std::vector<fs::path> files{dir / kImageCodecLibrary};
+    if (dir.empty()) return files;
+    files.push_back(dir / kImageCodecLibrary);
 #ifdef SAHARA_CODEC_RELATIVE_DIR
     // The installed layout's bin -> plugin directory, computed by CMake.
     files.push_back((dir / SAHARA_CODEC_RELATIVE_DIR / kImageCodecLibrary).lexically_normal());

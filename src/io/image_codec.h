@@ -70,7 +70,8 @@ inline constexpr int kImageCodecVersion = 3;
 inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
 /// The plugin's file name. It is looked for relative to the executable, never at
 /// a path fixed at build time, so an installed or moved sahara finds its own copy:
-/// beside the executable (the build tree), then in the plugin directory of the
+/// beside the shared object the library is linked into (the Python module's
+/// package directory), beside the executable (the build tree), then in the plugin directory of the
 /// installed layout (lib/sahara beside bin by default; CMake compiles in the
 /// relative path). SAHARA_IMAGE_CODEC, when set, names the file to load instead.
 inline constexpr const char* kImageCodecLibrary = "libsahara_image_codec.so";

@@ -276,6 +276,15 @@ SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path&
 
 SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file,
                            const SceneLoaders& loaders) {
+    return parse_scene_value(parse_json_text(text, file.string()), file, loaders);
+}
+
+SceneDesc parse_scene_value(const Json& root_json, const std::filesystem::path& file) {
+    return parse_scene_value(root_json, file, SceneLoaders::standard());
+}
+
+SceneDesc parse_scene_value(const Json& root_json, const std::filesystem::path& file,
+                            const SceneLoaders& loaders) {
     SceneDesc scene;
     ParseContext ctx;
     ctx.file = file.string();
@@ -285,7 +294,6 @@ SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path&
     scene.source = ctx.file;
     scene.materials.push_back(default_material());
 
-    const Json root_json = parse_json_text(text, ctx.file);
     JsonObject root(JsonValue(root_json, ctx.file, ""));
     if (auto v = root.get("format")) v->one_of({"scene/1"});
     if (auto v = root.get("render")) parse_render(JsonObject(*v), scene.render);

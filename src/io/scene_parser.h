@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "io/json_reader.h"
 #include "io/model_loader.h"
 #include "desc/scene_desc.h"
 
@@ -33,6 +34,12 @@ SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path&
 /// As above, with substitute loaders.
 SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file,
                            const SceneLoaders& loaders);
+
+/// Parses an already-parsed JSON document (e.g. built from a Python dict) with
+/// the same checks and messages as a file; `file` names it in messages and its
+/// parent directory is the base for relative paths.
+SceneDesc parse_scene_value(const Json& root, const std::filesystem::path& file);
+SceneDesc parse_scene_value(const Json& root, const std::filesystem::path& file, const SceneLoaders& loaders);
 
 /// The built-in scene (the workshop's final image): a red sphere on a big green
 /// ground sphere under the white-to-blue gradient sky, z up.

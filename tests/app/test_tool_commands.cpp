@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "app/bench_rays.h"
+#include "pipeline/bench_rays.h"
 #include "app/commands.h"
 #include "app/ray_batch.h"
 #include "cli_test_util.h"

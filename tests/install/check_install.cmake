@@ -1,7 +1,10 @@
 # ctest install_tree: installs the build into a temporary prefix, copies the
 # installed tree elsewhere (so neither the build tree nor the install prefix can
-# be what it uses), and renders PNG and EXR with the copied bin/sahara.
-#   cmake -DBUILD_DIR=<build tree> [-DOBJCOPY=<objcopy>] -P check_install.cmake
+# be what it uses), and renders PNG and EXR with the copied bin/sahara and,
+# when the Python module is built, with the copied Python package.
+#   cmake -DBUILD_DIR=<build tree> [-DOBJCOPY=<objcopy>]
+#         [-DPYTHON_EXECUTABLE=<python3> -DPYTHON_INSTALL_DIR=<site-packages relative to the prefix>]
+#         -P check_install.cmake
 if(NOT BUILD_DIR)
   message(FATAL_ERROR "usage: cmake -DBUILD_DIR=<build tree> -P check_install.cmake")
 endif()
@@ -75,6 +78,19 @@ execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=SAHARA_IMAGE_CODEC "${
 string(FIND "${version}" "plugin ${moved}/" where)
 if(NOT code EQUAL 0 OR where EQUAL -1)
   fail("sahara --version does not report the plugin under ${moved}:\n${version}")
+endif()
+
+if(PYTHON_EXECUTABLE)
+  set(site "${moved}/${PYTHON_INSTALL_DIR}")
+  set(script "import sahara, sys; img = sahara.render(width=8, height=6, spp=1); \
+sahara.write_image(sys.argv[1], img); print(sahara.__file__)")
+  execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=SAHARA_IMAGE_CODEC "PYTHONPATH=${site}"
+                          "${PYTHON_EXECUTABLE}" -c "${script}" "${root}/py.png"
+                  RESULT_VARIABLE code OUTPUT_VARIABLE where ERROR_VARIABLE err)
+  string(FIND "${where}" "${site}/sahara/" inside)
+  if(NOT code EQUAL 0 OR inside EQUAL -1 OR NOT EXISTS "${root}/py.png")
+    fail("the installed Python package did not import and render from ${site} (exit ${code}): ${where}${err}")
+  endif()
 endif()
 
 file(REMOVE_RECURSE "${root}")

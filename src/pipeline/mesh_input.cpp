@@ -1,4 +1,4 @@
-#include "app/mesh_input.h"
+#include "pipeline/mesh_input.h"
 
 #include "base/error.h"
 #include "io/scene_parser.h"

@@ -1,4 +1,4 @@
-#include "app/bench_rays.h"
+#include "pipeline/bench_rays.h"
 
 #include <cmath>
 #include <numbers>

@@ -1,0 +1,61 @@
+#include "pipeline/render_pipeline.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "base/error.h"
+#include "io/model_loader.h"
+#include "io/scene_parser.h"
+#include "io/view_scene.h"
+#include "render/tonemap.h"
+
+namespace sahara {
+
+void RenderOverrides::apply(RenderSettings& r) const {
+    if (width) r.width = *width;
+    if (height) r.height = *height;
+    if (spp) r.spp = *spp;
+    if (max_depth) r.max_depth = *max_depth;
+    if (seed) r.seed = *seed;
+    if (integrator) r.integrator = *integrator;
+    if (time_limit_s) r.time_limit_s = *time_limit_s;
+    if (target_error) r.target_error = *target_error;
+    if (exposure) r.exposure = *exposure;
+    if (tonemap) r.tonemap = *tonemap;
+    if (sampler) r.sampler = *sampler;
+    if (bvh_builder) r.bvh_builder = *bvh_builder;
+    if (bvh_layout) r.bvh_layout = *bvh_layout;
+}
+
+SceneDesc load_scene_source(const std::optional<std::string>& source) {
+    if (!source) return default_scene();
+    std::string ext = std::filesystem::path(*source).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".obj" || ext == ".gltf" || ext == ".glb")
+        return make_view_scene(load_model(*source), ext != ".obj", ViewOptions{}, *source);
+    return parse_scene_file(*source);
+}
+
+Scene prepare_scene(SceneDesc& desc, const RenderOverrides& overrides, std::optional<int> frame) {
+    overrides.apply(desc.render);
+    if (frame) {
+        desc.camera.shutter_open += float(*frame);
+        desc.camera.shutter_close += float(*frame);
+    }
+    return build_scene(desc);
+}
+
+size_t write_rgb_image(const std::filesystem::path& file, int width, int height,
+                       const std::vector<float>& rgb, float exposure, Tonemap tonemap,
+                       const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
+    if (is_hdr_output(file)) {
+        write_image(file, width, height, rgb, metadata, extra);
+        return 0;
+    }
+    size_t clipped = 0;
+    write_image(file, width, height, tonemap_image(rgb, exposure, tonemap, &clipped), metadata);
+    return clipped;
+}
+
+}  // namespace sahara

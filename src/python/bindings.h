@@ -1,0 +1,24 @@
+#pragma once
+/// The parts of `import sahara` besides the ray caster: rendering, scenes,
+/// image writing and the exception types.
+#include <pybind11/pybind11.h>
+
+#include "io/json_reader.h"
+
+namespace sahara::python {
+
+/// sahara.InputError (a ValueError): bad scene input, with the CLI's message.
+void bind_errors(pybind11::module_& m);
+/// sahara.Scene, render and write_image (the _sahara functions __init__.py wraps).
+void bind_render(pybind11::module_& m);
+
+/// A Python dict/list/str/number/bool/None tree as JSON, for the scene parser.
+/// Raises TypeError/ValueError naming `what` and the key path of a value that
+/// has no JSON form (a set, a non-string key, a self-containing list...).
+Json json_from_python(const pybind11::handle& value, const std::string& what);
+
+/// A JSON document as the equivalent Python dict/list/... tree (keys in the document's order).
+pybind11::object python_from_json(const nlohmann::json& value);
+pybind11::object python_from_json(const Json& value);
+
+}  // namespace sahara::python
