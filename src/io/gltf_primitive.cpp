@@ -201,9 +201,10 @@ void apply_skin(const Source& src, const tinygltf::Primitive& prim, const std::s
             throw input_error(src.file, element + ".attributes." + js, "element count differs from POSITION");
         for (size_t i = 0; i < n; ++i) {
             for (size_t k = 0; k < 4; ++k)
-                if (weights[4 * i + k] != 0.0 && joints[4 * i + k] >= double(joint_matrices.size()))
+                if (weights[4 * i + k] != 0.0 &&
+                    !(joints[4 * i + k] >= 0.0 && joints[4 * i + k] < double(joint_matrices.size())))
                     throw input_error(src.file, element + ".attributes." + js,
-                                      "joint " + std::to_string(size_t(joints[4 * i + k])) + " out of range");
+                                      "joint index " + std::to_string(joints[4 * i + k]) + " out of range");
             const Mat4 m = blend(joint_matrices, &joints[4 * i], &weights[4 * i], 4);
             for (size_t a = 0; a < 4; ++a)
                 for (size_t b = 0; b < 4; ++b) sum[i].m[a][b] = (set == 0 ? 0.0 : sum[i].m[a][b]) + m.m[a][b];

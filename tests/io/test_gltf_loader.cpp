@@ -224,14 +224,14 @@ TEST_CASE("the glTF files in tests/data load with their published counts") {
     for (const Expect& e : expect) check_gltf_loads(kTestData / e.path, e.scene_tris, e.exact_box);
 }
 
-TEST_CASE("a Duck-like glTF (scaled root, camera child, interleaved strides) loads whole, .gltf and .glb") {
+TEST_CASE("a Duck-like glTF (scaled root / camera child / interleaved strides) loads whole / .gltf and .glb") {
     const auto [gltf, glb] = write_duck_like(scratch("duck_counts"), "duck");
     const size_t tris = make_icosphere(4).triangle_count();
     check_gltf_loads(gltf, tris, true);
     check_gltf_loads(glb, tris, true);
 }
 
-TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale, and Cameras has both kinds") {
+TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale and Cameras has both kinds") {
     const fs::path duck_file = write_duck_like(scratch("duck_camera"), "duck").first;
     const LoadedModel duck = load_gltf(duck_file);
     REQUIRE(duck.cameras.size() == 1);
@@ -259,7 +259,7 @@ TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale, a
     CHECK(cams.cameras[1].basis_right == Vec3(1, 0, 0));
 }
 
-TEST_CASE("glTF node transforms: T * R * S, parents first, then world_from_model") {
+TEST_CASE("glTF node transforms: T * R * S / parents first / then world_from_model") {
     Doc d;
     const int mesh = d.mesh(d.positions({1, 0, 0, 0, 1, 0, 0, 0, 1}));
     const int child =
@@ -332,7 +332,7 @@ TEST_CASE("glTF triangle strips and fans become consistently wound lists") {
             CHECK(face_normal(mesh, t).z == doctest::Approx(1));
 }
 
-TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView") {
+TEST_CASE("glTF sparse accessors are applied / with and without a base bufferView") {
     Doc d;
     const int pos = d.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 5, 5});
     const size_t idx_at = d.blob.add(std::vector<uint16_t>{3, 0});
@@ -359,7 +359,7 @@ TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView
     CHECK(m.meshes[1].positions[3] == Vec3(1, 1, 0));
 }
 
-TEST_CASE("glTF buffers: external .bin, data URI and .glb give the same mesh") {
+TEST_CASE("glTF buffers: external .bin / data URI and .glb give the same mesh") {
     const fs::path dir = scratch("containers");
     Doc d;
     const int pos = d.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0});

@@ -10,7 +10,7 @@
 using namespace sahara;
 using namespace sahara::test::gltf;
 
-TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, sRGB decoding") {
+TEST_CASE("glTF materials: base colour factor x texture / alpha modes / emission / sRGB decoding") {
     const fs::path dir = scratch("materials");
     const std::vector<uint8_t> png = tiny_png(dir);
     const json material = {{"pbrMetallicRoughness",
@@ -160,7 +160,7 @@ TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through scene/te
     CHECK(near(sample(obj, 2), red));    // (0.25, 0.75): top left
 }
 
-TEST_CASE("glTF: the material's TEXCOORD set, normalized byte normals, u8 and u32 indices") {
+TEST_CASE("glTF: the material's TEXCOORD set / normalized byte normals / u8 and u32 indices") {
     const fs::path dir = scratch("sets");
     Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}});
     d.j["images"] = {{{"uri", "data:image/png;base64," + base64(tiny_png(dir))}}};
