@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -31,18 +33,30 @@ std::vector<double> read_accessor(const Source& src, int index, const std::strin
 /// Reads an index accessor (unsigned byte/short/int scalars).
 std::vector<uint32_t> read_indices(const Source& src, int index, const std::string& user);
 
+/// A textureInfo: core (tinygltf::TextureInfo) or inside an extension object.
+struct TextureRef {
+    int index = -1;
+    int texcoord = 0;
+    const tinygltf::Value* transform = nullptr;  ///< KHR_texture_transform, if present
+};
+
 /// Converts glTF materials (and their textures and images) on demand.
 class Materials {
    public:
     Materials(const Source& src, LoadedModel& out);
-    /// Index into out.materials for glTF material `index` (-1: a default material).
-    uint32_t get(int index, const std::string& user);
-    /// The TEXCOORD set the material's base colour (else emissive) texture reads.
-    int texcoord_set(int index) const;
+    /// Index into out.materials for glTF material `index` (-1: a default material),
+    /// used by a primitive with COLOR_0 if `vertex_colors`.
+    uint32_t get(int index, const std::string& user, bool vertex_colors);
 
    private:
     MaterialDesc convert(const tinygltf::Material& m, const std::string& element);
+    void set_alpha(MaterialDesc& out, const tinygltf::Material& m, float factor_alpha, int base_tex,
+                   const std::string& element);
+    void set_emission(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);
+    void set_extensions(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);
+    std::optional<TextureRef> texture_info(const tinygltf::Value& ext, const char* key) const;
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
+    int texture(const TextureRef& ref, bool srgb, const std::string& element);
     std::shared_ptr<const Image> image(int index, bool srgb, const std::string& element);
     std::shared_ptr<const Image> decode_buffer_view_image(const tinygltf::Image& img, bool srgb,
                                                           const std::string& element);
@@ -52,7 +66,19 @@ class Materials {
     std::map<int, uint32_t> converted_;
     std::map<std::string, int> texture_keys_;
     std::map<std::pair<int, bool>, std::shared_ptr<const Image>> images_;
+    std::set<std::string> ignored_;  ///< extensions already warned about
 };
+
+/// Primitive `p` of mesh `mesh` in model space: triangles, normals, both uv sets,
+/// COLOR_0 and TANGENT, with morph target i added at `weights[i]`. Nothing for
+/// points, lines and primitives without POSITION (with a warning). No material.
+std::optional<TriangleMesh> read_primitive(const Source& src, size_t mesh, size_t p,
+                                           const std::vector<double>& weights);
+
+/// Linear blend skinning of `mesh` (read from `prim`) by JOINTS_n/WEIGHTS_n with
+/// `joint_matrices[k]` = world matrix of skin joint k x its inverse bind matrix.
+void apply_skin(const Source& src, const tinygltf::Primitive& prim, const std::string& element,
+                const std::vector<Mat4>& joint_matrices, TriangleMesh& mesh);
 
 /// Walks the default scene (node transforms, then `world_from_model`) into
 /// meshes, cameras and lights of `out`; drops zero-area triangles.

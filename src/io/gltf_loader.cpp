@@ -10,6 +10,7 @@
 #include <numeric>
 #include <optional>
 #include <set>
+#include <sstream>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -23,8 +24,40 @@ namespace {
 using gltf::Source;
 
 /// Extensions sahara understands; any other in extensionsRequired is refused.
-const std::set<std::string> kSupportedRequired = {"KHR_texture_transform", "KHR_materials_emissive_strength",
-                                                  "KHR_lights_punctual", "KHR_mesh_quantization"};
+const std::set<std::string> kSupportedRequired = {
+    "KHR_texture_transform",      "KHR_materials_emissive_strength",
+    "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_volume",       "KHR_lights_punctual",
+    "KHR_mesh_quantization"};
+
+/// "major.minor" as two numbers; nothing if the text is not of that form.
+std::optional<std::pair<int, int>> version_numbers(const std::string& text) {
+    int major = 0, minor = 0;
+    char dot = 0, extra = 0;
+    std::istringstream in(text);
+    if (!(in >> major >> dot >> minor) || dot != '.' || (in >> extra)) return std::nullopt;
+    return std::make_pair(major, minor);
+}
+
+/// A 2.0 loader must refuse files whose minVersion is above 2.0 (glTF 2.0, "Versioning").
+void check_version(const std::string& file, const nlohmann::json& doc) {
+    auto asset = doc.find("asset");
+    if (asset == doc.end() || !asset->is_object()) return;  // tinygltf names a missing asset
+    if (auto min = asset->find("minVersion"); min != asset->end() && min->is_string()) {
+        const auto v = version_numbers(min->get<std::string>());
+        if (!v)
+            throw input_error(file, "asset.minVersion",
+                              "'" + min->get<std::string>() + "' is not major.minor");
+        if (*v > std::make_pair(2, 0))
+            throw input_error(file, "asset.minVersion",
+                              min->get<std::string>() + " is required, this loader reads glTF 2.0");
+    }
+    if (auto ver = asset->find("version"); ver != asset->end() && ver->is_string()) {
+        const auto v = version_numbers(ver->get<std::string>());
+        if (v && v->first != 2)
+            throw input_error(file, "asset.version", ver->get<std::string>() + " is not glTF 2.x");
+    }
+}
 
 std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
     std::error_code ec;
@@ -77,6 +110,7 @@ JsonPart json_part(const std::string& file, const std::vector<unsigned char>& by
 void precheck(const std::string& file, const std::filesystem::path& dir, const JsonPart& part) {
     const nlohmann::json doc = nlohmann::json::parse(part.text.begin(), part.text.end(), nullptr, false);
     if (!doc.is_object()) return;  // tinygltf reports the syntax error
+    check_version(file, doc);
     if (auto req = doc.find("extensionsRequired"); req != doc.end() && req->is_array())
         for (const auto& ext : *req)
             if (ext.is_string() && !kSupportedRequired.count(ext.get<std::string>()))

@@ -1,8 +1,11 @@
-// glTF materials -> MaterialDesc (Lambertian albedo from the base colour,
-// emission, alpha), textures -> TextureDesc with the uv convention of
-// scene_desc.h, images decoded through OpenImageIO.
+// glTF materials -> MaterialDesc of type pbr (every core input and the
+// transmission, ior, volume and emissive-strength extensions), textures ->
+// TextureDesc with the uv convention of scene_desc.h, images decoded through
+// OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "base/error.h"
@@ -39,57 +42,75 @@ Vec2 pair(const tinygltf::Value& v, const char* key, Vec2 fallback) {
     return {float(a.Get(0).GetNumberAsDouble()), float(a.Get(1).GetNumberAsDouble())};
 }
 
-/// KHR_texture_transform maps glTF uvs t = o + R(a) S p, where the spec's GLSL
-/// mat3(cos, sin, 0, -sin, cos, 0, ...) is column-major: R(a) = [cos -sin; sin cos].
+/// KHR_texture_transform maps glTF uvs t = o + R S p. The spec's GLSL and its
+/// worked example disagree about R; the example ("offset [0, 1], rotation pi/2,
+/// scale 0.5 uses the lower left quadrant rotated clockwise"), the Khronos sample
+/// viewer, three.js and the TextureTransformTest model all use R(a) = [cos sin; -sin cos].
 /// sahara's uvs are F(p) = (u, 1 - v), so the same lookup in sahara space is
 /// F(T(F(uv))) = offset' + D R(a) D S uv with D = diag(1, -1), where D R(a) D =
-/// [cos sin; -sin cos] is TextureDesc's rotate(a), and
-/// offset' = F(o + R(a) S (0, 1)) = (o.x - s.y sin a, 1 - o.y - s.y cos a).
+/// [cos -sin; sin cos] is TextureDesc's rotate(-a), and
+/// offset' = F(o + R(a) S (0, 1)) = (o.x + s.y sin a, 1 - o.y - s.y cos a).
 void set_transform(TextureDesc& t, Vec2 offset, float rotation, Vec2 scale) {
     const float s = std::sin(rotation), c = std::cos(rotation);
     t.uv_scale = scale;
-    t.uv_rotation = rotation;
-    t.uv_offset = {offset.x - scale.y * s, 1.0f - offset.y - scale.y * c};
+    t.uv_rotation = -rotation;
+    t.uv_offset = {offset.x + scale.y * s, 1.0f - offset.y - scale.y * c};
+}
+
+std::vector<double> numbers(const tinygltf::Value& v, const char* key) {
+    std::vector<double> out;
+    if (!v.Has(key) || !v.Get(key).IsArray()) return out;
+    const tinygltf::Value& a = v.Get(key);
+    for (size_t i = 0; i < a.ArrayLen(); ++i)
+        if (a.Get(int(i)).IsNumber()) out.push_back(a.Get(int(i)).GetNumberAsDouble());
+    return out;
+}
+
+const tinygltf::Value* transform_of(const tinygltf::ExtensionMap& extensions) {
+    auto it = extensions.find("KHR_texture_transform");
+    return it == extensions.end() ? nullptr : &it->second;
 }
 
 Rgb rgb_of(const std::vector<double>& v, Rgb fallback) {
-    if (v.size() < 3) return fallback;
+    if (v.size() < 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) return fallback;
     return Rgb(float(v[0]), float(v[1]), float(v[2]));
+}
+
+TextureRef texture_ref(const tinygltf::TextureInfo& info) {
+    return {info.index, info.texCoord, transform_of(info.extensions)};
 }
 
 }  // namespace
 
 Materials::Materials(const Source& src, LoadedModel& out) : src_(src), out_(out) {}
 
-uint32_t Materials::get(int index, const std::string& user) {
+uint32_t Materials::get(int index, const std::string& user, bool vertex_colors) {
     if (index >= 0 && size_t(index) >= src_.model.materials.size())
         throw input_error(src_.file, user, "material " + std::to_string(index) + " does not exist");
-    if (auto it = converted_.find(index); it != converted_.end()) return it->second;
-    const std::string element = "materials[" + std::to_string(index) + "]";
-    out_.materials.push_back(index < 0 ? default_material()
-                                       : convert(src_.model.materials[size_t(index)], element));
-    return converted_[index] = uint32_t(out_.materials.size() - 1);
-}
-
-int Materials::texcoord_set(int index) const {
-    if (index < 0 || size_t(index) >= src_.model.materials.size()) return 0;
-    const tinygltf::Material& m = src_.model.materials[size_t(index)];
-    const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture.index >= 0
-                                            ? m.pbrMetallicRoughness.baseColorTexture
-                                            : m.emissiveTexture;
-    int set = info.texCoord;
-    if (auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end())
-        set = int(number(it->second, "texCoord", set));
-    return set;
+    // Without a material, a primitive with COLOR_0 gets glTF's default material so
+    // that its colours show; without colours it keeps sahara's default grey.
+    const int key = index < 0 && vertex_colors ? -2 : index;
+    auto it = converted_.find(key);
+    if (it == converted_.end()) {
+        const std::string element = "materials[" + std::to_string(index) + "]";
+        MaterialDesc m = key == -1   ? default_material()
+                         : key == -2 ? convert(tinygltf::Material{}, "default (vertex colours)")
+                                     : convert(src_.model.materials[size_t(index)], element);
+        out_.materials.push_back(std::move(m));
+        it = converted_.emplace(key, uint32_t(out_.materials.size() - 1)).first;
+    }
+    if (vertex_colors) out_.materials[it->second].vertex_colors = true;
+    return it->second;
 }
 
 MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& element) {
     MaterialDesc out;
     out.name = m.name.empty() ? element : m.name;
+    out.type = MaterialType::pbr;
+    out.double_sided = m.doubleSided;
     const auto& pbr = m.pbrMetallicRoughness;
     const std::vector<double>& f = pbr.baseColorFactor;
     out.albedo.color = rgb_of(f, Rgb(1.0f));
-    const float factor_alpha = f.size() >= 4 ? float(f[3]) : 1.0f;
     int base_tex = -1;
     if (pbr.baseColorTexture.index >= 0) {
         base_tex = texture(pbr.baseColorTexture, true, element + ".pbrMetallicRoughness.baseColorTexture");
@@ -98,35 +119,99 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
             out.albedo.texture = base_tex;
         }
     }
-    if (m.alphaMode == "MASK" || m.alphaMode == "BLEND") {
-        out.alpha = std::clamp(factor_alpha, 0.0f, 1.0f);
-        out.alpha_texture = base_tex;
-        if (m.alphaMode == "MASK") out.alpha_cutoff = float(m.alphaCutoff);
+    set_alpha(out, m, f.size() >= 4 ? float(f[3]) : 1.0f, base_tex, element);
+    out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+    out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+    if (pbr.metallicRoughnessTexture.index >= 0)
+        out.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, false,
+                                                 element + ".pbrMetallicRoughness.metallicRoughnessTexture");
+    if (m.normalTexture.index >= 0) {
+        const TextureRef ref{m.normalTexture.index, m.normalTexture.texCoord,
+                             transform_of(m.normalTexture.extensions)};
+        out.normal_texture = texture(ref, false, element + ".normalTexture");
+        out.normal_scale = float(m.normalTexture.scale);
     }
-    float strength = 1.0f;
-    if (auto it = m.extensions.find("KHR_materials_emissive_strength"); it != m.extensions.end())
-        strength = float(number(it->second, "emissiveStrength", 1.0));
-    const Rgb emission = rgb_of(m.emissiveFactor, Rgb(0.0f)) * strength;
-    if (max_component(emission) > 0.0f) {
-        out.type = MaterialType::emissive;
-        out.radiance.color = emission;
-        if (m.emissiveTexture.index >= 0) {
-            const int t = texture(m.emissiveTexture, true, element + ".emissiveTexture");
-            if (t >= 0) {
-                out.radiance.kind = ColorSource::Kind::texture;
-                out.radiance.texture = t;
-            }
-        }
-    }
+    set_emission(out, m, element);
+    set_extensions(out, m, element);
     return out;
 }
 
+/// glTF alphaMode: OPAQUE ignores alpha entirely; MASK cuts at alphaCutoff;
+/// BLEND is rendered as stochastic transparency.
+void Materials::set_alpha(MaterialDesc& out, const tinygltf::Material& m, float factor_alpha, int base_tex,
+                          const std::string& element) {
+    if (m.alphaMode == "OPAQUE" || m.alphaMode.empty()) return;
+    if (m.alphaMode != "MASK" && m.alphaMode != "BLEND")
+        throw input_error(src_.file, element + ".alphaMode", "unknown mode '" + m.alphaMode + "'");
+    out.alpha = std::clamp(factor_alpha, 0.0f, 1.0f);
+    out.alpha_texture = base_tex;
+    if (m.alphaMode == "MASK") out.alpha_cutoff = float(m.alphaCutoff);
+}
+
+/// emissiveFactor x emissiveTexture x KHR_materials_emissive_strength, added to
+/// what the surface reflects.
+void Materials::set_emission(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
+    float strength = 1.0f;
+    if (auto it = m.extensions.find("KHR_materials_emissive_strength"); it != m.extensions.end())
+        strength = std::max(0.0f, float(number(it->second, "emissiveStrength", 1.0)));
+    const Rgb emission = rgb_of(m.emissiveFactor, Rgb(0.0f)) * strength;
+    if (!(max_component(emission) > 0.0f)) return;  // a texture times a zero factor emits nothing
+    out.radiance.color = emission;
+    if (m.emissiveTexture.index >= 0) {
+        const int t = texture(m.emissiveTexture, true, element + ".emissiveTexture");
+        if (t >= 0) {
+            out.radiance.kind = ColorSource::Kind::texture;
+            out.radiance.texture = t;
+        }
+    }
+}
+
+/// KHR_materials_transmission, _ior and _volume; other material extensions
+/// are named once per file as ignored.
+void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
+    for (const auto& [name, value] : m.extensions) {
+        const std::string ext = element + ".extensions." + name;
+        if (name == "KHR_materials_transmission") {
+            out.transmission = std::clamp(float(number(value, "transmissionFactor", 0.0)), 0.0f, 1.0f);
+            if (auto info = texture_info(value, "transmissionTexture"))
+                out.transmission_texture = texture(*info, false, ext + ".transmissionTexture");
+        } else if (name == "KHR_materials_ior") {
+            const float ior = float(number(value, "ior", 1.5));
+            if (ior >= 1.0f)
+                out.ior = ior;
+            else
+                log_warning(src_.file + ": " + ext + ": ior " + std::to_string(ior) +
+                            " is below 1, 1.5 used");
+        } else if (name == "KHR_materials_volume") {
+            const float distance = float(number(value, "attenuationDistance", kInfinity));
+            if (distance > 0.0f) out.attenuation_distance = distance;
+            out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
+        } else if (name != "KHR_materials_emissive_strength" && ignored_.insert(name).second) {
+            log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
+        }
+    }
+}
+
+/// A textureInfo inside an extension object (tinygltf leaves those as JSON values).
+std::optional<TextureRef> Materials::texture_info(const tinygltf::Value& ext, const char* key) const {
+    if (!ext.Has(key) || !ext.Get(key).IsObject()) return std::nullopt;
+    const tinygltf::Value& v = ext.Get(key);
+    TextureRef ref{int(number(v, "index", -1)), int(number(v, "texCoord", 0)), nullptr};
+    if (v.Has("extensions") && v.Get("extensions").Has("KHR_texture_transform"))
+        ref.transform = &v.Get("extensions").Get("KHR_texture_transform");
+    return ref;
+}
+
 int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element) {
+    return texture(texture_ref(info), srgb, element);
+}
+
+int Materials::texture(const TextureRef& ref, bool srgb, const std::string& element) {
     const tinygltf::Model& m = src_.model;
-    if (size_t(info.index) >= m.textures.size())
-        throw input_error(src_.file, element, "texture " + std::to_string(info.index) + " does not exist");
-    const tinygltf::Texture& tex = m.textures[size_t(info.index)];
-    const std::string tex_name = "textures[" + std::to_string(info.index) + "]";
+    if (ref.index < 0 || size_t(ref.index) >= m.textures.size())
+        throw input_error(src_.file, element, "texture " + std::to_string(ref.index) + " does not exist");
+    const tinygltf::Texture& tex = m.textures[size_t(ref.index)];
+    const std::string tex_name = "textures[" + std::to_string(ref.index) + "]";
     if (tex.source < 0) {
         log_warning(src_.file + ": " + tex_name +
                     ": no image source (extension-only images are not supported), ignored");
@@ -141,15 +226,22 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
     }
     Vec2 offset{0, 0}, scale{1, 1};
     float rotation = 0.0f;
-    if (auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end()) {
-        offset = pair(it->second, "offset", offset);
-        scale = pair(it->second, "scale", scale);
-        rotation = float(number(it->second, "rotation", 0.0));
+    desc.texcoord = ref.texcoord;
+    if (ref.transform) {
+        offset = pair(*ref.transform, "offset", offset);
+        scale = pair(*ref.transform, "scale", scale);
+        rotation = float(number(*ref.transform, "rotation", 0.0));
+        desc.texcoord = int(number(*ref.transform, "texCoord", desc.texcoord));
+    }
+    if (desc.texcoord != 0 && desc.texcoord != 1) {
+        log_warning(src_.file + ": " + element + ": TEXCOORD_" + std::to_string(desc.texcoord) +
+                    " is not supported (sets 0 and 1 are), set 0 used");
+        desc.texcoord = 0;
     }
     set_transform(desc, offset, rotation, scale);
     std::ostringstream key;
     key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x
-        << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation;
+        << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' ' << desc.texcoord;
     if (auto it = texture_keys_.find(key.str()); it != texture_keys_.end()) return it->second;
     desc.image = image(tex.source, srgb, tex_name);
     if (!desc.image) return texture_keys_[key.str()] = -1;

@@ -4,6 +4,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <tuple>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -16,31 +17,16 @@ namespace {
 
 std::string indexed(const char* kind, size_t i) { return std::string(kind) + "[" + std::to_string(i) + "]"; }
 
-/// Expands a strip or fan into a triangle list (glTF 2.0 spec, section 3.7.2.1:
-/// strip triangle i is {i, i+1+i%2, i+2-i%2}; fan triangle i is {i+1, i+2, 0}).
-std::vector<uint32_t> to_triangle_list(const std::vector<uint32_t>& idx, int mode) {
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
-        std::vector<uint32_t> out(idx.begin(), idx.begin() + std::ptrdiff_t(idx.size() / 3 * 3));
-        return out;
-    }
-    std::vector<uint32_t> out;
-    for (size_t i = 0; i + 2 < idx.size(); ++i) {
-        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP)
-            out.insert(out.end(), {idx[i], idx[i + 1 + i % 2], idx[i + 2 - i % 2]});
-        else
-            out.insert(out.end(), {idx[i + 1], idx[i + 2], idx[0]});
-    }
-    return out;
-}
-
 /// Builds world-space meshes, cameras and lights from the node tree.
 class SceneBuilder {
    public:
     SceneBuilder(const Source& src, const Mat4& world_from_model, LoadedModel& out)
         : src_(src), m_(src.model), world_from_model_(world_from_model), out_(out), materials_(src, out) {}
 
+    /// Node world matrices first (skins need their joints' matrices), then the meshes.
     void build() {
         for (int root : roots()) walk(root);
+        for (const auto& [node, world] : drawn_) add_mesh(node, world);
     }
 
    private:
@@ -79,7 +65,8 @@ class SceneBuilder {
             visited_[size_t(index)] = true;
             const tinygltf::Node& node = m_.nodes[size_t(index)];
             const Mat4 world = parent * local_matrix(node, element);
-            if (node.mesh >= 0) add_mesh(node.mesh, world, element);
+            node_world_[index] = world;
+            if (node.mesh >= 0) drawn_.emplace_back(index, world);
             if (node.camera >= 0) add_camera(node.camera, world, element);
             if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())
                 add_light(it->second, world, element);
@@ -119,84 +106,85 @@ class SceneBuilder {
         return result;
     }
 
-    void add_mesh(int mesh, const Mat4& world, const std::string& node_element) {
+    /// Default morph weights: the node's, else the mesh's, else zero (glTF 2.0, "Morph Targets").
+    std::vector<double> morph_weights(const tinygltf::Node& node, const tinygltf::Mesh& mesh,
+                                      const std::string& element) const {
+        const std::vector<double>& w = node.weights.empty() ? mesh.weights : node.weights;
+        for (double d : w)
+            if (!std::isfinite(d))
+                throw input_error(src_.file, element + ".weights", "is not a finite number");
+        return w;
+    }
+
+    void add_mesh(int node_index, const Mat4& world) {
+        const tinygltf::Node& node = m_.nodes[size_t(node_index)];
+        const std::string node_element = indexed("nodes", size_t(node_index));
+        const int mesh = node.mesh;
         if (size_t(mesh) >= m_.meshes.size())
             throw input_error(src_.file, node_element + ".mesh",
                               "mesh " + std::to_string(mesh) + " does not exist");
-        const auto& prims = m_.meshes[size_t(mesh)].primitives;
-        for (size_t p = 0; p < prims.size(); ++p) {
-            const auto key = std::make_pair(mesh, int(p));
-            if (!primitives_.count(key)) primitives_[key] = primitive(size_t(mesh), p);
+        const tinygltf::Mesh& gmesh = m_.meshes[size_t(mesh)];
+        const std::vector<double> weights = morph_weights(node, gmesh, node_element);
+        const std::optional<std::vector<Mat4>> joints = joint_matrices(node, node_element);
+        for (size_t p = 0; p < gmesh.primitives.size(); ++p) {
+            const auto key = std::make_tuple(mesh, int(p), weights);
+            if (!primitives_.count(key)) primitives_[key] = primitive(size_t(mesh), p, weights);
             const std::optional<TriangleMesh>& cached = primitives_[key];
             if (!cached) continue;
             TriangleMesh instance = *cached;
             instance.name = src_.file + ": " + node_element + " " + indexed("meshes", size_t(mesh)) + "." +
                             indexed("primitives", p);
-            transform_mesh(instance, world);
+            if (joints) {  // a skinned mesh ignores its node's transform (glTF 2.0, "Skins")
+                apply_skin(src_, gmesh.primitives[p],
+                           indexed("meshes", size_t(mesh)) + "." + indexed("primitives", p), *joints,
+                           instance);
+            } else {
+                transform_mesh(instance, world);
+            }
             out_.dropped_degenerate += remove_degenerate(instance);
             if (!instance.indices.empty()) out_.meshes.push_back(std::move(instance));
         }
     }
 
-    /// One primitive in model space, or nothing if it is not made of triangles.
-    std::optional<TriangleMesh> primitive(size_t mesh, size_t p) {
+    std::optional<TriangleMesh> primitive(size_t mesh, size_t p, const std::vector<double>& weights) {
+        std::optional<TriangleMesh> out = read_primitive(src_, mesh, p, weights);
+        if (!out) return out;
         const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
         const std::string element = indexed("meshes", mesh) + "." + indexed("primitives", p);
-        if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) {
-            log_warning(src_.file + ": " + element + ": points and lines are not rendered, skipped");
-            return std::nullopt;
-        }
-        if (prim.mode > TINYGLTF_MODE_TRIANGLE_FAN || prim.mode < 0)
-            throw input_error(src_.file, element + ".mode", "invalid mode " + std::to_string(prim.mode));
-        auto pos_it = prim.attributes.find("POSITION");
-        if (pos_it == prim.attributes.end()) {
-            log_warning(src_.file + ": " + element + ": no POSITION attribute, skipped");
-            return std::nullopt;
-        }
-        TriangleMesh out;
-        const std::vector<double> pos =
-            read_accessor(src_, pos_it->second, element + ".attributes.POSITION", 3);
-        const size_t n = pos.size() / 3;
-        for (size_t i = 0; i < n; ++i)
-            out.positions.emplace_back(float(pos[3 * i]), float(pos[3 * i + 1]), float(pos[3 * i + 2]));
-        if (auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-            const auto nrm = read_attribute(it->second, element + ".attributes.NORMAL", 3, n);
-            for (size_t i = 0; i < n; ++i) {
-                const Vec3 v{float(nrm[3 * i]), float(nrm[3 * i + 1]), float(nrm[3 * i + 2])};
-                out.normals.push_back(length_squared(v) > 0.0f ? normalize(v) : v);
-            }
-        }
-        const std::string uv_name = "TEXCOORD_" + std::to_string(materials_.texcoord_set(prim.material));
-        if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
-            const auto uv = read_attribute(it->second, element + ".attributes." + uv_name, 2, n);
-            for (size_t i = 0; i < n; ++i)
-                out.uvs.push_back({float(uv[2 * i]), 1.0f - float(uv[2 * i + 1])});  // v=0 at bottom
-        }
-        std::vector<uint32_t> idx;
-        if (prim.indices >= 0) {
-            idx = read_indices(src_, prim.indices, element + ".indices");
-            for (uint32_t i : idx)
-                if (i >= n)
-                    throw input_error(
-                        src_.file, element + ".indices",
-                        "index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
-        } else {
-            idx.resize(n);
-            std::iota(idx.begin(), idx.end(), 0u);
-        }
-        out.indices = to_triangle_list(idx, prim.mode);
-        out.material = materials_.get(prim.material, element + ".material");
+        out->material = materials_.get(prim.material, element + ".material", !out->colors.empty());
         return out;
     }
 
-    std::vector<double> read_attribute(int accessor, const std::string& element, int components,
-                                       size_t count) {
-        std::vector<double> v = read_accessor(src_, accessor, element, components);
-        if (v.size() != count * size_t(components))
-            throw input_error(src_.file, element,
-                              "has " + std::to_string(v.size() / size_t(components)) +
-                                  " elements, POSITION has " + std::to_string(count));
-        return v;
+    /// For a skinned node: world_from_model x each joint's world matrix x its inverse
+    /// bind matrix, posing the mesh as the nodes stand (the bind pose unless the file
+    /// stores another); nothing for unskinned nodes.
+    std::optional<std::vector<Mat4>> joint_matrices(const tinygltf::Node& node, const std::string& element) {
+        if (node.skin < 0) return std::nullopt;
+        if (size_t(node.skin) >= m_.skins.size())
+            throw input_error(src_.file, element + ".skin",
+                              "skin " + std::to_string(node.skin) + " does not exist");
+        const tinygltf::Skin& skin = m_.skins[size_t(node.skin)];
+        const std::string skin_element = indexed("skins", size_t(node.skin));
+        std::vector<double> ibm;
+        if (skin.inverseBindMatrices >= 0)
+            ibm = read_accessor(src_, skin.inverseBindMatrices, skin_element + ".inverseBindMatrices", 16);
+        if (!ibm.empty() && ibm.size() != 16 * skin.joints.size())
+            throw input_error(src_.file, skin_element + ".inverseBindMatrices", "needs one matrix per joint");
+        std::vector<Mat4> out;
+        for (size_t k = 0; k < skin.joints.size(); ++k) {
+            auto it = node_world_.find(skin.joints[k]);
+            if (it == node_world_.end()) {
+                log_warning(src_.file + ": " + skin_element + ": joint " + std::to_string(skin.joints[k]) +
+                            " is not in the scene, mesh drawn unskinned");
+                return std::nullopt;
+            }
+            Mat4 inverse_bind;
+            for (size_t r = 0; r < 4 && !ibm.empty(); ++r)
+                for (size_t c = 0; c < 4; ++c)
+                    inverse_bind.m[r][c] = ibm[16 * k + c * 4 + r];  // column-major
+            out.push_back(it->second * inverse_bind);
+        }
+        return out;
     }
 
     /// Camera looks down its local -Z with +Y up (glTF 2.0 spec, "Cameras").
@@ -268,7 +256,9 @@ class SceneBuilder {
     LoadedModel& out_;
     Materials materials_;
     std::vector<bool> visited_;
-    std::map<std::pair<int, int>, std::optional<TriangleMesh>> primitives_;
+    std::map<int, Mat4> node_world_;           ///< world matrix of every node in the scene
+    std::vector<std::pair<int, Mat4>> drawn_;  ///< nodes with a mesh, in walk order
+    std::map<std::tuple<int, int, std::vector<double>>, std::optional<TriangleMesh>> primitives_;
 };
 
 }  // namespace

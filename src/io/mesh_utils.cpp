@@ -124,7 +124,14 @@ size_t remove_degenerate(TriangleMesh& mesh) {
 void transform_mesh(TriangleMesh& mesh, const Mat4& world_from_model) {
     for (Vec3& p : mesh.positions) p = world_from_model.apply_point(p);
     for (Vec3& n : mesh.normals) n = world_from_model.apply_normal(n);
-    if (world_from_model.determinant3() < 0)
+    const bool mirrors = world_from_model.determinant3() < 0;
+    for (auto& t : mesh.tangents) {
+        Vec3 v = world_from_model.apply_vector({t[0], t[1], t[2]});
+        if (length_squared(v) > 0.0f) v = normalize(v);
+        // A mirror flips the bitangent cross(n, t) relative to the mapped uv direction.
+        t = {v.x, v.y, v.z, mirrors ? -t[3] : t[3]};
+    }
+    if (mirrors)
         for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
             std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
 }

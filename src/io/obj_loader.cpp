@@ -16,6 +16,7 @@
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "io/obj_material.h"
 
 namespace sahara {
 
@@ -71,121 +72,31 @@ class MtlFileReader : public tinyobj::MaterialReader {
         }
         if (!found_) dir_ = path.parent_path();
         found_ = true;
+        files_.push_back(path);
         tinyobj::LoadMtl(names, materials, &in, warn, err);
         return true;
     }
 
     const std::filesystem::path& texture_dir() const { return dir_; }
+    /// The .mtl files read, in order.
+    const std::vector<std::filesystem::path>& files() const { return files_; }
 
    private:
     std::filesystem::path obj_file_, dir_;
+    std::vector<std::filesystem::path> files_;
     bool found_ = false;
 };
 
-/// tinyobjloader reads "nan" and "inf" as 0; sahara rejects them. Numbers in
-/// v/vn/vt lines only ever contain digits, signs, '.', 'e' and 'E'.
-void reject_non_finite_words(const std::string& file, const std::string& text) {
-    size_t counts[3] = {0, 0, 0};
-    const char* names[3] = {"v", "vt", "vn"};
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find('\n', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string_view line(text.data() + pos, end - pos);
-        pos = end + 1;
-        const size_t start = line.find_first_not_of(" \t");
-        if (start == std::string_view::npos || line[start] != 'v') continue;
-        int kind = -1;
-        const std::string_view rest = line.substr(start);
-        if (rest.size() > 1 && (rest[1] == ' ' || rest[1] == '\t'))
-            kind = 0;
-        else if (rest.size() > 2 && (rest[2] == ' ' || rest[2] == '\t'))
-            kind = rest[1] == 't' ? 1 : rest[1] == 'n' ? 2 : -1;
-        if (kind < 0) continue;
-        ++counts[kind];
-        const std::string_view numbers = rest.substr(0, rest.find('#'));  // comments may say anything
-        if (numbers.find_first_of("nNiI", kind == 0 ? 1 : 2) != std::string_view::npos)
-            throw input_error(file, std::string(names[kind]) + " #" + std::to_string(counts[kind]),
-                              "coordinate is not a finite number");
+/// True if each corner turns the same way about the quad's Newell normal (a
+/// non-planar quad is judged in that plane).
+bool is_convex_quad(const std::vector<Vec3>& q) {
+    const Vec3d n = newell_normal(q);
+    if (!(length_squared(n) > 0.0)) return false;
+    for (size_t i = 0; i < 4; ++i) {
+        const Vec3d a(q[i]), b(q[(i + 1) % 4]), c(q[(i + 2) % 4]);
+        if (!(dot(cross(b - a, c - b), n) > 0.0)) return false;
     }
-}
-
-/// What a texture is used for decides its decoding.
-enum class TexUse { color, alpha };
-
-/// Loads MTL textures once per (file, use) and turns them into TextureDesc.
-class ObjTextures {
-   public:
-    ObjTextures(LoadedModel& model, std::filesystem::path mtl_dir)
-        : model_(model), dir_(std::move(mtl_dir)) {}
-
-    /// Index into model.textures, or -1 (with a warning) when the file is missing.
-    int get(const std::string& name, const tinyobj::texture_option_t& opt, TexUse use,
-            const std::string& what) {
-        const std::filesystem::path path = dir_ / portable_path(name);
-        const auto key = std::make_pair(path.string(), use);
-        if (auto it = cache_.find(key); it != cache_.end()) return it->second;
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(path, ec)) {
-            log_warning(path.string() + ": " + what +
-                        " texture not found, material falls back to its colour");
-            return cache_[key] = -1;
-        }
-        TextureDesc tex;
-        tex.path = path.string();
-        tex.image = use == TexUse::color ? read_image(path, true) : alpha_from_grey(read_image(path, false));
-        tex.wrap_u = tex.wrap_v = opt.clamp ? WrapMode::clamp : WrapMode::repeat;
-        tex.uv_offset = {float(opt.origin_offset[0]), float(opt.origin_offset[1])};
-        tex.uv_scale = {float(opt.scale[0]), float(opt.scale[1])};
-        model_.textures.push_back(std::move(tex));
-        return cache_[key] = int(model_.textures.size()) - 1;
-    }
-
-   private:
-    /// map_d images are usually grey without an alpha channel: then the grey
-    /// value is the alpha (MaterialDesc reads a texture's alpha channel).
-    static std::shared_ptr<const Image> alpha_from_grey(std::shared_ptr<const Image> img) {
-        for (size_t i = 3; i < img->rgba.size(); i += 4)
-            if (img->rgba[i] != 1.0f) return img;
-        auto out = std::make_shared<Image>(*img);
-        for (size_t i = 0; i + 3 < out->rgba.size(); i += 4) out->rgba[i + 3] = out->rgba[i];
-        return out;
-    }
-
-    LoadedModel& model_;
-    std::filesystem::path dir_;
-    std::map<std::pair<std::string, TexUse>, int> cache_;
-};
-
-Rgb to_rgb(const tinyobj::real_t* c) { return Rgb(float(c[0]), float(c[1]), float(c[2])); }
-
-/// MTL -> MaterialDesc: Kd/map_Kd albedo (the map replaces Kd, as most OBJ
-/// viewers do), Ke/map_Ke emission, d/map_d alpha cut-outs.
-MaterialDesc convert_material(const tinyobj::material_t& m, ObjTextures& textures) {
-    MaterialDesc out;
-    out.name = m.name;
-    out.albedo.color = to_rgb(m.diffuse);
-    if (!m.diffuse_texname.empty()) {
-        const int t = textures.get(m.diffuse_texname, m.diffuse_texopt, TexUse::color, "map_Kd of " + m.name);
-        if (t >= 0) out.albedo = {ColorSource::Kind::texture, Rgb(1.0f), {}, {}, 1.0f, t};
-    }
-    const Rgb ke = to_rgb(m.emission);
-    int ke_tex = -1;
-    if (!m.emissive_texname.empty())
-        ke_tex = textures.get(m.emissive_texname, m.emissive_texopt, TexUse::color, "map_Ke of " + m.name);
-    if (max_component(ke) > 0.0f || ke_tex >= 0) {
-        out.type = MaterialType::emissive;
-        out.radiance.color = max_component(ke) > 0.0f ? ke : Rgb(1.0f);
-        if (ke_tex >= 0) {
-            out.radiance.kind = ColorSource::Kind::texture;
-            out.radiance.texture = ke_tex;
-        }
-    }
-    out.alpha = std::clamp(float(m.dissolve), 0.0f, 1.0f);
-    if (!m.alpha_texname.empty())
-        out.alpha_texture =
-            textures.get(m.alpha_texname, m.alpha_texopt, TexUse::alpha, "map_d of " + m.name);
-    return out;
+    return true;
 }
 
 /// Rejects NaN/Inf in v, vn and vt (1-based element numbers as in the file).
@@ -275,7 +186,10 @@ class ObjShapeBuilder {
             if (length_squared(n) > 0.0) flat = Vec3(normalize(n));
         }
         local_.clear();
-        triangulate_polygon(poly_, local_);
+        if (poly_.size() == 4 && is_convex_quad(poly_))
+            local_ = {0, 1, 2, 0, 2, 3};  // the v0-v2 diagonal, as Blender, assimp and tinyobjloader split
+        else
+            triangulate_polygon(poly_, local_);
         const uint32_t material = material_index(material_id);
         for (size_t t = 0; t < local_.size(); t += 3) {
             for (size_t k = 0; k < 3; ++k) {
@@ -355,8 +269,9 @@ void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
 
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model) {
     const std::string text = read_text_file(file);
-    reject_non_finite_words(file.string(), text);
-    std::istringstream stream(text);
+    obj::check_encoding(file.string(), text);
+    obj::check_obj_numbers(file.string(), text);
+    std::istringstream stream(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);  // UTF-8 BOM
     MtlFileReader mtl_reader(file);
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
@@ -372,8 +287,12 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
             log_warning(file.string() + ": " + line);
 
     LoadedModel model;
-    ObjTextures textures(model, mtl_reader.texture_dir());
-    for (const tinyobj::material_t& m : materials) model.materials.push_back(convert_material(m, textures));
+    obj::MtlKeys keys;
+    for (const std::filesystem::path& mtl : mtl_reader.files())
+        for (auto& [name, set] : obj::scan_mtl(mtl.string(), read_text_file(mtl))) keys[name].merge(set);
+    obj::ObjTextures textures(model, mtl_reader.texture_dir());
+    for (const tinyobj::material_t& m : materials)
+        model.materials.push_back(obj::convert_material(m, keys[m.name], textures));
     build_obj_meshes(file.string(), attrib, shapes, model);
     if (model.meshes.empty()) throw input_error(file.string(), "", "no faces (is this an OBJ file?)");
     if (model.materials.empty()) model.materials.push_back(default_material());

@@ -14,162 +14,17 @@
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "gltf_test_doc.h"
 #include "mesh_fixtures.h"
 #include "scene/texture.h"
 #include "test_data.h"
 
 using namespace sahara;
+using namespace sahara::test::gltf;
 using sahara::test::kTestData;
 using sahara::test::make_icosphere;
-namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace {
-
-fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("sahara_gltf_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::vector<uint8_t> read_all(const fs::path& f) {
-    std::ifstream in(f, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const fs::path& f, const std::vector<uint8_t>& b) {
-    std::ofstream(f, std::ios::binary)
-        .write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
-}
-
-void write_text(const fs::path& f, const std::string& s) { std::ofstream(f, std::ios::binary) << s; }
-
-std::string base64(const std::vector<uint8_t>& in) {
-    static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < in.size(); i += 3) {
-        uint32_t v = uint32_t(in[i]) << 16;
-        if (i + 1 < in.size()) v |= uint32_t(in[i + 1]) << 8;
-        if (i + 2 < in.size()) v |= in[i + 2];
-        out += t[v >> 18 & 63];
-        out += t[v >> 12 & 63];
-        out += i + 1 < in.size() ? t[v >> 6 & 63] : '=';
-        out += i + 2 < in.size() ? t[v & 63] : '=';
-    }
-    return out;
-}
-
-/// A binary buffer assembled by the tests, 4-byte aligned per block.
-struct Blob {
-    std::vector<uint8_t> bytes;
-    template <class T>
-    size_t add(const std::vector<T>& values) {
-        while (bytes.size() % 4) bytes.push_back(0);
-        const size_t at = bytes.size();
-        bytes.resize(at + values.size() * sizeof(T));
-        std::memcpy(bytes.data() + at, values.data(), values.size() * sizeof(T));
-        return at;
-    }
-    std::string data_uri() const { return "data:application/octet-stream;base64," + base64(bytes); }
-};
-
-/// A glTF document built in the tests: one buffer (embedded as a data URI by default).
-struct Doc {
-    json j = {{"asset", {{"version", "2.0"}}},
-              {"scene", 0},
-              {"scenes", {{{"nodes", json::array()}}}},
-              {"nodes", json::array()},
-              {"meshes", json::array()},
-              {"accessors", json::array()},
-              {"bufferViews", json::array()},
-              {"buffers", json::array()}};
-    Blob blob;
-
-    /// Adds data as its own bufferView and an accessor over it.
-    template <class T>
-    int accessor(const std::vector<T>& data, int component_type, const char* type, size_t count,
-                 bool normalized = false) {
-        const size_t at = blob.add(data);
-        j["bufferViews"].push_back(
-            {{"buffer", 0}, {"byteOffset", at}, {"byteLength", data.size() * sizeof(T)}});
-        json a = {{"bufferView", j["bufferViews"].size() - 1},
-                  {"componentType", component_type},
-                  {"type", type},
-                  {"count", count}};
-        if (normalized) a["normalized"] = true;
-        j["accessors"].push_back(a);
-        return int(j["accessors"].size()) - 1;
-    }
-    int positions(const std::vector<float>& p) { return accessor(p, 5126, "VEC3", p.size() / 3); }
-    int mesh(int pos, int indices = -1, int mode = 4, json extra_attrs = json::object()) {
-        json prim = {{"attributes", {{"POSITION", pos}}}, {"mode", mode}};
-        for (auto& [k, v] : extra_attrs.items()) prim["attributes"][k] = v;
-        if (indices >= 0) prim["indices"] = indices;
-        j["meshes"].push_back({{"primitives", {prim}}});
-        return int(j["meshes"].size()) - 1;
-    }
-    int node(json n, bool root = true) {
-        j["nodes"].push_back(n);
-        const int i = int(j["nodes"].size()) - 1;
-        if (root) j["scenes"][0]["nodes"].push_back(i);
-        return i;
-    }
-    std::string text() {
-        j["buffers"] = json::array();
-        if (!blob.bytes.empty())
-            j["buffers"].push_back({{"byteLength", blob.bytes.size()}, {"uri", blob.data_uri()}});
-        return j.dump();
-    }
-    fs::path write(const fs::path& file) {
-        write_text(file, text());
-        return file;
-    }
-};
-
-/// Writes a .glb holding `j` with the BIN chunk `bin`.
-void write_glb(const fs::path& file, json j, std::vector<uint8_t> bin) {
-    std::string text = j.dump();
-    while (text.size() % 4) text += ' ';
-    while (bin.size() % 4) bin.push_back(0);
-    std::vector<uint8_t> out;
-    auto u32 = [&](uint32_t v) {
-        for (int k = 0; k < 4; ++k) out.push_back(uint8_t(v >> (8 * k)));
-    };
-    out.insert(out.end(), {'g', 'l', 'T', 'F'});
-    u32(2);
-    u32(uint32_t(12 + 8 + text.size() + 8 + bin.size()));
-    u32(uint32_t(text.size()));
-    u32(0x4E4F534A);
-    out.insert(out.end(), text.begin(), text.end());
-    u32(uint32_t(bin.size()));
-    u32(0x004E4942);
-    out.insert(out.end(), bin.begin(), bin.end());
-    write_bytes(file, out);
-}
-
-/// The JSON of a .gltf or .glb file, parsed in the test itself.
-json json_of(const fs::path& file) {
-    const std::vector<uint8_t> b = read_all(file);
-    if (b.size() >= 20 && std::memcmp(b.data(), "glTF", 4) == 0) {
-        uint32_t len;
-        std::memcpy(&len, &b[12], 4);
-        return json::parse(b.begin() + 20, b.begin() + 20 + len);
-    }
-    return json::parse(b);
-}
-
-size_t triangles(const LoadedModel& m) {
-    size_t n = 0;
-    for (const auto& mesh : m.meshes) n += mesh.triangle_count();
-    return n;
-}
-
-Bounds3 bounds(const LoadedModel& m) {
-    Bounds3 b;
-    for (const auto& mesh : m.meshes) b.extend(mesh_bounds(mesh));
-    return b;
-}
 
 /// glTF node matrix from the JSON (column-major `matrix`, else T * R * S).
 Mat4 node_matrix(const json& n) {
@@ -215,24 +70,6 @@ Bounds3 corner_bounds(const json& j) {
         for (const auto& c : n.value("children", json::array())) stack.emplace_back(c.get<int>(), world);
     }
     return b;
-}
-
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no InputError)";
-}
-
-const std::vector<float> kTriangle = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-
-Vec3 face_normal(const TriangleMesh& m, size_t t) {
-    const auto& p = m.positions;
-    const uint32_t* i = &m.indices[3 * t];
-    return triangle_normal(p[i[0]], p[i[1]], p[i[2]]);
 }
 
 /// Writes a textured model with the features of the Khronos "Duck" sample (whose
@@ -387,14 +224,14 @@ TEST_CASE("the glTF files in tests/data load with their published counts") {
     for (const Expect& e : expect) check_gltf_loads(kTestData / e.path, e.scene_tris, e.exact_box);
 }
 
-TEST_CASE("a Duck-like glTF (scaled root, camera child, interleaved strides) loads whole, .gltf and .glb") {
+TEST_CASE("a Duck-like glTF (scaled root / camera child / interleaved strides) loads whole / .gltf and .glb") {
     const auto [gltf, glb] = write_duck_like(scratch("duck_counts"), "duck");
     const size_t tris = make_icosphere(4).triangle_count();
     check_gltf_loads(gltf, tris, true);
     check_gltf_loads(glb, tris, true);
 }
 
-TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale, and Cameras has both kinds") {
+TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale and Cameras has both kinds") {
     const fs::path duck_file = write_duck_like(scratch("duck_camera"), "duck").first;
     const LoadedModel duck = load_gltf(duck_file);
     REQUIRE(duck.cameras.size() == 1);
@@ -422,7 +259,7 @@ TEST_CASE("glTF cameras: a camera under a 0.01-scaled root includes the scale, a
     CHECK(cams.cameras[1].basis_right == Vec3(1, 0, 0));
 }
 
-TEST_CASE("glTF node transforms: T * R * S, parents first, then world_from_model") {
+TEST_CASE("glTF node transforms: T * R * S / parents first / then world_from_model") {
     Doc d;
     const int mesh = d.mesh(d.positions({1, 0, 0, 0, 1, 0, 0, 0, 1}));
     const int child =
@@ -495,7 +332,7 @@ TEST_CASE("glTF triangle strips and fans become consistently wound lists") {
             CHECK(face_normal(mesh, t).z == doctest::Approx(1));
 }
 
-TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView") {
+TEST_CASE("glTF sparse accessors are applied / with and without a base bufferView") {
     Doc d;
     const int pos = d.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 5, 5});
     const size_t idx_at = d.blob.add(std::vector<uint16_t>{3, 0});
@@ -522,7 +359,7 @@ TEST_CASE("glTF sparse accessors are applied, with and without a base bufferView
     CHECK(m.meshes[1].positions[3] == Vec3(1, 1, 0));
 }
 
-TEST_CASE("glTF buffers: external .bin, data URI and .glb give the same mesh") {
+TEST_CASE("glTF buffers: external .bin / data URI and .glb give the same mesh") {
     const fs::path dir = scratch("containers");
     Doc d;
     const int pos = d.positions({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0});
@@ -573,133 +410,6 @@ TEST_CASE("glTF buffers: external .bin, data URI and .glb give the same mesh") {
         CHECK(mesh.uvs[3].x == 1.0f);
         CHECK(mesh.uvs[3].y == 0.0f);
         CHECK(mesh.uvs[0].y == 1.0f);
-    }
-}
-
-namespace {
-
-/// A 2x2 RGBA PNG (written through OpenImageIO): top row red, (0,128,0,128); bottom row blue, white.
-std::vector<uint8_t> tiny_png(const fs::path& dir) {
-    const uint8_t px[16] = {255, 0, 0, 255, 0, 128, 0, 128, 0, 0, 255, 255, 255, 255, 255, 255};
-    const fs::path file = dir / "tiny.png";
-    write_image_u8(file, 2, 2, 4, px);
-    return read_all(file);
-}
-
-/// A one-triangle document whose primitive uses material 0, with uvs.
-Doc textured_doc(const json& material) {
-    Doc d;
-    const int uv = d.accessor(std::vector<float>{0, 0, 1, 0, 0, 1}, 5126, "VEC2", 3);
-    d.node({{"mesh", d.mesh(d.positions(kTriangle), -1, 4, {{"TEXCOORD_0", uv}})}});
-    d.j["meshes"][0]["primitives"][0]["material"] = 0;
-    d.j["materials"] = {material};
-    return d;
-}
-
-/// A PNG assembled chunk by chunk (valid CRCs): RGBA8 `w` x `h`, IDAT bytes as given.
-std::vector<uint8_t> handmade_png(uint32_t w, uint32_t h, const std::vector<uint8_t>& idat) {
-    std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 13, 10, 26, 10};
-    auto chunk = [&](const char* type, std::vector<uint8_t> data) {
-        for (int k = 3; k >= 0; --k) png.push_back(uint8_t(data.size() >> (8 * k)));
-        data.insert(data.begin(), type, type + 4);
-        uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of type + data, as PNG requires
-        for (uint8_t b : data) {
-            crc ^= b;
-            for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-        }
-        crc = ~crc;
-        png.insert(png.end(), data.begin(), data.end());
-        for (int k = 3; k >= 0; --k) png.push_back(uint8_t(crc >> (8 * k)));
-    };
-    std::vector<uint8_t> ihdr;
-    for (uint32_t v : {w, h})
-        for (int k = 3; k >= 0; --k) ihdr.push_back(uint8_t(v >> (8 * k)));
-    ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});
-    chunk("IHDR", ihdr);
-    chunk("IDAT", idat);
-    chunk("IEND", {});
-    return png;
-}
-
-}  // namespace
-
-TEST_CASE("glTF materials: base colour factor x texture, alpha modes, emission, sRGB decoding") {
-    const fs::path dir = scratch("materials");
-    const std::vector<uint8_t> png = tiny_png(dir);
-    const json material = {{"pbrMetallicRoughness",
-                            {{"baseColorFactor", {0.5, 1, 1, 0.8}}, {"baseColorTexture", {{"index", 0}}}}},
-                           {"alphaMode", "MASK"},
-                           {"alphaCutoff", 0.3},
-                           {"emissiveFactor", {1, 0.5, 0}},
-                           {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}}}};
-    Doc d = textured_doc(material);
-    d.j["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
-    d.j["samplers"] = {{{"wrapS", 33071}, {"wrapT", 33648}}};
-    d.j["textures"] = {{{"source", 0}, {"sampler", 0}}};
-    const LoadedModel m = load_gltf(d.write(dir / "mat.gltf"));
-    REQUIRE(m.materials.size() == 1);
-    const MaterialDesc& mat = m.materials[0];
-    CHECK(mat.type == MaterialType::emissive);
-    CHECK(mat.radiance.color == Rgb(4, 2, 0));
-    CHECK(mat.alpha == doctest::Approx(0.8f));
-    REQUIRE(mat.alpha_cutoff.has_value());
-    CHECK(*mat.alpha_cutoff == doctest::Approx(0.3f));
-    REQUIRE(mat.albedo.kind == ColorSource::Kind::texture);
-    CHECK(mat.albedo.color == Rgb(0.5f, 1, 1));
-    CHECK(mat.alpha_texture == mat.albedo.texture);
-    REQUIRE(m.textures.size() == 1);
-    const TextureDesc& t = m.textures[0];
-    CHECK(t.wrap_u == WrapMode::clamp);
-    CHECK(t.wrap_v == WrapMode::mirror);
-    const Image& img = *t.image;
-    REQUIRE(img.width == 2);
-    CHECK(img.rgba[0] == doctest::Approx(1.0f));                       // top-left red, row 0 = top
-    CHECK(img.rgba[5] == doctest::Approx(srgb_decode(128 / 255.0f)));  // sRGB decoded
-    CHECK(img.rgba[5] == doctest::Approx(0.2158605f).epsilon(1e-4));
-    CHECK(img.rgba[7] == doctest::Approx(128 / 255.0f));  // alpha stays linear
-    CHECK(img.rgba[10] == doctest::Approx(1.0f));         // bottom-left blue
-
-    // The same image from a bufferView (as in .glb files), opaque mode.
-    Doc v = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
-    const size_t at = v.blob.add(png);
-    v.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", png.size()}});
-    v.j["images"] = {{{"bufferView", v.j["bufferViews"].size() - 1}, {"mimeType", "image/png"}}};
-    v.j["textures"] = {{{"source", 0}}};
-    const LoadedModel mv = load_gltf(v.write(dir / "view.gltf"));
-    CHECK(mv.materials[0].alpha == 1.0f);
-    CHECK(mv.materials[0].alpha_texture == -1);
-    CHECK(mv.materials[0].type == MaterialType::lambertian);
-    CHECK(mv.textures.at(0).image->rgba == img.rgba);
-}
-
-TEST_CASE("KHR_texture_transform is rewritten for sahara's v-up uvs") {
-    const fs::path dir = scratch("ktt");
-    const std::vector<uint8_t> png = tiny_png(dir);
-    const float off[2] = {0.25f, 0.125f}, scl[2] = {2.0f, 3.0f}, rot = 0.4f;
-    json ktt = {{"offset", {off[0], off[1]}}, {"scale", {scl[0], scl[1]}}, {"rotation", rot}};
-    json info = {{"index", 0}, {"extensions", {{"KHR_texture_transform", ktt}}}};
-    Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", info}}}});
-    write_bytes(dir / "tiny file.png", png);
-    d.j["images"] = {{{"uri", "tiny%20file.png"}}};
-    d.j["textures"] = {{{"source", 0}}};
-    const LoadedModel m = load_gltf(d.write(dir / "ktt.gltf"));
-    REQUIRE(m.textures.size() == 1);
-    const TextureDesc& t = m.textures[0];
-    // For a few glTF uvs: the texel row/column glTF addresses must equal sahara's lookup.
-    for (const auto& [u, vg] :
-         std::vector<std::pair<float, float>>{{0.1f, 0.2f}, {0.7f, 0.9f}, {0.5f, 0.0f}}) {
-        // glTF: t = offset + R * (scale * uv) with the spec's column-major GLSL
-        // mat3(cos, sin, 0, -sin, cos, 0, ...), i.e. R = [cos -sin; sin cos]; row = t.y * height.
-        const float su = scl[0] * u, sv = scl[1] * vg;
-        const float tu = off[0] + std::cos(rot) * su - std::sin(rot) * sv;
-        const float tv = off[1] + std::sin(rot) * su + std::cos(rot) * sv;
-        // sahara (scene_desc.h, scene/texture.cpp): uv = (u, 1 - vg);
-        // uv' = offset + [cos sin; -sin cos] * (scale * uv); row = (1 - uv'.y) * height.
-        const float xu = t.uv_scale.x * u, xv = t.uv_scale.y * (1 - vg);
-        const float pu = t.uv_offset.x + std::cos(t.uv_rotation) * xu + std::sin(t.uv_rotation) * xv;
-        const float pv = t.uv_offset.y - std::sin(t.uv_rotation) * xu + std::cos(t.uv_rotation) * xv;
-        CHECK(pu == doctest::Approx(tu).epsilon(1e-5));
-        CHECK(1 - pv == doctest::Approx(tv).epsilon(1e-5));
     }
 }
 
@@ -760,174 +470,4 @@ TEST_CASE("glTF primitives of points and lines are skipped with a warning") {
     const LoadedModel m = load_gltf(d.write(scratch("lines") / "lines.gltf"));
     CHECK(warning_count() == before + 1);
     CHECK(m.meshes.size() == 1);
-}
-
-TEST_CASE("bad glTF input throws InputError naming file and element") {
-    const fs::path dir = scratch("bad");
-    const std::string f = (dir / "x.gltf").string();
-    auto load = [&](Doc& d) { return error_of([&] { load_gltf(d.write(dir / "x.gltf")); }); };
-    CHECK(error_of([&] { load_gltf(dir / "none.gltf"); }) == (dir / "none.gltf").string() + ": no such file");
-    fs::create_directories(dir / "folder.glb");
-    CHECK(error_of([&] { load_model(dir / "folder.glb"); }).find("not a regular file") != std::string::npos);
-    write_text(dir / "broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [");
-    CHECK(error_of([&] { load_gltf(dir / "broken.gltf"); }).find("broken.gltf: malformed glTF") !=
-          std::string::npos);
-
-    {  // index out of range
-        Doc d;
-        d.node({{"mesh", d.mesh(d.positions(kTriangle),
-                                d.accessor(std::vector<uint16_t>{0, 1, 3}, 5123, "SCALAR", 3))}});
-        CHECK(load(d) == f + ": meshes[0].primitives[0].indices: index 3 out of range (3 vertices)");
-    }
-    {  // NaN coordinate
-        Doc d;
-        d.node({{"mesh", d.mesh(d.positions({0, 0, 0, 1, std::nanf(""), 0, 0, 1, 0}))}});
-        CHECK(load(d) == f + ": accessors[0]: element 1 is not a finite number");
-    }
-    {  // accessor reading past its bufferView
-        Doc d;
-        const int pos = d.positions(kTriangle);
-        d.j["accessors"][size_t(pos)]["count"] = 4;
-        d.node({{"mesh", d.mesh(pos)}});
-        CHECK(load(d) == f + ": accessors[0]: reads past the end of bufferViews[0]");
-    }
-    {  // bufferView past its buffer
-        Doc d;
-        const int pos = d.positions(kTriangle);
-        d.j["bufferViews"][0]["byteLength"] = 400;
-        d.node({{"mesh", d.mesh(pos)}});
-        CHECK(load(d) == f + ": bufferViews[0]: extends past the end of buffers[0]");
-    }
-    {  // buffer larger than its file
-        Doc d;
-        d.node({{"mesh", d.mesh(d.positions(kTriangle))}});
-        json j = d.j;
-        j["buffers"] = {{{"byteLength", 1000}, {"uri", "small.bin"}}};
-        write_bytes(dir / "small.bin", d.blob.bytes);
-        write_text(dir / "big.gltf", j.dump());
-        CHECK(error_of([&] { load_gltf(dir / "big.gltf"); }) ==
-              (dir / "big.gltf").string() +
-                  ": buffers[0]: byteLength 1000 is larger than small.bin (36 bytes)");
-        j["buffers"] = {{{"byteLength", 1000}}};
-        write_glb(dir / "big.glb", j, d.blob.bytes);
-        CHECK(error_of([&] { load_gltf(dir / "big.glb"); }) ==
-              (dir / "big.glb").string() +
-                  ": buffers[0]: byteLength 1000 is larger than the GLB BIN chunk (36 bytes)");
-    }
-    {  // unsupported required extension
-        Doc d;
-        d.j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
-        d.j["extensionsRequired"] = {"KHR_draco_mesh_compression"};
-        CHECK(load(d) == f + ": extensionsRequired: KHR_draco_mesh_compression is not supported");
-    }
-    {  // texture that fails to decode
-        Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
-        d.j["images"] = {
-            {{"uri", "data:image/png;base64," + base64({0x89, 'P', 'N', 'G', 13, 10, 26, 10, 1, 2, 3})}}};
-        d.j["textures"] = {{{"source", 0}}};
-        CHECK(load(d) == f + ": images[0]: cannot decode image: PNG is truncated (chunk 0 header)");
-        // Well-formed chunks around a corrupt zlib stream: the decoder itself fails.
-        const std::vector<uint8_t> bad = handmade_png(4, 4, {0x78, 0x9C, 0xFF, 0xFF, 0xFF, 0x00, 0x11});
-        d.j["images"] = {{{"uri", "data:image/png;base64," + base64(bad)}}};
-        CHECK(load(d).find(f + ": images[0]: cannot decode image: ") == 0);
-    }
-    {  // an image over 32k pixels per side (a valid PNG header claiming 40000 x 8)
-        // A well-formed PNG header claiming 40000 x 8 pixels.
-        const std::vector<uint8_t> png =
-            handmade_png(40000, 8, {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});
-        Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
-        write_bytes(dir / "huge.png", png);
-        d.j["images"] = {{{"uri", "huge.png"}}};
-        d.j["textures"] = {{{"source", 0}}};
-        const std::string e = load(d);
-        CHECK(e.find(f + ": images[0]: ") == 0);
-        CHECK(e.find("huge.png") != std::string::npos);
-        CHECK(e.find("32768") != std::string::npos);
-    }
-    {  // node cycle
-        Doc d;
-        d.node({{"children", {1}}});
-        d.node({{"children", {0}}}, false);
-        CHECK(load(d) == f + ": nodes[0]: reached twice (cycle or shared child in the node tree)");
-    }
-    {  // references to things that do not exist
-        Doc d;
-        d.node({{"mesh", 5}});
-        CHECK(load(d) == f + ": nodes[0].mesh: mesh 5 does not exist");
-        Doc e;
-        e.node({{"mesh", e.mesh(7)}});
-        CHECK(load(e) == f + ": meshes[0].primitives[0].attributes.POSITION: accessor 7 does not exist");
-    }
-}
-
-TEST_CASE("glTF and OBJ uvs reach the texels their formats mean through scene/texture.h") {
-    // tiny_png: top row red, (0,128,0); bottom row blue, white. uv 0.25/0.75 hit texel centres.
-    const fs::path dir = scratch("texels");
-    const std::vector<uint8_t> png = tiny_png(dir);
-    const Rgb red(1, 0, 0), blue(0, 0, 1), green(0, srgb_decode(128 / 255.0f), 0);
-    auto sample = [](const LoadedModel& m, size_t vertex) {
-        const TriangleMesh& mesh = m.meshes.at(0);
-        return sample_texture_rgb(m.textures.at(0), mesh.uvs.at(vertex));
-    };
-    auto near = [](Rgb a, Rgb b) { return length(a - b) < 1e-4f; };
-
-    // glTF: v = 0 is the top row, so uv (0.25, 0.25) is the top-left texel (red).
-    for (const json& ktt :
-         {json(nullptr), json{{"offset", {0.5, 0}}}, json{{"rotation", std::numbers::pi / 2}}}) {
-        CAPTURE(ktt.dump());
-        Doc d;
-        const int uv =
-            d.accessor(std::vector<float>{0.25f, 0.25f, 0.75f, 0.25f, 0.25f, 0.75f}, 5126, "VEC2", 3);
-        d.node({{"mesh", d.mesh(d.positions(kTriangle), -1, 4, {{"TEXCOORD_0", uv}})}});
-        d.j["meshes"][0]["primitives"][0]["material"] = 0;
-        json info = {{"index", 0}};
-        if (!ktt.is_null()) info["extensions"] = {{"KHR_texture_transform", ktt}};
-        d.j["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", info}}}}};
-        d.j["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
-        d.j["textures"] = {{{"source", 0}}};
-        const LoadedModel m = load_gltf(d.write(dir / "t.gltf"));
-        if (ktt.is_null()) {
-            CHECK(near(sample(m, 0), red));
-            CHECK(near(sample(m, 1), green));  // (0.75, 0.25): top right
-            CHECK(near(sample(m, 2), blue));   // (0.25, 0.75): bottom left
-        } else if (ktt.contains("offset")) {
-            CHECK(near(sample(m, 0), green));  // u + 0.5
-        } else {
-            // glTF rotation pi/2: t = [cos -sin; sin cos] p = (-0.25, 0.25) -> wraps to (0.75, 0.25): top
-            // right.
-            CHECK(near(sample(m, 0), green));
-        }
-    }
-
-    // OBJ: v = 0 is the bottom row, so vt 0.25 0.25 is the bottom-left texel (blue).
-    write_text(dir / "t.mtl", "newmtl m\nmap_Kd tiny.png\n");
-    write_text(dir / "t.obj",
-               "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.25\nvt 0.75 0.75\nvt 0.25 0.75\n"
-               "usemtl m\nf 1/1 2/2 3/3\n");
-    const LoadedModel obj = load_obj(dir / "t.obj");
-    CHECK(near(sample(obj, 0), blue));
-    CHECK(near(sample(obj, 1), green));  // (0.75, 0.75): top right
-    CHECK(near(sample(obj, 2), red));    // (0.25, 0.75): top left
-}
-
-TEST_CASE("glTF: the material's TEXCOORD set, normalized byte normals, u8 and u32 indices") {
-    const fs::path dir = scratch("sets");
-    Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}, {"texCoord", 1}}}}}});
-    d.j["images"] = {{{"uri", "data:image/png;base64," + base64(tiny_png(dir))}}};
-    d.j["textures"] = {{{"source", 0}}};
-    auto& attrs = d.j["meshes"][0]["primitives"][0]["attributes"];
-    attrs["TEXCOORD_1"] = d.accessor(std::vector<uint8_t>{0, 0, 51, 0, 0, 255, 0, 0}, 5121, "VEC2", 3, true);
-    // Signed normalized bytes: -127 maps to -1 exactly, 127 to 1.
-    attrs["NORMAL"] =
-        d.accessor(std::vector<int8_t>{0, 0, 127, 0, 0, 127, 0, -127, 0, 0}, 5120, "VEC3", 3, true);
-    d.j["meshes"][0]["primitives"][0]["indices"] =
-        d.accessor(std::vector<uint32_t>{2, 1, 0}, 5125, "SCALAR", 3);
-    const LoadedModel m = load_gltf(d.write(dir / "sets.gltf"));
-    const TriangleMesh& mesh = m.meshes.at(0);
-    REQUIRE(mesh.uvs.size() == 3);
-    CHECK(mesh.uvs[1].x == doctest::Approx(0.2f));  // 51/255 from TEXCOORD_1 (TEXCOORD_0 has 1 there)
-    CHECK(mesh.uvs[2].y == 0.0f);                   // v_gltf = 1 -> 0
-    CHECK(mesh.uvs[1].y == 1.0f);                   // v_gltf = 0 -> 1
-    CHECK(mesh.normals[2] == Vec3(0, -1, 0));
-    CHECK(mesh.indices == std::vector<uint32_t>{2, 1, 0});
 }
