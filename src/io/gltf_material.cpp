@@ -169,6 +169,9 @@ void Materials::set_emission(MaterialDesc& out, const tinygltf::Material& m, con
 /// KHR_materials_transmission, _ior and _volume; other material extensions
 /// are named once per file as ignored.
 void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
+    // Without KHR_materials_volume (or with thicknessFactor 0) a transmissive
+    // surface is thin-walled: light passes through it without refraction.
+    out.thin_walled = true;
     for (const auto& [name, value] : m.extensions) {
         const std::string ext = element + ".extensions." + name;
         if (name == "KHR_materials_transmission") {
@@ -183,6 +186,7 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
                 log_warning(src_.file + ": " + ext + ": ior " + std::to_string(ior) +
                             " is below 1, 1.5 used");
         } else if (name == "KHR_materials_volume") {
+            out.thin_walled = !(number(value, "thicknessFactor", 0.0) > 0.0);
             const float distance = float(number(value, "attenuationDistance", kInfinity));
             if (distance > 0.0f) out.attenuation_distance = distance;
             out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
