@@ -4,7 +4,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <numbers>
 #include <numeric>
@@ -13,6 +12,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "io/files.h"
 #include "io/gltf_detail.h"
 #include "io/mesh_utils.h"
 
@@ -25,18 +25,6 @@ using gltf::Source;
 /// Extensions sahara understands; any other in extensionsRequired is refused.
 const std::set<std::string> kSupportedRequired = {"KHR_texture_transform", "KHR_materials_emissive_strength",
                                                   "KHR_lights_punctual", "KHR_mesh_quantization"};
-
-std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
-    if (!std::filesystem::is_regular_file(file, ec))
-        throw input_error(file.string(), "", "not a regular file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw input_error(file.string(), "", "cannot open file");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw input_error(file.string(), "", "read error");
-    return bytes;
-}
 
 uint32_t le32(const unsigned char* p) {
     return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
@@ -153,7 +141,7 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     Source src;
     src.file = file.string();
     src.dir = file.parent_path();
-    const std::vector<unsigned char> bytes = read_bytes(file);
+    const std::vector<unsigned char> bytes = read_file_bytes(file);
     precheck(src.file, src.dir, json_part(src.file, bytes));
     parse(src, bytes);
     LoadedModel out;
