@@ -28,6 +28,7 @@ const char* const kRenderUsage =
     "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
     "  --layout L           traversal structure: wide8 (default) | pairs\n"
     "                       (see sahara bench --help; pairs: a plain binary BVH, one ray at a time)\n"
+    "  --no-packets         trace camera rays one by one, never as 4x4 packets (same image)\n"
     "  --threads N          worker threads (default: all)\n"
     "  --time SECONDS       stop after this long, keeping the samples done\n"
     "  --target-error E     adaptive sampling: stop when the estimated relative error is <= E\n"
@@ -101,6 +102,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (sampler) r.sampler = *sampler;
     if (bvh_builder) r.bvh_builder = *bvh_builder;
     if (bvh_layout) r.bvh_layout = *bvh_layout;
+    if (packets) r.packets = *packets;
 }
 
 void parse_render_args(const std::vector<std::string>& args, RenderArgs& r,

@@ -26,9 +26,15 @@ fs::path executable_dir() {
     return fs::path(buf).parent_path();
 }
 
+/// The file set_image_codec_file named; empty: none.
+std::string& chosen_codec_file() {
+    static std::string file;
+    return file;
+}
+
 /// Where the plugin may be, in the order tried (see kImageCodecLibrary).
 std::vector<fs::path> candidate_files() {
-    if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) return {forced};
+    if (const std::string& chosen = chosen_codec_file(); !chosen.empty()) return {chosen};
     const fs::path dir = executable_dir();
     if (dir.empty()) return {};
     std::vector<fs::path> files{dir / kImageCodecLibrary};
@@ -65,6 +71,8 @@ Loaded load() {
 }
 
 }  // namespace
+
+void set_image_codec_file(const std::string& file) { chosen_codec_file() = file; }
 
 ImageCodecSearch find_image_codec() {
     ImageCodecSearch search;

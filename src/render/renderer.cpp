@@ -36,12 +36,12 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 
 /// Whether camera rays are traced as packets: the path integrator (which can
 /// take a first hit) over the block layout (wide8) without cut-outs, unless
-/// SAHARA_PACKETS=0, with the AVX-512 kernel or the AVX2 kernel
+/// --no-packets (RenderSettings::packets), with the AVX-512 kernel or the AVX2 kernel
 /// (packet_wide8.cpp), which trace camera rays faster than single rays. The
 /// SSE2 kernel is slower than single rays, so it stays for tests and bench.
 bool use_packets(const Scene& scene) {
     const Accelerator* accel = scene.accelerator();
-    if (!packets_enabled() || scene.render.integrator != IntegratorType::path || !accel ||
+    if (!scene.render.packets || scene.render.integrator != IntegratorType::path || !accel ||
         !layout_has_blocks(accel->layout()) || !accel->uses_tree() || accel->has_cutouts())
         return false;
     return active_simd_path() != SimdPath::sse2;
