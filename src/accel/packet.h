@@ -57,10 +57,4 @@ struct alignas(64) HitPacket {
     Hit hit(int i) const { return Hit{t[i], prim[i], u[i], v[i]}; }
 };
 
-/// Whether packets are enabled for rendering: true unless SAHARA_PACKETS=0 is
-/// set or set_packets_enabled(false) was called.
-bool packets_enabled();
-/// Overrides the environment (tests, --no-packets).
-void set_packets_enabled(bool on);
-
 }  // namespace sahara

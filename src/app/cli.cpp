@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "app/cli_args.h"
 #include "base/error.h"
+#include "io/image_codec.h"
 
 namespace sahara {
 
@@ -32,7 +33,10 @@ const char* const kUsage =
     "  trace MESH            trace rays from a file and write the hits\n"
     "\n"
     "  sahara COMMAND --help   options of a command\n"
-    "  sahara --version        the version and the optional parts built in\n";
+    "  sahara --version        the version and the optional parts built in\n"
+    "\n"
+    "  --image-codec FILE      (before the command) load the image codec plugin from FILE\n"
+    "                          instead of looking beside the executable and in ../lib/sahara\n";
 
 /// The command's entry point, given the words after the command name.
 int dispatch(const std::string& cmd, const std::vector<std::string>& rest) {
@@ -62,8 +66,10 @@ int run_cli(int argc, char** argv) {
     }
     CLI::App app;
     bool help = false, version = false;
+    std::string codec_file;
     configure_app(app, help);
     app.add_flag("-V,--version", version);
+    app.add_option("--image-codec", codec_file);
     for (const char* name :
          {"render", "view", "info", "converge", "bvh", "bench", "trace", "version", "help"}) {
         CLI::App* sub = app.add_subcommand(name);
@@ -82,6 +88,7 @@ int run_cli(int argc, char** argv) {
         std::fputs(kUsage, stdout);
         return 0;
     }
+    set_image_codec_file(codec_file);
     if (version || cmd == "version") return run_version_command();
     if (cmd.empty() || !app.remaining().empty()) {
         const std::string first = app.remaining().empty() ? args[0] : app.remaining()[0];

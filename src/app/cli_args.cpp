@@ -179,6 +179,7 @@ void add_render_flags(CLI::App& app, RenderOverrides& o) {
     add_parsed(app, "--builder", o.bvh_builder, parse_builder_name);
     add_parsed(app, "--layout", o.bvh_layout, parse_layout_name);
     add_parsed(app, "--sampler", o.sampler, parse_sampler_name);
+    app.add_flag_callback("--no-packets", [&o] { o.packets = false; });
     add_parsed(app, "--exposure", o.exposure, [](const std::string& flag, const std::string& v) {
         return float(parse_real_value(flag, v, -64.0, 64.0));
     });

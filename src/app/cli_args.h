@@ -59,7 +59,7 @@ CLI::Option* add_size_option(CLI::App& app, std::optional<int>& width, std::opti
 /// The render settings every rendering command takes (render, view, converge and
 /// converge's --compare): --spp, --width, --height, --size, --max-depth, --seed,
 /// --integrator, --time, --target-error, --builder, --layout, --sampler,
-/// --exposure, --tonemap.
+/// --no-packets, --exposure, --tonemap.
 void add_render_flags(CLI::App& app, RenderOverrides& o);
 
 }  // namespace sahara

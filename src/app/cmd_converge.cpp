@@ -12,6 +12,7 @@
 
 #include <omp.h>
 
+#include "app/mesh_input.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_io.h"
@@ -315,7 +316,7 @@ void print_summary(const std::vector<Series>& all) {
 }
 
 int run(const ConvergeArgs& a) {
-    SceneDesc base = a.scene ? parse_scene_file(*a.scene) : default_scene();
+    SceneDesc base = read_scene_argument(a.scene);
     a.overrides.apply(base.render);
     const int threads = a.threads > 0 ? a.threads : omp_get_max_threads();
     std::vector<ConvergeConfig> configs = a.configs;

@@ -10,6 +10,7 @@
 
 #include "app/cli_args.h"
 #include "base/error.h"
+#include "io/files.h"
 #include "io/model_loader.h"
 #include "pipeline/scene_info.h"
 #include "render/stats.h"
@@ -36,18 +37,12 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-std::string lower_ext(const fs::path& p) {
-    std::string e = p.extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return e;
-}
-
 /// A scene file, or a model wrapped into a scene description.
 SceneDesc load_input(const std::optional<std::string>& input) {
     if (!input) return default_scene();
-    const std::string ext = lower_ext(*input);
-    if (ext == ".json") return parse_scene_file(*input);
-    if (ext == ".obj" || ext == ".gltf" || ext == ".glb") {
+    const FileKind kind = file_kind(*input);
+    if (kind == FileKind::scene) return parse_scene_file(*input);
+    if (is_model_kind(kind)) {
         LoadedModel m = load_model(*input);
         SceneDesc d;
         d.source = *input;

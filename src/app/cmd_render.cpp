@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "app/mesh_input.h"
 #include "app/mpi_render.h"
 #include "app/preview.h"
 #include "app/render_args.h"
@@ -15,6 +16,7 @@
 #include "base/counters.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "io/files.h"
 #include "io/image_io.h"
 #include "pipeline/render_pipeline.h"
 #include "render/progress.h"
@@ -81,7 +83,7 @@ void maybe_checkpoint(RenderJob& job, const SnapshotFn& snapshot, double elapsed
     if (!job.args.checkpoint_s || seconds_since(job.last_checkpoint) < *job.args.checkpoint_s) return;
     const fs::path out(job.args.output);
     write_snapshot(job, snapshot, elapsed, out);
-    if (out.extension() != ".exr") write_snapshot(job, snapshot, elapsed, partial_path(out));
+    if (file_kind(out) != FileKind::exr) write_snapshot(job, snapshot, elapsed, partial_path(out));
     job.last_checkpoint = Clock::now();
 }
 
@@ -237,7 +239,7 @@ void print_job_summary(const RenderJob& job, const std::string& line, std::optio
                      std::string(tonemap_name(job.scene.render.tonemap)).c_str());
     if (unfinished)
         std::fprintf(stderr, "sahara: resume with --resume %s\n",
-                     (out.extension() == ".exr" ? out : partial_path(out)).string().c_str());
+                     (file_kind(out) == FileKind::exr ? out : partial_path(out)).string().c_str());
 }
 
 /// Renders, writes the output (and the resumable partial file if needed), reports.
@@ -271,7 +273,7 @@ int run_job(RenderJob& job, const std::atomic<bool>& signal_stop) {
     const size_t clipped = write_render(out, job.scene, job.film, meta, exposure);
     const bool unfinished = result.stop == StopReason::interrupted || result.stop == StopReason::time_limit;
     std::error_code ec;
-    if (out.extension() != ".exr") {
+    if (file_kind(out) != FileKind::exr) {
         if (unfinished)
             write_render(partial_path(out), job.scene, job.film, meta);
         else if (a.checkpoint_s)
@@ -303,7 +305,7 @@ int run_render_command(const std::vector<std::string>& args) {
         std::fputs(kRenderUsage, stdout);
         return 0;
     }
-    return run_render(a, [&a] { return a.scene ? parse_scene_file(*a.scene) : default_scene(); });
+    return run_render(a, [&a] { return read_scene_argument(a.scene); });
 }
 
 namespace {

@@ -18,6 +18,7 @@
 #include "app/cli_args.h"
 #include "base/error.h"
 #include "base/pending_file.h"
+#include "io/files.h"
 
 namespace sahara {
 
@@ -38,9 +39,7 @@ constexpr const char* kTraceUsage =
     "their index and are never hit. Outputs are written to a temporary file and renamed.\n";
 
 std::vector<Ray> read_ray_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw input_error(path, "", "cannot open ray file");
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = read_file(path, "ray file");
     if (bytes.size() % 32 != 0)
         throw input_error(
             path, "",
@@ -87,9 +86,9 @@ struct TraceArgs {
 };
 
 int trace(const TraceArgs& args) {
-    if (is_scene_file(args.mesh))
+    if (const FileKind kind = file_kind(args.mesh); kind == FileKind::scene || kind == FileKind::gltf)
         throw input_error(args.mesh, "",
-                          "trace reads meshes only (primitive indices are OBJ triangle indices)");
+                          "trace reads OBJ meshes only (primitive indices are OBJ triangle indices)");
     const std::vector<Ray> rays = read_ray_file(args.rays);
     const Scene scene = scene_from_mesh(read_obj_triangles(args.mesh));
     const Accelerator accel(scene);

@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "app/render_args.h"
+#include "io/files.h"
 #include "io/model_loader.h"
 #include "io/view_scene.h"
 
@@ -51,11 +52,6 @@ ViewArgs parse_view_args(const std::vector<std::string>& args) {
     return v;
 }
 
-bool is_gltf_file(const std::string& file) {
-    const std::string ext = std::filesystem::path(file).extension().string();
-    return ext == ".gltf" || ext == ".glb" || ext == ".GLTF" || ext == ".GLB";
-}
-
 }  // namespace
 
 int run_view_command(const std::vector<std::string>& args) {
@@ -71,7 +67,7 @@ int run_view_command(const std::vector<std::string>& args) {
     }
     const std::string model = *v.render.scene;
     return run_render(v.render,
-                      [&] { return make_view_scene(load_model(model), is_gltf_file(model), v.view, model); });
+                      [&] { return make_view_scene(load_model(model), file_kind(model) == FileKind::gltf, v.view, model); });
 }
 
 }  // namespace sahara

@@ -1,10 +1,9 @@
 #include "app/render_file.h"
 
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include "base/error.h"
+#include "io/files.h"
 #include "io/plot.h"
 #include "math/rng.h"
 #include "pipeline/render_pipeline.h"
@@ -92,11 +91,12 @@ const char* stop_reason_name(StopReason r) {
 }
 
 std::string scene_fingerprint(const std::string& source) {
-    std::ifstream in(source, std::ios::binary);
-    if (!in) return "-";
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    const std::string bytes = ss.str();
+    std::string bytes;
+    try {
+        bytes = read_file(source);
+    } catch (const InputError&) {
+        return "-";  // the built-in scene, or a file gone since it was parsed
+    }
     uint64_t h = hash_words(bytes.size(), 0x5a4a);
     for (size_t i = 0; i < bytes.size(); i += 8) {
         uint64_t word = 0;

@@ -4,7 +4,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <numbers>
 #include <numeric>
@@ -14,6 +13,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "io/files.h"
 #include "io/gltf_detail.h"
 #include "io/mesh_utils.h"
 
@@ -57,18 +57,6 @@ void check_version(const std::string& file, const nlohmann::json& doc) {
         if (v && v->first != 2)
             throw input_error(file, "asset.version", ver->get<std::string>() + " is not glTF 2.x");
     }
-}
-
-std::vector<unsigned char> read_bytes(const std::filesystem::path& file) {
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
-    if (!std::filesystem::is_regular_file(file, ec))
-        throw input_error(file.string(), "", "not a regular file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw input_error(file.string(), "", "cannot open file");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw input_error(file.string(), "", "read error");
-    return bytes;
 }
 
 uint32_t le32(const unsigned char* p) {
@@ -187,7 +175,7 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     Source src;
     src.file = file.string();
     src.dir = file.parent_path();
-    const std::vector<unsigned char> bytes = read_bytes(file);
+    const std::vector<unsigned char> bytes = read_file_bytes(file);
     precheck(src.file, src.dir, json_part(src.file, bytes));
     parse(src, bytes);
     LoadedModel out;

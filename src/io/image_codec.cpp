@@ -36,9 +36,15 @@ fs::path shared_object_dir() {
     return file.parent_path();
 }
 
+/// The file set_image_codec_file named; empty: none.
+std::string& chosen_codec_file() {
+    static std::string file;
+    return file;
+}
+
 /// Where the plugin may be, in the order tried (see kImageCodecLibrary).
 std::vector<fs::path> candidate_files() {
-    if (const char* forced = std::getenv("SAHARA_IMAGE_CODEC"); forced && *forced) return {forced};
+    if (const std::string& chosen = chosen_codec_file(); !chosen.empty()) return {chosen};
     std::vector<fs::path> files;
     // Inside a Python interpreter the executable is python3: the module keeps its plugin beside itself.
     if (const fs::path own = shared_object_dir(); !own.empty()) files.push_back(own / kImageCodecLibrary);
@@ -78,6 +84,8 @@ Loaded load() {
 }
 
 }  // namespace
+
+void set_image_codec_file(const std::string& file) { chosen_codec_file() = file; }
 
 ImageCodecSearch find_image_codec() {
     ImageCodecSearch search;

@@ -73,8 +73,14 @@ inline constexpr const char* kImageCodecSymbol = "sahara_image_codec_api";
 /// beside the shared object the library is linked into (the Python module's
 /// package directory), beside the executable (the build tree), then in the plugin directory of the
 /// installed layout (lib/sahara beside bin by default; CMake compiles in the
-/// relative path). SAHARA_IMAGE_CODEC, when set, names the file to load instead.
+/// relative path). set_image_codec_file (`sahara --image-codec FILE`) names the
+/// file to load instead.
 inline constexpr const char* kImageCodecLibrary = "libsahara_image_codec.so";
+
+/// Makes `file` the only place the plugin is looked for (empty: the places
+/// above again). Effective only before the codec is first needed: call it
+/// before any image is read or written.
+void set_image_codec_file(const std::string& file);
 
 /// The outcome of looking for the plugin file (nothing is loaded).
 struct ImageCodecSearch {

@@ -12,23 +12,13 @@
 
 #include "base/error.h"
 #include "base/pending_file.h"
+#include "io/files.h"
 #include "io/image_bytes.h"
 #include "io/image_codec.h"
 
 namespace sahara {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string lower_extension(const fs::path& file) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
-}
-
-}  // namespace
 
 float srgb_encode(float v) {
     if (!(v > 0.0f)) return 0.0f;
@@ -54,12 +44,9 @@ std::shared_ptr<const Image> read_image(const fs::path& file, bool srgb_to_linea
     return img;
 }
 
-bool is_supported_output(const fs::path& file) {
-    const std::string ext = lower_extension(file);
-    return ext == ".png" || ext == ".exr" || ext == ".hdr" || ext == ".pfm";
-}
+bool is_supported_output(const fs::path& file) { return is_output_image_kind(file_kind(file)); }
 
-bool is_hdr_output(const fs::path& file) { return lower_extension(file) != ".png"; }
+bool is_hdr_output(const fs::path& file) { return file_kind(file) != FileKind::png; }
 
 void check_output_path(const fs::path& file) {
     const std::string name = file.string();
@@ -71,7 +58,7 @@ void check_output_path(const fs::path& file) {
     if (!fs::is_directory(dir, ec))
         throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
-    if (lower_extension(file) != ".pfm")
+    if (file_kind(file) != FileKind::pfm)
         image_codec(name);  // a missing codec fails here, not after the render
 }
 
@@ -88,7 +75,7 @@ struct EncodedPixels {
 void encode_pixels(const fs::path& file, int width, int height, const std::vector<float>& rgb,
                    const std::vector<ExtraChannel>& extra, EncodedPixels& e) {
     const bool hdr = is_hdr_output(file);
-    const bool with_extra = lower_extension(file) == ".exr" && !extra.empty();
+    const bool with_extra = file_kind(file) == FileKind::exr && !extra.empty();
     e.spec.width = width;
     e.spec.height = height;
     e.spec.types.assign(3, hdr ? ChannelType::f32 : ChannelType::u8);
@@ -146,7 +133,7 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
                  const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
     const std::string name = file.string();
     const fs::path tmp = temp_path_for(file);
-    const bool pfm = lower_extension(file) == ".pfm";
+    const bool pfm = file_kind(file) == FileKind::pfm;
     const ImageCodecApi* codec = pfm ? nullptr : &image_codec(name);
     EncodedPixels pixels;
     if (!pfm) encode_pixels(file, width, height, rgb, extra, pixels);

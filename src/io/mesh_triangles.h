@@ -7,7 +7,8 @@
 /// (v0,v2,v3), ..., (v0,vk-1,vk). Concave polygons are fan-split the same way,
 /// without ear clipping, so their fan may cover area outside the polygon.
 /// Zero-area triangles are KEPT so that indices stay file-order indices.
-/// Only positions are read (the tools need no normals, UVs or materials).
+/// The OBJ is read by io's loader (load_obj with ObjReadOptions), without its
+/// materials; only positions and indices are kept.
 #include <filesystem>
 
 #include "desc/scene_desc.h"
@@ -19,7 +20,7 @@ namespace sahara {
 TriangleMesh read_obj_triangles(const std::filesystem::path& file);
 
 /// Triangles of any mesh file: OBJ through read_obj_triangles (file order kept,
-/// degenerate triangles kept), .gltf/.glb through the glTF loader with every
+/// degenerate triangles kept), .gltf/.glb (any case) through the glTF loader with every
 /// mesh of the default scene merged into one.
 TriangleMesh read_mesh_triangles(const std::filesystem::path& file);
 

@@ -1,19 +1,21 @@
 #include "io/model_loader.h"
 
-#include <algorithm>
-#include <cctype>
-
 #include "base/error.h"
+#include "io/files.h"
 
 namespace sahara {
 
 LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".obj") return load_obj(file, world_from_model);
-    if (ext == ".gltf" || ext == ".glb") return load_gltf(file, world_from_model);
-    throw input_error(file.string(), "", "unknown model format '" + ext + "' (expected .obj, .gltf or .glb)");
+    switch (file_kind(file)) {
+        case FileKind::obj:
+            return load_obj(file, world_from_model);
+        case FileKind::gltf:
+            return load_gltf(file, world_from_model);
+        default:
+            throw input_error(file.string(), "",
+                              "unknown model format '" + file.extension().string() +
+                                  "' (expected .obj, .gltf or .glb)");
+    }
 }
 
 }  // namespace sahara

@@ -24,6 +24,15 @@ struct LoadedModel {
 /// `world_from_model` is applied to positions/normals (and glTF node transforms before it).
 LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+
+/// How load_obj reads a file for the BVH tools (io/mesh_triangles.h) rather than for rendering.
+struct ObjReadOptions {
+    bool materials = true;         ///< false: no mtllib, no textures; every face gets the default material
+    bool fan_split = false;        ///< true: polygon v0..vk gives (v0,v1,v2), (v0,v2,v3)... (no ear clipping)
+    bool keep_degenerate = false;  ///< true: zero-area triangles stay, so triangle i is the file's i-th
+};
+LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model,
+                     const ObjReadOptions& options);
 LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
 
 }  // namespace sahara

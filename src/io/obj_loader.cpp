@@ -6,13 +6,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
 #include "base/error.h"
 #include "base/log.h"
+#include "io/files.h"
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
@@ -21,20 +22,6 @@
 namespace sahara {
 
 namespace {
-
-/// Reads a whole file; InputError if it cannot be opened.
-std::string read_text_file(const std::filesystem::path& file) {
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) throw input_error(file.string(), "", "no such file");
-    if (!std::filesystem::is_regular_file(file, ec))
-        throw input_error(file.string(), "", "not a regular file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw input_error(file.string(), "", "cannot open file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw input_error(file.string(), "", "read error");
-    return ss.str();
-}
 
 /// First line of a multi-line library message, trimmed to a sane length.
 std::string first_line(const std::string& text) {
@@ -62,10 +49,12 @@ class MtlFileReader : public tinyobj::MaterialReader {
     bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* names, std::string* warn, std::string* err) override {
         const std::filesystem::path path = obj_file_.parent_path() / portable_path(name);
-        std::error_code ec;
-        std::ifstream in;
-        if (std::filesystem::is_regular_file(path, ec)) in.open(path, std::ios::binary);
-        if (!in.is_open()) {
+        std::optional<std::string> text;
+        try {
+            text = read_file(path);
+        } catch (const InputError&) {  // missing or unreadable: the model still loads
+        }
+        if (!text) {
             log_warning(path.string() + ": material library not found (mtllib of " +
                         obj_file_.filename().string() + "), using the default material");
             return false;
@@ -73,6 +62,7 @@ class MtlFileReader : public tinyobj::MaterialReader {
         if (!found_) dir_ = path.parent_path();
         found_ = true;
         files_.push_back(path);
+        std::istringstream in(*text);
         tinyobj::LoadMtl(names, materials, &in, warn, err);
         return true;
     }
@@ -112,9 +102,10 @@ void validate_attributes(const std::string& file, const tinyobj::attrib_t& attri
     }
 }
 
-/// Identifies an output vertex: OBJ position/texcoord/normal indices. Faces
-/// without normals store -(face + 2) as normal index: their vertices carry
-/// that face's own flat normal.
+/// Identifies an output vertex: OBJ position/texcoord/normal indices. In a
+/// group with normals, faces without them store -(face + 2) as normal index:
+/// their vertices carry that face's own flat normal. A group without normals
+/// shares its vertices between faces.
 struct VertexKey {
     int v, vt, vn;
     bool operator==(const VertexKey&) const = default;
@@ -131,8 +122,12 @@ struct VertexKeyHash {
 class ObjShapeBuilder {
    public:
     ObjShapeBuilder(const std::string& file, const tinyobj::attrib_t& attrib, LoadedModel& model,
-                    int& default_material)
-        : file_(file), attrib_(attrib), model_(model), default_material_(default_material) {}
+                    int& default_material, bool fan_split)
+        : file_(file),
+          attrib_(attrib),
+          model_(model),
+          default_material_(default_material),
+          fan_split_(fan_split) {}
 
     TriangleMesh build(const tinyobj::shape_t& shape, size_t& face_number) {
         const tinyobj::mesh_t& m = shape.mesh;
@@ -186,7 +181,9 @@ class ObjShapeBuilder {
             if (length_squared(n) > 0.0) flat = Vec3(normalize(n));
         }
         local_.clear();
-        if (poly_.size() == 4 && is_convex_quad(poly_))
+        if (fan_split_)
+            for (uint32_t k = 1; k + 1 < poly_.size(); ++k) local_.insert(local_.end(), {0, k, k + 1});
+        else if (poly_.size() == 4 && is_convex_quad(poly_))
             local_ = {0, 1, 2, 0, 2, 3};  // the v0-v2 diagonal, as Blender, assimp and tinyobjloader split
         else
             triangulate_polygon(poly_, local_);
@@ -194,8 +191,8 @@ class ObjShapeBuilder {
         for (size_t t = 0; t < local_.size(); t += 3) {
             for (size_t k = 0; k < 3; ++k) {
                 const tinyobj::index_t& i = face[local_[t + k]];
-                const VertexKey key{i.vertex_index, i.texcoord_index,
-                                    face_normals ? i.normal_index : -int(face_number) - 1};
+                const int vn = face_normals ? i.normal_index : with_normals_ ? -int(face_number) - 1 : -1;
+                const VertexKey key{i.vertex_index, i.texcoord_index, vn};
                 mesh_.indices.push_back(vertex(key, poly_[local_[t + k]], flat));
             }
             mesh_.material_ids.push_back(material);
@@ -239,6 +236,7 @@ class ObjShapeBuilder {
     const tinyobj::attrib_t& attrib_;
     LoadedModel& model_;
     int& default_material_;
+    const bool fan_split_;
     TriangleMesh mesh_;
     std::unordered_map<VertexKey, uint32_t, VertexKeyHash> map_;
     bool with_normals_ = false, with_uvs_ = false;
@@ -248,11 +246,11 @@ class ObjShapeBuilder {
 
 /// One mesh per group; per-triangle material ids collapse to `material` when uniform.
 void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
-                      const std::vector<tinyobj::shape_t>& shapes, LoadedModel& model) {
+                      const std::vector<tinyobj::shape_t>& shapes, bool fan_split, LoadedModel& model) {
     validate_attributes(file, attrib);
     int default_material = -1;
     size_t face_number = 0;
-    ObjShapeBuilder builder(file, attrib, model, default_material);
+    ObjShapeBuilder builder(file, attrib, model, default_material, fan_split);
     for (const tinyobj::shape_t& shape : shapes) {
         TriangleMesh mesh = builder.build(shape, face_number);
         if (mesh.indices.empty()) continue;
@@ -265,11 +263,28 @@ void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
     }
 }
 
+/// tinyobjloader's warnings, one line each; a missing .mtl is reported by MtlFileReader, and
+/// without materials (the BVH tools) unknown usemtl names are expected.
+void log_obj_warnings(const std::string& file, const std::string& warn, bool materials) {
+    std::istringstream warnings(warn);
+    for (std::string line; std::getline(warnings, line);) {
+        if (line.empty() || line.find("Failed to load material file") != std::string::npos) continue;
+        if (!materials && line.find("not found in .mtl") != std::string::npos) continue;
+        log_warning(file + ": " + line);
+    }
+}
+
 }  // namespace
 
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model) {
-    const std::string text = read_text_file(file);
+    return load_obj(file, world_from_model, ObjReadOptions{});
+}
+
+LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model,
+                     const ObjReadOptions& options) {
+    const std::string text = read_file(file);
     obj::check_encoding(file.string(), text);
+    reject_non_finite_words(file.string(), text);
     obj::check_obj_numbers(file.string(), text);
     std::istringstream stream(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);  // UTF-8 BOM
     MtlFileReader mtl_reader(file);
@@ -277,29 +292,27 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
     std::string warn, err;
-    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, &mtl_reader,
+    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream,
+                          options.materials ? &mtl_reader : nullptr,
                           /*triangulate=*/false,
                           /*default_vcols_fallback=*/false))
         throw input_error(file.string(), "", "malformed OBJ: " + first_line(err));
-    std::istringstream warnings(warn);
-    for (std::string line; std::getline(warnings, line);)
-        if (!line.empty() && line.find("Failed to load material file") == std::string::npos)
-            log_warning(file.string() + ": " + line);
+    log_obj_warnings(file.string(), warn, options.materials);
 
     LoadedModel model;
     obj::MtlKeys keys;
     for (const std::filesystem::path& mtl : mtl_reader.files())
-        for (auto& [name, set] : obj::scan_mtl(mtl.string(), read_text_file(mtl))) keys[name].merge(set);
+        for (auto& [name, set] : obj::scan_mtl(mtl.string(), read_file(mtl))) keys[name].merge(set);
     obj::ObjTextures textures(model, mtl_reader.texture_dir());
     for (const tinyobj::material_t& m : materials)
         model.materials.push_back(obj::convert_material(m, keys[m.name], textures));
-    build_obj_meshes(file.string(), attrib, shapes, model);
+    build_obj_meshes(file.string(), attrib, shapes, options.fan_split, model);
     if (model.meshes.empty()) throw input_error(file.string(), "", "no faces (is this an OBJ file?)");
     if (model.materials.empty()) model.materials.push_back(default_material());
 
     for (TriangleMesh& mesh : model.meshes) {
         transform_mesh(mesh, world_from_model);
-        model.dropped_degenerate += remove_degenerate(mesh);
+        if (!options.keep_degenerate) model.dropped_degenerate += remove_degenerate(mesh);
     }
     std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.indices.empty(); });
     if (model.dropped_degenerate > 0)

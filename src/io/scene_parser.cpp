@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "io/files.h"
 #include "io/image_io.h"
 #include "io/scene_parser_internal.h"
 
@@ -203,19 +204,6 @@ void parse_materials(JsonObject o, ParseContext& ctx) {
     }
 }
 
-std::string read_text_file(const std::filesystem::path& file) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec))
-        throw input_error(file.string(), "", "is a directory, not a scene file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in)
-        throw input_error(file.string(), "", std::string("cannot open scene file: ") + std::strerror(errno));
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw input_error(file.string(), "", "read error");
-    return ss.str();
-}
-
 }  // namespace
 
 // --- ParseContext ------------------------------------------------------------------
@@ -267,7 +255,7 @@ SceneLoaders SceneLoaders::standard() {
 }
 
 SceneDesc parse_scene_file(const std::filesystem::path& file) {
-    return parse_scene_json(read_text_file(file), file);
+    return parse_scene_json(read_file(file, "scene file"), file);
 }
 
 SceneDesc parse_scene_json(const std::string& text, const std::filesystem::path& file) {

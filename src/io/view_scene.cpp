@@ -54,6 +54,50 @@ UpAxis guess_up_axis(const LoadedModel& model, std::string& reason) {
     return UpAxis::y;
 }
 
+namespace {
+
+/// The up axis: the user's, a glTF's (+y by the spec), or guessed for an OBJ.
+UpAxis choose_up_axis(const LoadedModel& model, bool is_gltf, const ViewOptions& options) {
+    if (options.up) return *options.up;
+    if (is_gltf) return UpAxis::y;
+    std::string reason;
+    const UpAxis up = guess_up_axis(model, reason);
+    log_info(std::string("up axis guessed as ") + (up == UpAxis::y ? "y" : "z") + " (" + reason +
+             "); use --up y|z to change it");
+    return up;
+}
+
+/// A checkered ground plane touching the lowest point of the model along `up`.
+void add_ground(SceneDesc& scene, const Bounds3& box, UpAxis up) {
+    const float radius = 0.5f * length(box.extent());
+    MaterialDesc ground;
+    ground.name = "view-ground";
+    ground.albedo.kind = ColorSource::Kind::checker;
+    ground.albedo.even = {0.75f, 0.75f, 0.75f};
+    ground.albedo.odd = {0.55f, 0.55f, 0.55f};
+    ground.albedo.checker_scale = std::max(radius * 0.25f, 1e-6f);
+    scene.materials.push_back(ground);
+    const float lowest = up == UpAxis::y ? box.lo.y : box.lo.z;
+    PlaneDesc plane;
+    plane.point = box.center();
+    (up == UpAxis::y ? plane.point.y : plane.point.z) = lowest;
+    plane.normal = axis_vector(up);
+    plane.material = uint32_t(scene.materials.size() - 1);
+    scene.planes.push_back(plane);
+}
+
+/// A warm sun from above, slightly to the side and front.
+void add_sun(SceneDesc& scene, UpAxis up) {
+    LightDesc sun;
+    sun.type = LightDesc::Type::directional;
+    sun.direction = -normalize(axis_vector(up) * 1.0f + Vec3(0.4f, 0, 0) +
+                               (up == UpAxis::y ? Vec3(0, 0, 0.3f) : Vec3(0, -0.3f, 0)));
+    sun.irradiance = {2.0f, 1.9f, 1.7f};
+    scene.lights.push_back(sun);
+}
+
+}  // namespace
+
 SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& options,
                           const std::string& source) {
     if (model.meshes.empty()) throw input_error(source, "", "the model has no triangles to show");
@@ -64,20 +108,11 @@ SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& op
     scene.render.height = 600;
     scene.render.spp = 64;
 
-    UpAxis up = UpAxis::y;
-    if (options.up) {
-        up = *options.up;
-    } else if (!is_gltf) {
-        std::string reason;
-        up = guess_up_axis(model, reason);
-        log_info(std::string("up axis guessed as ") + (up == UpAxis::y ? "y" : "z") + " (" + reason +
-                 "); use --up y|z to change it");
-    }
+    const UpAxis up = choose_up_axis(model, is_gltf, options);
     const Bounds3 box = model_bounds(model);
     std::vector<CameraDesc> cameras = model.cameras;
     merge_loaded_model(scene, std::move(model), std::nullopt);
 
-    const Vec3 upv = axis_vector(up);
     const float aspect = float(scene.render.width) / float(scene.render.height);
     if (options.gltf_camera) {
         if (*options.gltf_camera < 0 || size_t(*options.gltf_camera) >= cameras.size())
@@ -88,34 +123,9 @@ SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& op
         scene.camera = frame_box(box, up, 35.0f, aspect);
     }
     scene.background.type = BackgroundDesc::Type::gradient;
-    scene.background.up = upv;
-
-    const float radius = 0.5f * length(box.extent());
-    if (options.ground) {
-        MaterialDesc ground;
-        ground.name = "view-ground";
-        ground.albedo.kind = ColorSource::Kind::checker;
-        ground.albedo.even = {0.75f, 0.75f, 0.75f};
-        ground.albedo.odd = {0.55f, 0.55f, 0.55f};
-        ground.albedo.checker_scale = std::max(radius * 0.25f, 1e-6f);
-        scene.materials.push_back(ground);
-        // The plane touches the lowest point of the model along `up`.
-        const float lowest = up == UpAxis::y ? box.lo.y : box.lo.z;
-        PlaneDesc plane;
-        plane.point = box.center();
-        (up == UpAxis::y ? plane.point.y : plane.point.z) = lowest;
-        plane.normal = upv;
-        plane.material = uint32_t(scene.materials.size() - 1);
-        scene.planes.push_back(plane);
-    }
-    if (options.sun) {
-        LightDesc sun;
-        sun.type = LightDesc::Type::directional;
-        sun.direction = -normalize(upv * 1.0f + Vec3(0.4f, 0, 0) +
-                                   (up == UpAxis::y ? Vec3(0, 0, 0.3f) : Vec3(0, -0.3f, 0)));
-        sun.irradiance = {2.0f, 1.9f, 1.7f};
-        scene.lights.push_back(sun);
-    }
+    scene.background.up = axis_vector(up);
+    if (options.ground) add_ground(scene, box, up);
+    if (options.sun) add_sun(scene, up);
     return scene;
 }
 

@@ -1,15 +1,21 @@
 #include "pipeline/mesh_input.h"
 
 #include "base/error.h"
+#include "io/files.h"
 #include "io/scene_parser.h"
 
 namespace sahara {
 
-bool is_scene_file(const std::filesystem::path& file) { return file.extension() == ".json"; }
+SceneDesc read_scene_argument(const std::optional<std::string>& file) {
+    if (!file) return default_scene();
+    if (is_model_kind(file_kind(*file)))
+        throw input_error(*file, "", "a model, not a scene file (`sahara view " + *file + "` renders a model)");
+    return parse_scene_file(*file);
+}
 
 ToolInput read_tool_input(const std::filesystem::path& file) {
     ToolInput in;
-    if (!is_scene_file(file)) {
+    if (file_kind(file) != FileKind::scene) {
         in.triangles = read_mesh_triangles(file);
         in.scene = scene_from_mesh(in.triangles);
         return in;

@@ -1,7 +1,10 @@
 #pragma once
-/// What the BVH tools (`sahara bvh`, `bench`, `trace`) read: a mesh
-/// (io/mesh_triangles.h, scene/mesh_scene.h) or a whole scene file.
+/// What the commands read: the scene of `render` and `converge`, and what the
+/// BVH tools (`sahara bvh`, `bench`, `trace`) read: a mesh
+/// (io/mesh_triangles.h, scene/mesh_scene.h) or a whole scene file. The file
+/// kind comes from io/files.h, so the extension's case does not matter.
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "io/mesh_triangles.h"
@@ -10,8 +13,10 @@
 
 namespace sahara {
 
-/// Whether the BVH tools read `file` as a scene file (extension .json) rather than a mesh.
-bool is_scene_file(const std::filesystem::path& file);
+/// The scene of `render` and `converge`: the file parsed as a scene (any
+/// extension but a model's), or the built-in scene when none is given. A model
+/// file (.obj, .gltf, .glb) is an InputError that points to `sahara view`.
+SceneDesc read_scene_argument(const std::optional<std::string>& file);
 
 /// What `sahara bvh` and `bench` trace: a mesh or a whole scene file.
 struct ToolInput {

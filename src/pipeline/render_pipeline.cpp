@@ -25,6 +25,7 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (sampler) r.sampler = *sampler;
     if (bvh_builder) r.bvh_builder = *bvh_builder;
     if (bvh_layout) r.bvh_layout = *bvh_layout;
+    if (packets) r.packets = *packets;
 }
 
 SceneDesc load_scene_source(const std::optional<std::string>& source) {

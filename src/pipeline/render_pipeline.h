@@ -26,6 +26,7 @@ struct RenderOverrides {
     std::optional<SamplerType> sampler;
     std::optional<BvhBuilder> bvh_builder;
     std::optional<BvhLayout> bvh_layout;
+    std::optional<bool> packets;
 
     void apply(RenderSettings& r) const;
 };

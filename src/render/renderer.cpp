@@ -35,9 +35,9 @@ void render_pixel(const Scene& scene, const Camera& camera, Film& film, Sampler&
 
 /// Whether camera rays are traced as packets: the path integrator (which can
 /// take a first hit), where the scene says packets are faster than single rays
-/// (Scene::packets_pay_off; SAHARA_PACKETS=0 turns them off).
+/// (Scene::packets_pay_off), unless --no-packets (RenderSettings::packets).
 bool use_packets(const Scene& scene) {
-    return scene.render.integrator == IntegratorType::path && scene.packets_pay_off();
+    return scene.render.packets && scene.render.integrator == IntegratorType::path && scene.packets_pay_off();
 }
 
 /// Takes samples [begin[i], end[i]) of the pixels of the block of up to 4x4

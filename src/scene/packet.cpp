@@ -83,24 +83,6 @@ namespace packet_avx512 {
 }  // namespace packet_avx512
 #pragma GCC pop_options
 
-namespace {
-
-std::atomic<int> g_packets_override{-1};
-
-}  // namespace
-
-bool packets_enabled() {
-    const int o = g_packets_override.load(std::memory_order_relaxed);
-    if (o >= 0) return o != 0;
-    static const bool from_env = [] {
-        const char* env = std::getenv("SAHARA_PACKETS");
-        return !(env && std::strcmp(env, "0") == 0);
-    }();
-    return from_env;
-}
-
-void set_packets_enabled(bool on) { g_packets_override.store(on ? 1 : 0, std::memory_order_relaxed); }
-
 void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     for (int i = 0; i < kPacketSize; ++i) hits.prim[i] = kNoPrim, hits.t[i] = kInfinity;
     if (!packet.active) return;

@@ -144,8 +144,8 @@ TEST_CASE("cli: OpenImageIO is loaded only by commands that read or write an ima
 TEST_CASE("cli: a missing image codec exits 2 before rendering and writes nothing") {
     TempDir dir("nocodec");
     const std::string out = dir / "out.png";
-    const std::string cmd = "SAHARA_IMAGE_CODEC=" + (dir / "no-such-codec.so") + " " +
-                            std::string(SAHARA_EXE) + " render" + kSmall + "--spp 1 -o " + out +
+    const std::string cmd = std::string(SAHARA_EXE) + " --image-codec " + (dir / "no-such-codec.so") +
+                            " render" + kSmall + "--spp 1 -o " + out +
                             " >/dev/null 2>" + (dir / "err.txt");
     const int status = std::system(cmd.c_str());
     CHECK(WIFEXITED(status));
@@ -345,6 +345,15 @@ TEST_CASE("render --layout picks the traversal structure the scene's tree is bui
         CHECK_THROWS_WITH_AS(parse_render_args({"--layout", removed}),
                              doctest::Contains("expected wide8|pairs"), UsageError);
     CHECK_THROWS_AS(parse_render_args({"--layout"}), UsageError);
+}
+
+TEST_CASE("render --no-packets traces camera rays one by one") {
+    RenderSettings r;
+    CHECK(r.packets);
+    parse_render_args({}).overrides.apply(r);
+    CHECK(r.packets);
+    parse_render_args({"--no-packets"}).overrides.apply(r);
+    CHECK_FALSE(r.packets);
 }
 
 TEST_CASE("render flags accept the scene file's ranges, and --size WxH or N") {

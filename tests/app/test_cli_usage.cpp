@@ -112,7 +112,7 @@ TEST_CASE("cli: --version names the version and every optional part") {
 TEST_CASE("cli: --version reports a missing plugin and a narrowed SIMD path") {
     TempDir dir("version_env");
     const std::string missing = (dir.path / "no-codec.so").string();
-    const CliRun r = run_sahara("--version", dir, "SAHARA_IMAGE_CODEC=" + missing + " SAHARA_SIMD=sse2");
+    const CliRun r = run_sahara("--image-codec " + missing + " --version", dir, "SAHARA_SIMD=sse2");
     CHECK(r.code == 0);
     CHECK(r.out.find("plugin not found (looked for " + missing + ")") != std::string::npos);
     if (sahara::best_simd_path() != sahara::SimdPath::sse2)

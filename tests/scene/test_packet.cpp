@@ -265,7 +265,7 @@ TEST_CASE(
     }
 }
 
-TEST_CASE("SIMD path names, forcing a path and the SAHARA_PACKETS switch") {
+TEST_CASE("SIMD path names and forcing a path") {
     CHECK(std::strcmp(simd_path_name(SimdPath::avx512), "avx512") == 0);
     CHECK(std::strcmp(simd_path_name(SimdPath::avx2), "avx2") == 0);
     CHECK(std::strcmp(simd_path_name(SimdPath::sse2), "sse2") == 0);
@@ -275,12 +275,6 @@ TEST_CASE("SIMD path names, forcing a path and the SAHARA_PACKETS switch") {
     CHECK(active_simd_path() == SimdPath::sse2);
     clear_forced_simd_path();
     CHECK(active_simd_path() == automatic);
-    const bool was = packets_enabled();
-    set_packets_enabled(false);
-    CHECK_FALSE(packets_enabled());
-    set_packets_enabled(true);
-    CHECK(packets_enabled());
-    set_packets_enabled(was);
 }
 
 namespace {
@@ -299,18 +293,17 @@ void check_packets_keep_image(SceneDesc desc, int w, int h, int spp) {
     desc.render.width = w;
     desc.render.height = h;
     desc.render.spp = spp;
+    desc.render.packets = true;
     const Scene scene = build_scene(desc);
+    desc.render.packets = false;  // what --no-packets sets
+    const Scene single_rays = build_scene(desc);
     Film with(w, h), without(w, h), pass_with(w, h), pass_without(w, h);
     RenderOptions o;
     o.threads = 2;
-    const bool was = packets_enabled();
-    set_packets_enabled(true);
     render_image(scene, with, o);
     render_pass(scene, pass_with, 0, spp, 2, nullptr);
-    set_packets_enabled(false);
-    render_image(scene, without, o);
-    render_pass(scene, pass_without, 0, spp, 2, nullptr);
-    set_packets_enabled(was);
+    render_image(single_rays, without, o);
+    render_pass(single_rays, pass_without, 0, spp, 2, nullptr);
     CHECK(same_film(with, without));
     CHECK(same_film(pass_with, pass_without));
     CHECK(same_film(with, pass_with));
