@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""Casts the same rays through sahara.RayCaster and Open3D's RaycastingScene.
+
+    PYTHONPATH=build/python python3 bench/raycast_vs_open3d.py MESH [--rays N]
+
+Two ray sets: N random rays (origins on a sphere around the mesh, aimed at random
+points inside its box) and a pinhole camera's rays (sqrt(N) x sqrt(N) pixels).
+Prints hit/miss agreement, t agreement and MRays/s of both engines with all
+threads (one warm-up call, then the best of --repeats). Rays on which the two
+disagree are re-tested in double precision against every triangle, which says
+which engine was right. --markdown prints the table row docs/performance.md uses.
+"""
+import argparse
+import os
+import time
+
+import numpy as np
+
+import sahara
+
+try:
+    import open3d as o3d
+except ImportError:  # pragma: no cover
+    raise SystemExit("needs Open3D (Debian: apt-get install python3-open3d)")
+
+
+def random_rays(vertices, count, rng):
+    lo, hi = vertices.min(0), vertices.max(0)
+    center, radius = (lo + hi) / 2, np.linalg.norm(hi - lo)
+    d = rng.normal(size=(count, 3))
+    origins = center + radius * d / np.linalg.norm(d, axis=1, keepdims=True)
+    targets = rng.uniform(lo, hi, size=(count, 3))
+    return np.hstack([origins, targets - origins]).astype(np.float32)
+
+
+def camera_rays(vertices, count):
+    """A 40-degree pinhole camera looking at the box centre from a diagonal."""
+    side = max(1, int(round(count ** 0.5)))
+    lo, hi = vertices.min(0), vertices.max(0)
+    center, size = (lo + hi) / 2, np.linalg.norm(hi - lo)
+    eye = center + size * np.array([0.6, 0.45, 0.9])
+    forward = (center - eye) / np.linalg.norm(center - eye)
+    right = np.cross(forward, [0, 1, 0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    half = np.tan(np.radians(20))
+    s = (np.arange(side) + 0.5) / side * 2 - 1
+    x, y = np.meshgrid(s * half, -s * half)
+    dirs = forward + x[..., None] * right + y[..., None] * up
+    return np.hstack([np.broadcast_to(eye, (side * side, 3)), dirs.reshape(-1, 3)]).astype(np.float32)
+
+
+def best_of(fn, repeats):
+    fn()  # warm-up: page faults, thread pools, lazy builds
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def double_check(vertices, triangles, ray):
+    """Nearest hit of one ray in double (Möller-Trumbore over all triangles), and how close
+    the nearest crossing lies to a triangle edge (barycentric margin; ~0: on an edge)."""
+    o, d = ray[:3].astype(float), ray[3:].astype(float)
+    p0, p1, p2 = (vertices[triangles[:, k]].astype(float) for k in range(3))
+    e1, e2 = p1 - p0, p2 - p0
+    pv = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, pv)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1 / det
+        s = o - p0
+        u = np.einsum("ij,ij->i", s, pv) * inv
+        q = np.cross(s, e1)
+        v = q @ d * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+    margin = np.minimum(np.minimum(u, v), 1 - u - v)
+    ok = (det != 0) & (margin >= 0) & (t > 0)
+    if not ok.any():
+        return np.inf, float(np.nanmax(np.where((det != 0) & (t > 0), margin, -np.inf)))
+    i = np.argmin(np.where(ok, t, np.inf))
+    return t[i], float(margin[i])
+
+
+def compare(name, rays, caster, scene, repeats, vertices, triangles):
+    t_rays = o3d.core.Tensor(rays)
+    ours = caster.cast_rays(rays)
+    theirs = scene.cast_rays(t_rays)
+    s_t, o_t = ours["t_hit"], theirs["t_hit"].numpy()
+    s_hit, o_hit = np.isfinite(s_t), np.isfinite(o_t)
+    agree = s_hit == o_hit
+    both = s_hit & o_hit
+    rel = np.abs(s_t[both] - o_t[both]) / np.maximum(np.abs(o_t[both]), 1e-30)
+    s_time = best_of(lambda: caster.cast_rays(rays), repeats)
+    o_time = best_of(lambda: scene.cast_rays(t_rays), repeats)
+    n = len(rays)
+    verdict = {"sahara": 0, "open3d": 0, "edge": 0}
+    for i in np.flatnonzero(~agree)[:200]:
+        t_ref, margin = double_check(vertices, triangles, rays[i])
+        if abs(margin) < 1e-9:
+            verdict["edge"] += 1  # within double rounding of an edge: both answers are defensible
+        elif np.isfinite(t_ref) == s_hit[i]:
+            verdict["sahara"] += 1
+        else:
+            verdict["open3d"] += 1
+    row = {
+        "set": name, "rays": n, "hit_rate": s_hit.mean(), "agree": agree.mean(), "disagree": int((~agree).sum()),
+        "t_within_1e-5": float(np.mean(rel <= 1e-5)) if len(rel) else 1.0,
+        "t_max_rel": float(rel.max()) if len(rel) else 0.0,
+        "sahara_mrays": n / s_time / 1e6, "open3d_mrays": n / o_time / 1e6, "verdict": verdict,
+    }
+    print(f"{name:7s} {n} rays, {100 * row['hit_rate']:.1f}% hit | hit/miss agree {100 * row['agree']:.4f}% "
+          f"({row['disagree']} differ; double check of up to 200: sahara right {verdict['sahara']}, "
+          f"open3d right {verdict['open3d']}, on an edge {verdict['edge']}) | t within 1e-5 rel "
+          f"{100 * row['t_within_1e-5']:.3f}%, max {row['t_max_rel']:.2e} | MRays/s sahara "
+          f"{row['sahara_mrays']:.2f}, open3d {row['open3d_mrays']:.2f} ({row['sahara_mrays'] / row['open3d_mrays']:.2f}x)")
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("mesh", help="OBJ or glTF file")
+    ap.add_argument("--rays", type=int, default=1_000_000, help="rays per set (default 1M)")
+    ap.add_argument("--repeats", type=int, default=5, help="timed runs per engine; the best counts")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--markdown", action="store_true", help="also print docs/performance.md table rows")
+    args = ap.parse_args()
+
+    start = time.perf_counter()
+    caster = sahara.RayCaster.from_file(args.mesh)
+    sahara_build = time.perf_counter() - start
+    vertices, triangles = np.array(caster.vertices), np.array(caster.triangles)
+    start = time.perf_counter()
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(vertices), o3d.core.Tensor(triangles))
+    scene.cast_rays(o3d.core.Tensor(np.zeros((1, 6), np.float32)))  # Embree commits the scene lazily
+    open3d_build = time.perf_counter() - start
+    print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {os.cpu_count()} threads; "
+          f"build sahara {1e3 * sahara_build:.0f} ms (load included), open3d {1e3 * open3d_build:.0f} ms")
+    rng = np.random.default_rng(args.seed)
+    rows = [compare("random", random_rays(vertices, args.rays, rng), caster, scene, args.repeats, vertices, triangles),
+            compare("camera", camera_rays(vertices, args.rays), caster, scene, args.repeats, vertices, triangles)]
+    if args.markdown:
+        for r in rows:
+            v = r["verdict"]
+            print(f"| {os.path.basename(args.mesh)} | {len(triangles)} | {r['set']} | {100 * r['agree']:.4f}% "
+                  f"({r['disagree']}: sahara {v['sahara']}, open3d {v['open3d']}, edge {v['edge']}) | "
+                  f"{100 * r['t_within_1e-5']:.3f}% | {r['sahara_mrays']:.2f} | {r['open3d_mrays']:.2f} | "
+                  f"{r['sahara_mrays'] / r['open3d_mrays']:.2f}x |")
+
+
+if __name__ == "__main__":
+    main()
