@@ -83,39 +83,92 @@ def double_check(vertices, triangles, ray):
     return t[i], float(margin[i])
 
 
-def compare(name, rays, caster, scene, repeats, vertices, triangles):
-    t_rays = o3d.core.Tensor(rays)
-    ours = caster.cast_rays(rays)
-    theirs = scene.cast_rays(t_rays)
-    s_t, o_t = ours["t_hit"], theirs["t_hit"].numpy()
-    s_hit, o_hit = np.isfinite(s_t), np.isfinite(o_t)
-    agree = s_hit == o_hit
-    both = s_hit & o_hit
-    rel = np.abs(s_t[both] - o_t[both]) / np.maximum(np.abs(o_t[both]), 1e-30)
-    s_time = best_of(lambda: caster.cast_rays(rays), repeats)
-    o_time = best_of(lambda: scene.cast_rays(t_rays), repeats)
+class EmbreeDirect:
+    """Embree 3 called through ctypes as Open3D's RaycastingScene calls it (default scene
+    flags, rtcIntersect on float32 rays), on all threads: ctypes releases the GIL, so a
+    thread pool runs one chunk of rays per thread. Used because Debian's Open3D 0.16
+    returns misses for every ray with Debian's Embree (built with ray masks)."""
+
+    RAYHIT = np.dtype({"names": ["org", "tnear", "dir", "time", "tfar", "mask", "id", "flags",
+                                 "ng", "u", "v", "prim", "geom", "inst"],
+                       "formats": [("<f4", 3), "<f4", ("<f4", 3), "<f4", "<f4", "<u4", "<u4", "<u4",
+                                   ("<f4", 3), "<f4", "<f4", "<u4", "<u4", "<u4"],
+                       "offsets": [0, 12, 16, 28, 32, 36, 40, 44, 48, 60, 64, 68, 72, 76], "itemsize": 80})
+
+    def __init__(self, vertices, triangles):
+        import ctypes
+        self.ct = ctypes
+        lib = self.lib = ctypes.CDLL("libembree3.so.3")
+        for name in ("rtcNewDevice", "rtcNewScene", "rtcNewGeometry"):
+            getattr(lib, name).restype = ctypes.c_void_p
+        vp = ctypes.c_void_p
+        self.device = vp(lib.rtcNewDevice(None))
+        self.scene = vp(lib.rtcNewScene(self.device))
+        geom = vp(lib.rtcNewGeometry(self.device, 0))  # RTC_GEOMETRY_TYPE_TRIANGLE
+        # Embree reads 16 bytes per vertex: one padding row.
+        self.vertices = np.zeros((len(vertices) + 1, 3), np.float32)
+        self.vertices[:-1] = vertices
+        self.triangles = np.ascontiguousarray(triangles, np.uint32)
+        lib.rtcSetSharedGeometryBuffer(geom, 1, 0, 0x9003, self.vertices.ctypes.data_as(vp), ctypes.c_size_t(0),
+                                       ctypes.c_size_t(12), ctypes.c_size_t(len(vertices)))
+        lib.rtcSetSharedGeometryBuffer(geom, 0, 0, 0x5003, self.triangles.ctypes.data_as(vp), ctypes.c_size_t(0),
+                                       ctypes.c_size_t(12), ctypes.c_size_t(len(triangles)))
+        lib.rtcCommitGeometry(geom)
+        lib.rtcAttachGeometry(self.scene, geom)
+        lib.rtcReleaseGeometry(geom)
+        lib.rtcCommitScene(self.scene)
+        # RTCIntersectContext: flags 0 (incoherent), no filter, instID[0] invalid.
+        self.context = (ctypes.c_uint32 * 6)(0, 0, 0, 0, 0xFFFFFFFF, 0)
+        self.pool = __import__("concurrent.futures").futures.ThreadPoolExecutor(os.cpu_count())
+
+    def cast_rays(self, rays):
+        rh = np.zeros(len(rays), self.RAYHIT)
+        rh["org"], rh["dir"] = rays[:, :3], rays[:, 3:]
+        rh["tfar"], rh["mask"], rh["geom"] = np.inf, 0xFFFFFFFF, 0xFFFFFFFF
+        chunk = 1 << 14
+        def run(start):
+            n = min(chunk, len(rays) - start)
+            self.lib.rtcIntersect1M(self.scene, self.context, self.ct.c_void_p(rh.ctypes.data + 80 * start),
+                                    self.ct.c_uint(n), self.ct.c_size_t(80))
+        list(self.pool.map(run, range(0, len(rays), chunk)))
+        return np.where(rh["geom"] != 0xFFFFFFFF, rh["tfar"], np.inf)
+
+
+def compare(name, rays, engines, repeats, vertices, triangles):
+    """engines: name -> function(rays) -> t_hit (inf on a miss); the first is sahara."""
+    t = {e: np.asarray(fn(rays)) for e, fn in engines.items()}
+    secs = {e: best_of(lambda fn=fn: fn(rays), repeats) for e, fn in engines.items()}
     n = len(rays)
-    verdict = {"sahara": 0, "open3d": 0, "edge": 0}
-    for i in np.flatnonzero(~agree)[:200]:
-        t_ref, margin = double_check(vertices, triangles, rays[i])
-        if abs(margin) < 1e-9:
-            verdict["edge"] += 1  # within double rounding of an edge: both answers are defensible
-        elif np.isfinite(t_ref) == s_hit[i]:
-            verdict["sahara"] += 1
-        else:
-            verdict["open3d"] += 1
-    row = {
-        "set": name, "rays": n, "hit_rate": s_hit.mean(), "agree": agree.mean(), "disagree": int((~agree).sum()),
-        "t_within_1e-5": float(np.mean(rel <= 1e-5)) if len(rel) else 1.0,
-        "t_max_rel": float(rel.max()) if len(rel) else 0.0,
-        "sahara_mrays": n / s_time / 1e6, "open3d_mrays": n / o_time / 1e6, "verdict": verdict,
-    }
-    print(f"{name:7s} {n} rays, {100 * row['hit_rate']:.1f}% hit | hit/miss agree {100 * row['agree']:.4f}% "
-          f"({row['disagree']} differ; double check of up to 200: sahara right {verdict['sahara']}, "
-          f"open3d right {verdict['open3d']}, on an edge {verdict['edge']}) | t within 1e-5 rel "
-          f"{100 * row['t_within_1e-5']:.3f}%, max {row['t_max_rel']:.2e} | MRays/s sahara "
-          f"{row['sahara_mrays']:.2f}, open3d {row['open3d_mrays']:.2f} ({row['sahara_mrays'] / row['open3d_mrays']:.2f}x)")
-    return row
+    s_t = t["sahara"]
+    s_hit = np.isfinite(s_t)
+    rows = []
+    for other in [e for e in engines if e != "sahara"]:
+        o_t = t[other]
+        o_hit = np.isfinite(o_t)
+        agree = s_hit == o_hit
+        both = s_hit & o_hit
+        rel = np.abs(s_t[both] - o_t[both]) / np.maximum(np.abs(o_t[both]), 1e-30)
+        verdict = {"sahara": 0, other: 0, "edge": 0}
+        for i in np.flatnonzero(~agree)[:200]:
+            t_ref, margin = double_check(vertices, triangles, rays[i])
+            if abs(margin) < 1e-9:
+                verdict["edge"] += 1  # within double rounding of an edge: both answers defensible
+            elif np.isfinite(t_ref) == s_hit[i]:
+                verdict["sahara"] += 1
+            else:
+                verdict[other] += 1
+        row = {"set": name, "other": other, "rays": n, "hit_rate": s_hit.mean(), "agree": agree.mean(),
+               "disagree": int((~agree).sum()), "verdict": verdict,
+               "t_within_1e-5": float(np.mean(rel <= 1e-5)) if len(rel) else 1.0,
+               "t_max_rel": float(rel.max()) if len(rel) else 0.0,
+               "sahara_mrays": n / secs["sahara"] / 1e6, "other_mrays": n / secs[other] / 1e6}
+        print(f"{name:7s} vs {other:7s} {n} rays, sahara {100 * row['hit_rate']:.1f}% hit, {other} "
+              f"{100 * o_hit.mean():.1f}% | hit/miss agree {100 * row['agree']:.4f}% ({row['disagree']} differ; "
+              f"double check of up to 200: {verdict}) | t within 1e-5 rel {100 * row['t_within_1e-5']:.3f}%, "
+              f"max {row['t_max_rel']:.2e} | MRays/s sahara {row['sahara_mrays']:.2f}, {other} "
+              f"{row['other_mrays']:.2f} ({row['sahara_mrays'] / row['other_mrays']:.2f}x)")
+        rows.append(row)
+    return rows
 
 
 def main():
@@ -136,18 +189,22 @@ def main():
     scene.add_triangles(o3d.core.Tensor(vertices), o3d.core.Tensor(triangles))
     scene.cast_rays(o3d.core.Tensor(np.zeros((1, 6), np.float32)))  # Embree commits the scene lazily
     open3d_build = time.perf_counter() - start
+    embree = EmbreeDirect(vertices, triangles)
     print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {os.cpu_count()} threads; "
           f"build sahara {1e3 * sahara_build:.0f} ms (load included), open3d {1e3 * open3d_build:.0f} ms")
+    engines = {"sahara": lambda r: caster.cast_rays(r)["t_hit"],
+               "open3d": lambda r: scene.cast_rays(o3d.core.Tensor(r))["t_hit"].numpy(),
+               "embree": embree.cast_rays}
     rng = np.random.default_rng(args.seed)
-    rows = [compare("random", random_rays(vertices, args.rays, rng), caster, scene, args.repeats, vertices, triangles),
-            compare("camera", camera_rays(vertices, args.rays), caster, scene, args.repeats, vertices, triangles)]
+    rows = (compare("random", random_rays(vertices, args.rays, rng), engines, args.repeats, vertices, triangles)
+            + compare("camera", camera_rays(vertices, args.rays), engines, args.repeats, vertices, triangles))
     if args.markdown:
         for r in rows:
             v = r["verdict"]
-            print(f"| {os.path.basename(args.mesh)} | {len(triangles)} | {r['set']} | {100 * r['agree']:.4f}% "
-                  f"({r['disagree']}: sahara {v['sahara']}, open3d {v['open3d']}, edge {v['edge']}) | "
-                  f"{100 * r['t_within_1e-5']:.3f}% | {r['sahara_mrays']:.2f} | {r['open3d_mrays']:.2f} | "
-                  f"{r['sahara_mrays'] / r['open3d_mrays']:.2f}x |")
+            print(f"| {os.path.basename(args.mesh)} | {len(triangles)} | {r['set']} | {r['other']} | "
+                  f"{100 * r['agree']:.4f}% | {r['disagree']} ({', '.join(f'{k} {x}' for k, x in v.items())}) | "
+                  f"{100 * r['t_within_1e-5']:.3f}% | {r['sahara_mrays']:.2f} | {r['other_mrays']:.2f} | "
+                  f"{r['sahara_mrays'] / r['other_mrays']:.2f}x |")
 
 
 if __name__ == "__main__":
