@@ -50,13 +50,17 @@ def camera_rays(vertices, count):
     return np.hstack([np.broadcast_to(eye, (side * side, 3)), dirs.reshape(-1, 3)]).astype(np.float32)
 
 
-def best_of(fn, repeats):
-    fn()  # warm-up: page faults, thread pools, lazy builds
-    best = float("inf")
+def best_of(fns, repeats):
+    """Best time of each function; the runs alternate between the functions, so a burst of
+    load on a shared machine does not fall on one engine only."""
+    for fn in fns.values():
+        fn()  # warm-up: page faults, thread pools, lazy builds
+    best = {name: float("inf") for name in fns}
     for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
+        for name, fn in fns.items():
+            start = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - start)
     return best
 
 
@@ -137,7 +141,7 @@ class EmbreeDirect:
 def compare(name, rays, engines, repeats, vertices, triangles):
     """engines: name -> function(rays) -> t_hit (inf on a miss); the first is sahara."""
     t = {e: np.asarray(fn(rays)) for e, fn in engines.items()}
-    secs = {e: best_of(lambda fn=fn: fn(rays), repeats) for e, fn in engines.items()}
+    secs = best_of({e: (lambda fn=fn: fn(rays)) for e, fn in engines.items()}, repeats)
     n = len(rays)
     s_t = t["sahara"]
     s_hit = np.isfinite(s_t)

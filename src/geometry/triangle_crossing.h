@@ -7,7 +7,7 @@
 /// whole fan: right for a nearest hit, wrong for a count. Here an edge function
 /// that is exactly 0 takes the sign it would have if the ray were moved by
 /// (eps, eps^2) in the sheared plane (simulation of simplicity, Edelsbrunner and
-/// Mücke 1990): the sign of its derivative along x, or along y when that is 0.
+/// Muecke 1990): the sign of its derivative along x, or along y when that is 0.
 /// The two triangles of a shared edge see the edge reversed, so exactly one of
 /// them keeps the point; at a vertex exactly one triangle of the fan does. A ray
 /// that only touches the surface (a silhouette edge or vertex) gets 0 or 2

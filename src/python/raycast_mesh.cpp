@@ -47,30 +47,44 @@ Vec3 CastMesh::unit_normal(uint32_t triangle) const {
     return Vec3(float(n[0] / len), float(n[1] / len), float(n[2] / len));
 }
 
+void CastMesh::store(size_t k, const Hit& hit, const NearestHits& out) const {
+    if (!hit.hit()) {
+        out.t[k] = kInfinity;
+        out.prim[k] = -1;
+        out.uv[2 * k] = out.uv[2 * k + 1] = 0.0f;
+        out.normal[3 * k] = out.normal[3 * k + 1] = out.normal[3 * k + 2] = 0.0f;
+        return;
+    }
+    const uint32_t tri = prim_index(hit.prim);
+    out.t[k] = hit.t;
+    out.prim[k] = int64_t(tri);
+    out.uv[2 * k] = hit.u;
+    out.uv[2 * k + 1] = hit.v;
+    const Vec3 nrm = unit_normal(tri);
+    out.normal[3 * k] = nrm.x;
+    out.normal[3 * k + 1] = nrm.y;
+    out.normal[3 * k + 2] = nrm.z;
+}
+
 void CastMesh::nearest(const RayBatch& rays, const NearestHits& out) const {
     const auto n = int64_t(rays.size());
-#pragma omp parallel for schedule(dynamic, kRayChunk)
-    for (int64_t i = 0; i < n; ++i) {
-        Ray ray = rays.ray(size_t(i));
-        Hit hit;
-        const bool found = accel_ && accel_->intersect(ray, hit);
-        const size_t k = size_t(i);
-        if (!found) {
-            out.t[k] = kInfinity;
-            out.prim[k] = -1;
-            out.uv[2 * k] = out.uv[2 * k + 1] = 0.0f;
-            out.normal[3 * k] = out.normal[3 * k + 1] = out.normal[3 * k + 2] = 0.0f;
-            continue;
-        }
-        const uint32_t tri = prim_index(hit.prim);
-        out.t[k] = hit.t;
-        out.prim[k] = int64_t(tri);
-        out.uv[2 * k] = hit.u;
-        out.uv[2 * k + 1] = hit.v;
-        const Vec3 nrm = unit_normal(tri);
-        out.normal[3 * k] = nrm.x;
-        out.normal[3 * k + 1] = nrm.y;
-        out.normal[3 * k + 2] = nrm.z;
+    if (!accel_) {
+        for (int64_t i = 0; i < n; ++i) store(size_t(i), Hit{}, out);
+        return;
+    }
+    // Runs of kPacketSize consecutive rays go through the packet traversal, which takes
+    // the coherent ones (camera rays in image order share directions and origins) as
+    // packets and traces the others ray by ray; the hits are the single-ray hits.
+    const int64_t packets = (n + kPacketSize - 1) / kPacketSize;
+#pragma omp parallel for schedule(dynamic, kRayChunk / kPacketSize)
+    for (int64_t p = 0; p < packets; ++p) {
+        RayPacket packet;
+        HitPacket hits;
+        const int64_t first = p * kPacketSize;
+        const int lanes = int(std::min<int64_t>(kPacketSize, n - first));
+        for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(first + l)));
+        accel_->intersect_packet(packet, hits);
+        for (int l = 0; l < lanes; ++l) store(size_t(first + l), hits.hit(l), out);
     }
 }
 

@@ -57,6 +57,8 @@ class CastMesh {
 
    private:
     Vec3 unit_normal(uint32_t triangle) const;
+    /// Writes ray k's entry of `out` (a miss when !hit.hit()).
+    void store(size_t k, const Hit& hit, const NearestHits& out) const;
 
     std::vector<Vec3> positions_;
     std::vector<uint32_t> indices_;

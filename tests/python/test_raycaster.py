@@ -60,6 +60,21 @@ def test_nearest_hits_match_brute_force(sphere):
     np.testing.assert_allclose(got["normals"][hit], n / np.linalg.norm(n, axis=1, keepdims=True), atol=1e-5)
 
 
+def test_coherent_rays_match_brute_force(sphere):
+    # A camera's rays in image order: runs of them share direction signs, so they take
+    # the packet traversal rather than the single-ray one.
+    v, f, caster = sphere
+    x, y = np.meshgrid(np.linspace(-1.2, 1.2, 48), np.linspace(-1.2, 1.2, 48))
+    dirs = np.stack([x.ravel() * 0.3, y.ravel() * 0.3, np.ones(x.size)], axis=1)
+    rays = rays_from([[0.05, -0.02, -4]], dirs)
+    got = caster.cast_rays(rays)
+    t_ref, id_ref = brute_force_nearest(v, f, rays)
+    assert 0.3 < np.isfinite(t_ref).mean() < 1.0
+    np.testing.assert_allclose(got["t_hit"], t_ref, rtol=1e-5)
+    hit = np.isfinite(t_ref)
+    assert np.mean(got["primitive_ids"][hit] == id_ref[hit]) > 0.999
+
+
 def test_misses_report_inf_and_minus_one(sphere):
     _, _, caster = sphere
     rays = rays_from([[0, 0, 3], [5, 5, 5]], [[0, 0, 1], [1, 0, 0]])
