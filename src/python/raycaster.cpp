@@ -1,7 +1,178 @@
 #include "python/raycaster.h"
 
+#include <pybind11/numpy.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "io/model_loader.h"
+#include "python/raycast_arrays.h"
+#include "python/raycast_mesh.h"
+
 namespace sahara::python {
 
-void bind_raycaster(pybind11::module_&) {}
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "vertices are exposed as an (N, 3) float32 view");
+
+/// A new array of the batch's leading shape, plus `extra` trailing dimensions.
+template <class T>
+py::array_t<T> result_array(const RayBatch& rays, std::initializer_list<py::ssize_t> extra = {}) {
+    std::vector<py::ssize_t> shape = rays.shape();
+    shape.insert(shape.end(), extra.begin(), extra.end());
+    return py::array_t<T>(shape);
+}
+
+/// A read-only (rows, 3) view of `data` that keeps `owner` alive.
+template <class T>
+py::array read_only_view(const T* data, size_t rows, const py::object& owner) {
+    py::array_t<T> a({py::ssize_t(rows), py::ssize_t(3)}, data, owner);
+    a.attr("setflags")(py::arg("write") = false);
+    return a;
+}
+
+std::unique_ptr<CastMesh> mesh_from_arrays(const py::handle& vertices, const py::handle& triangles) {
+    std::vector<Vec3> positions = read_vertices(as_array(vertices, "vertices"));
+    std::vector<uint32_t> indices = read_triangles(as_array(triangles, "triangles"), positions.size());
+    py::gil_scoped_release release;
+    return std::make_unique<CastMesh>(std::move(positions), std::move(indices));
+}
+
+/// The meshes of a model file merged in file order (triangle ids count across meshes).
+std::unique_ptr<CastMesh> mesh_from_file(const std::filesystem::path& path) {
+    py::gil_scoped_release release;
+    const LoadedModel model = load_model(path);
+    std::vector<Vec3> positions;
+    std::vector<uint32_t> indices;
+    for (const TriangleMesh& m : model.meshes) {
+        const auto base = uint32_t(positions.size());
+        positions.insert(positions.end(), m.positions.begin(), m.positions.end());
+        for (uint32_t i : m.indices) indices.push_back(base + i);
+    }
+    return std::make_unique<CastMesh>(std::move(positions), std::move(indices));
+}
+
+py::dict cast_rays(const CastMesh& mesh, const py::handle& rays_in, const py::handle& tmin,
+                   const py::handle& tmax) {
+    const RayBatch rays(rays_in, tmin, tmax);
+    auto t = result_array<float>(rays);
+    auto prim = result_array<int64_t>(rays);
+    auto uv = result_array<float>(rays, {2});
+    auto normal = result_array<float>(rays, {3});
+    const NearestHits out{t.mutable_data(), prim.mutable_data(), uv.mutable_data(), normal.mutable_data()};
+    {
+        py::gil_scoped_release release;
+        mesh.nearest(rays, out);
+    }
+    py::dict d;
+    d["t_hit"] = t;
+    d["primitive_ids"] = prim;
+    d["primitive_uvs"] = uv;
+    d["normals"] = normal;
+    return d;
+}
+
+py::array_t<bool> occluded(const CastMesh& mesh, const py::handle& rays_in, const py::handle& tmin,
+                           const py::handle& tmax) {
+    const RayBatch rays(rays_in, tmin, tmax);
+    auto out = result_array<bool>(rays);
+    bool* p = out.mutable_data();
+    py::gil_scoped_release release;
+    mesh.occluded(rays, p);
+    return out;
+}
+
+py::array_t<int32_t> count_intersections(const CastMesh& mesh, const py::handle& rays_in,
+                                         const py::handle& tmin, const py::handle& tmax) {
+    const RayBatch rays(rays_in, tmin, tmax);
+    auto out = result_array<int32_t>(rays);
+    int32_t* p = out.mutable_data();
+    py::gil_scoped_release release;
+    mesh.count_crossings(rays, p);
+    return out;
+}
+
+py::dict intersect_all(const CastMesh& mesh, const py::handle& rays_in, const py::handle& tmin,
+                       const py::handle& tmax) {
+    const RayBatch rays(rays_in, tmin, tmax);
+    Crossings found;
+    {
+        py::gil_scoped_release release;
+        found = mesh.crossings(rays);
+    }
+    const auto n = py::ssize_t(found.total());
+    py::array_t<int64_t> ray(n), prim(n);
+    py::array_t<float> t(n), uv({n, py::ssize_t(2)});
+    {
+        int64_t *pr = ray.mutable_data(), *pp = prim.mutable_data();
+        float *pt = t.mutable_data(), *puv = uv.mutable_data();
+        py::gil_scoped_release release;
+        found.write(pr, pp, pt, puv);
+        found = Crossings{};
+    }
+    py::dict d;
+    d["ray_ids"] = ray;
+    d["primitive_ids"] = prim;
+    d["t"] = t;
+    d["primitive_uvs"] = uv;
+    return d;
+}
+
+}  // namespace
+
+void bind_raycaster(py::module_& m) {
+    py::class_<CastMesh>(m, "RayCaster", R"doc(
+Rays cast into one triangle mesh through sahara's watertight 8-wide BVH.
+
+RayCaster(vertices, triangles): vertices an (N, 3) float32 or float64 array,
+triangles an (M, 3) integer array of vertex indices (counter-clockwise is the
+front). The BVH is built once, in float32; the caster keeps a float32/uint32
+copy of the mesh for normals and for the `vertices`/`triangles` views.
+
+Every query takes rays as a (..., 6) float32/float64 array (origin, direction;
+t is measured in units of |direction|) and optional tmin/tmax (a number or one
+value per ray; defaults 0 and inf; hits need tmin < t < tmax). Queries run on
+all OpenMP threads with the GIL released.)doc")
+        .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"))
+        .def_static("from_file", &mesh_from_file, py::arg("path"),
+                    "A caster over every mesh of an OBJ or glTF file, merged; triangle ids count in the "
+                    "order the loader reads them (the `triangles` property lists them).")
+        .def("cast_rays", &cast_rays, py::arg("rays"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(),
+             "Nearest hits: a dict of t_hit (float32, inf on a miss), primitive_ids (int64, -1 on a miss), "
+             "primitive_uvs (float32 (..., 2): barycentric weights of the triangle's 2nd and 3rd vertex) and "
+             "normals (float32 (..., 3): the unit geometric normal, counter-clockwise front, not flipped "
+             "towards the ray; 0 on a miss).")
+        .def("occluded", &occluded, py::arg("rays"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(),
+             "Whether anything lies on each ray with tmin < t < tmax (bool array).")
+        .def("intersect_all", &intersect_all, py::arg("rays"), py::arg("tmin") = py::none(),
+             py::arg("tmax") = py::none(),
+             "Every crossing along every ray as flat arrays ray_ids (int64, index into the flattened rays), "
+             "primitive_ids (int64), t (float32) and primitive_uvs, sorted by ray then t. A ray through a "
+             "shared edge or vertex crosses there once; one that only touches the surface there, 0 or 2 "
+             "times, so the count's parity tells inside from outside on closed meshes.")
+        .def("count_intersections", &count_intersections, py::arg("rays"), py::arg("tmin") = py::none(),
+             py::arg("tmax") = py::none(), "The number of crossings intersect_all finds per ray (int32).")
+        .def_property_readonly(
+            "vertices",
+            [](const py::object& self) {
+                const auto& mesh = self.cast<const CastMesh&>();
+                return read_only_view(&mesh.positions().data()->x, mesh.positions().size(), self);
+            },
+            "The mesh's vertices as the BVH sees them (float32 (N, 3), read-only).")
+        .def_property_readonly(
+            "triangles",
+            [](const py::object& self) {
+                const auto& mesh = self.cast<const CastMesh&>();
+                return read_only_view(mesh.indices().data(), mesh.triangle_count(), self);
+            },
+            "The triangles (uint32 (M, 3), read-only); row i is primitive id i.")
+        .def_property_readonly("bvh_bytes", &CastMesh::bvh_bytes, "Bytes of the BVH and its leaf triangles.")
+        .def("__repr__", [](const CastMesh& mesh) {
+            return "<sahara.RayCaster: " + std::to_string(mesh.positions().size()) + " vertices, " +
+                   std::to_string(mesh.triangle_count()) + " triangles>";
+        });
+}
 
 }  // namespace sahara::python

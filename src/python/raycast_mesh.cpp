@@ -1,0 +1,149 @@
+#include "python/raycast_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+#include "accel/crossings.h"
+#include "geometry/triangle.h"
+#include "scene/accelerator.h"
+#include "scene/scene.h"
+
+namespace sahara::python {
+
+namespace {
+
+/// Rays per OpenMP work item: large enough to amortise scheduling, small enough that
+/// uneven rays (long misses beside early hits) still balance across threads.
+constexpr int64_t kRayChunk = 256;
+
+}  // namespace
+
+CastMesh::CastMesh(std::vector<Vec3> positions, std::vector<uint32_t> indices) {
+    // The Accelerator reads the mesh from a Scene and copies the vertices it tests into
+    // its leaf blocks; the arrays move through the Scene and back, never copied.
+    Scene scene;
+    scene.triangles.positions = std::move(positions);
+    scene.triangles.indices = std::move(indices);
+    if (scene.triangles.size() > 0) accel_ = std::make_unique<Accelerator>(scene);
+    positions_ = std::move(scene.triangles.positions);
+    indices_ = std::move(scene.triangles.indices);
+}
+
+CastMesh::~CastMesh() = default;
+
+size_t CastMesh::bvh_bytes() const { return accel_ ? accel_->bytes() : 0; }
+
+Vec3 CastMesh::unit_normal(uint32_t triangle) const {
+    const uint32_t* v = &indices_[3 * size_t(triangle)];
+    // In double: a sliver's cross product loses most of its bits in float.
+    const Vec3 &p0 = positions_[v[0]], &p1 = positions_[v[1]], &p2 = positions_[v[2]];
+    const double e1[3] = {double(p1.x) - double(p0.x), double(p1.y) - double(p0.y), double(p1.z) - double(p0.z)};
+    const double e2[3] = {double(p2.x) - double(p0.x), double(p2.y) - double(p0.y), double(p2.z) - double(p0.z)};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0)) return Vec3(0.0f);
+    return Vec3(float(n[0] / len), float(n[1] / len), float(n[2] / len));
+}
+
+void CastMesh::store(size_t k, const Hit& hit, const NearestHits& out) const {
+    if (!hit.hit()) {
+        out.t[k] = kInfinity;
+        out.prim[k] = -1;
+        out.uv[2 * k] = out.uv[2 * k + 1] = 0.0f;
+        out.normal[3 * k] = out.normal[3 * k + 1] = out.normal[3 * k + 2] = 0.0f;
+        return;
+    }
+    const uint32_t tri = prim_index(hit.prim);
+    out.t[k] = hit.t;
+    out.prim[k] = int64_t(tri);
+    out.uv[2 * k] = hit.u;
+    out.uv[2 * k + 1] = hit.v;
+    const Vec3 nrm = unit_normal(tri);
+    out.normal[3 * k] = nrm.x;
+    out.normal[3 * k + 1] = nrm.y;
+    out.normal[3 * k + 2] = nrm.z;
+}
+
+void CastMesh::nearest(const RayBatch& rays, const NearestHits& out) const {
+    const auto n = int64_t(rays.size());
+    if (!accel_) {
+        for (int64_t i = 0; i < n; ++i) store(size_t(i), Hit{}, out);
+        return;
+    }
+    // Runs of kPacketSize consecutive rays go through the packet traversal, which takes
+    // the coherent ones (camera rays in image order share directions and origins) as
+    // packets and traces the others ray by ray; the hits are the single-ray hits.
+    const int64_t packets = (n + kPacketSize - 1) / kPacketSize;
+#pragma omp parallel for schedule(dynamic, kRayChunk / kPacketSize)
+    for (int64_t p = 0; p < packets; ++p) {
+        RayPacket packet;
+        HitPacket hits;
+        const int64_t first = p * kPacketSize;
+        const int lanes = int(std::min<int64_t>(kPacketSize, n - first));
+        for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(first + l)));
+        accel_->intersect_packet(packet, hits);
+        for (int l = 0; l < lanes; ++l) store(size_t(first + l), hits.hit(l), out);
+    }
+}
+
+void CastMesh::occluded(const RayBatch& rays, bool* out) const {
+    const auto n = int64_t(rays.size());
+#pragma omp parallel for schedule(dynamic, kRayChunk)
+    for (int64_t i = 0; i < n; ++i) out[i] = accel_ && accel_->occluded(rays.ray(size_t(i)));
+}
+
+void CastMesh::count_crossings(const RayBatch& rays, int32_t* out) const {
+    const auto n = int64_t(rays.size());
+    const std::span<const TriangleBlock4> blocks =
+        accel_ ? std::span<const TriangleBlock4>(accel_->leaf_blocks()) : std::span<const TriangleBlock4>();
+#pragma omp parallel for schedule(dynamic, kRayChunk)
+    for (int64_t i = 0; i < n; ++i)
+        out[i] = accel_ ? int32_t(sahara::count_crossings(accel_->bvh8(), blocks, rays.ray(size_t(i)))) : 0;
+}
+
+Crossings CastMesh::crossings(const RayBatch& rays) const {
+    Crossings out;
+    if (!accel_) return out;
+    const std::span<const TriangleBlock4> blocks(accel_->leaf_blocks());
+    // Each chunk of rays collects its sorted crossings on its own; a prefix sum over the
+    // chunks then places them, so the result does not depend on the thread count.
+    const auto n = int64_t(rays.size());
+    const int64_t chunks = (n + kRayChunk - 1) / kRayChunk;
+    out.hits.resize(size_t(chunks));
+    out.ray_of.resize(size_t(chunks));
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t c = 0; c < chunks; ++c) {
+        auto& h = out.hits[size_t(c)];
+        auto& r = out.ray_of[size_t(c)];
+        for (int64_t i = c * kRayChunk; i < std::min(n, (c + 1) * kRayChunk); ++i) {
+            const size_t first = h.size();
+            collect_crossings(accel_->bvh8(), blocks, rays.ray(size_t(i)), h);
+            std::sort(h.begin() + ptrdiff_t(first), h.end(), [](const Hit& a, const Hit& b) {
+                return a.t < b.t || (a.t == b.t && a.prim < b.prim);
+            });
+            r.resize(h.size(), i);
+        }
+    }
+    out.offset.assign(size_t(chunks) + 1, 0);
+    for (size_t c = 0; c < size_t(chunks); ++c) out.offset[c + 1] = out.offset[c] + out.hits[c].size();
+    return out;
+}
+
+void Crossings::write(int64_t* ray, int64_t* prim, float* t, float* uv) const {
+    const auto chunks = int64_t(hits.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t c = 0; c < chunks; ++c)
+        for (size_t j = 0; j < hits[size_t(c)].size(); ++j) {
+            const Hit& h = hits[size_t(c)][j];
+            const size_t k = offset[size_t(c)] + j;
+            ray[k] = ray_of[size_t(c)][j];
+            prim[k] = int64_t(prim_index(h.prim));
+            t[k] = h.t;
+            uv[2 * k] = h.u;
+            uv[2 * k + 1] = h.v;
+        }
+}
+
+}  // namespace sahara::python
