@@ -1,9 +1,9 @@
 #include "pipeline/render_pipeline.h"
 
 #include <algorithm>
-#include <cctype>
 
 #include "base/error.h"
+#include "io/files.h"
 #include "io/model_loader.h"
 #include "io/scene_parser.h"
 #include "io/view_scene.h"
@@ -30,11 +30,9 @@ void RenderOverrides::apply(RenderSettings& r) const {
 
 SceneDesc load_scene_source(const std::optional<std::string>& source) {
     if (!source) return default_scene();
-    std::string ext = std::filesystem::path(*source).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext == ".obj" || ext == ".gltf" || ext == ".glb")
-        return make_view_scene(load_model(*source), ext != ".obj", ViewOptions{}, *source);
+    const FileKind kind = file_kind(*source);
+    if (is_model_kind(kind))
+        return make_view_scene(load_model(*source), kind == FileKind::gltf, ViewOptions{}, *source);
     return parse_scene_file(*source);
 }
 
