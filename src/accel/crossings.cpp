@@ -1,13 +1,14 @@
 #include "accel/crossings.h"
 
 #include "accel/bvh_traverse.h"
+#include "accel/traverse_wide.h"
 #include "geometry/triangle_crossing.h"
 
 namespace sahara {
 
 namespace {
 
-/// Calls on_hit(TriangleHit, prim id) for each crossing; the traversal visits every
+/// Calls on_hit(ShapeHit, prim id) for each crossing; the traversal visits every
 /// leaf whose box the ray enters within (tmin, tmax), since no leaf reports a hit.
 template <class OnHit>
 void for_each_crossing(const Bvh8& tree, std::span<const TriangleBlock4> blocks, const Ray& ray,
@@ -24,7 +25,7 @@ void for_each_crossing(const Bvh8& tree, std::span<const TriangleBlock4> blocks,
                 const TriangleVerts tri{{{block.p[0][0][l], block.p[0][1][l], block.p[0][2][l]},
                                          {block.p[1][0][l], block.p[1][1][l], block.p[1][2][l]},
                                          {block.p[2][0][l], block.p[2][1][l], block.p[2][2][l]}}};
-                TriangleHit h{};
+                ShapeHit h{};
                 if (cross_triangle(tr, tri, ray.tmin, ray.tmax, h)) on_hit(h, slot);
             }
         }
@@ -40,12 +41,12 @@ void for_each_crossing(const Bvh8& tree, std::span<const TriangleBlock4> blocks,
 void collect_crossings(const Bvh8& tree, std::span<const TriangleBlock4> blocks, const Ray& ray,
                        std::vector<Hit>& out) {
     for_each_crossing(tree, blocks, ray,
-                      [&](const TriangleHit& h, uint32_t prim) { out.push_back(Hit{h.t, prim, h.u, h.v}); });
+                      [&](const ShapeHit& h, uint32_t prim) { out.push_back(Hit{h.t, prim, h.u, h.v}); });
 }
 
 uint32_t count_crossings(const Bvh8& tree, std::span<const TriangleBlock4> blocks, const Ray& ray) {
     uint32_t n = 0;
-    for_each_crossing(tree, blocks, ray, [&](const TriangleHit&, uint32_t) { ++n; });
+    for_each_crossing(tree, blocks, ray, [&](const ShapeHit&, uint32_t) { ++n; });
     return n;
 }
 

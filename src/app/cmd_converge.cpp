@@ -12,7 +12,7 @@
 
 #include <omp.h>
 
-#include "app/mesh_input.h"
+#include "pipeline/mesh_input.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "io/image_io.h"

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "app/commands.h"
-#include "app/mesh_input.h"
+#include "pipeline/mesh_input.h"
 #include "app/mpi_render.h"
 #include "app/preview.h"
 #include "app/render_args.h"

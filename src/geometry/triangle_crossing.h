@@ -13,6 +13,7 @@
 /// that only touches the surface (a silhouette edge or vertex) gets 0 or 2
 /// crossings there, so parity stays exact on closed meshes. Shared vertices must
 /// have bit-identical coordinates (welded or not), which any exported mesh has.
+#include "geometry/shape.h"
 #include "geometry/triangle.h"
 
 namespace sahara {
@@ -32,7 +33,7 @@ inline int perturbed_sign(float f, float gx, float gy) {
 /// Whether the ray crosses the triangle with tmin < t < tmax, edges and vertices
 /// resolved as above. `out` gets the same t, u, v intersect_triangle computes.
 inline bool cross_triangle(const TriangleRay& tr, const TriangleVerts& tri, float tmin, float tmax,
-                           TriangleHit& out) {
+                           ShapeHit& out) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
     const float a_x = tri.p[0][kx] - tr.org[kx], a_y = tri.p[0][ky] - tr.org[ky],
                 a_z = tri.p[0][kz] - tr.org[kz];

@@ -284,7 +284,6 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
                      const ObjReadOptions& options) {
     const std::string text = read_file(file);
     obj::check_encoding(file.string(), text);
-    reject_non_finite_words(file.string(), text);
     obj::check_obj_numbers(file.string(), text);
     std::istringstream stream(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);  // UTF-8 BOM
     MtlFileReader mtl_reader(file);
