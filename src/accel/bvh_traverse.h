@@ -91,10 +91,10 @@ struct NoTraversalCounters {
     void on_prims(uint32_t) {}
 };
 
-/// Traverses `bvh` with `ray`. `leaf(first_slot, count, tmax)` tests the
-/// primitives bvh.prim_indices[first_slot .. first_slot + count), lowers
-/// `tmax` to the nearest hit it finds and returns whether it found one.
-/// kAnyHit stops at the first hit (occlusion). Returns whether anything was hit.
+/// Traverses `bvh` with `ray`; `leaf(first_slot, count, tmax)` tests bvh.prim_indices
+/// [first_slot, first_slot + count), lowers `tmax` to its nearest hit, returns whether it
+/// found one. kAnyHit stops at the first hit. Returns whether anything was hit. A traversal
+/// kernel, over 60 lines on purpose: one loop keeps the ray's constants in registers.
 template <bool kAnyHit, class Counters, class LeafFn>
 bool traverse_bvh(const Bvh& bvh, BvhRay& ray, LeafFn&& leaf, Counters& counters) {
     if (bvh.nodes.empty()) return false;

@@ -86,6 +86,22 @@ Bvh single_leaf_bvh(const PrimitiveList& prims) {
     return bvh;
 }
 
+/// Non-triangle slots get consecutive entries of others_ in slot order: the rank of
+/// each among them (fixed before the parallel fill, so the result does not depend on
+/// the threads); empty when every slot is a triangle.
+std::vector<uint32_t> other_slot_ranks(const std::vector<uint32_t>& ids, size_t& other_count) {
+    other_count = size_t(std::count_if(ids.begin(), ids.end(),
+                                       [](uint32_t id) { return prim_kind(id) != PrimKind::triangle; }));
+    std::vector<uint32_t> rank;
+    if (other_count) {
+        rank.resize(ids.size());
+        uint32_t k = 0;
+        for (size_t s = 0; s < ids.size(); ++s)
+            if (prim_kind(ids[s]) != PrimKind::triangle) rank[s] = k++;
+    }
+    return rank;
+}
+
 }  // namespace
 
 const char* bvh_layout_name(BvhLayout layout) {
@@ -162,17 +178,8 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 template <int N>
 void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                                    const std::vector<TriangleVerts>& tris) {
-    // Non-triangle slots get consecutive entries of others_ in slot order (fixed
-    // before the parallel fill, so the result does not depend on the threads).
-    std::vector<uint32_t> other_rank;
-    const size_t other_count = size_t(std::count_if(
-        ids.begin(), ids.end(), [](uint32_t id) { return prim_kind(id) != PrimKind::triangle; }));
-    if (other_count) {
-        other_rank.resize(ids.size());
-        uint32_t k = 0;
-        for (size_t s = 0; s < ids.size(); ++s)
-            if (prim_kind(ids[s]) != PrimKind::triangle) other_rank[s] = k++;
-    }
+    size_t other_count = 0;
+    const std::vector<uint32_t> other_rank = other_slot_ranks(ids, other_count);
     others_.assign(other_count, 0);
     auto fill_leaf = [&](uint32_t first, uint32_t count, uint32_t block) {
         for (uint32_t s = first; s < first + count; s += 4, ++block) {

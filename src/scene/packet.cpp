@@ -10,23 +10,11 @@
 #include <type_traits>
 
 #include "scene/accelerator.h"
+#include "scene/packet_kernel.h"
 
 namespace sahara {
 
 namespace {
-
-/// What every ISA's kernel needs: the packet, the tree, and the permutation
-/// and plane choice shared by all active rays (see packet_eligible).
-struct PacketContext {
-    const RayPacket* rays;
-    const TriangleBlock4* blocks;
-    const Accelerator* accel;
-    int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
-    int neg[3];       ///< direction sign per axis, common to all active rays
-    int near_off[3];  ///< offset of each axis's near planes in a node, in units of N floats
-    int far_off[3];   ///< offset of each axis's far planes, in units of N floats
-    int first;        ///< first active lane
-};
 
 /// Fills the common permutation and signs; false when the active rays do not
 /// share them (or a direction is zero or not finite, or an origin not finite): such packets are traced ray by
@@ -60,29 +48,6 @@ bool packet_eligible(const RayPacket& p, PacketContext& c) {
 
 }  // namespace
 
-// The kernels pass 64-byte vectors between always-inline helpers only, so
-// GCC's note that such arguments change the ABI without AVX-512 is moot.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off")
-namespace packet_sse2 {
-#define SAHARA_PACKET_ISA 128
-#include "scene/packet_kernel.inc"
-#undef SAHARA_PACKET_ISA
-}  // namespace packet_sse2
-#pragma GCC pop_options
-
-#pragma GCC push_options
-#pragma GCC target("avx512f")
-#pragma GCC optimize("fp-contract=off")
-namespace packet_avx512 {
-#define SAHARA_PACKET_ISA 512
-#include "scene/packet_kernel.inc"
-#undef SAHARA_PACKET_ISA
-}  // namespace packet_avx512
-#pragma GCC pop_options
-
 void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     for (int i = 0; i < kPacketSize; ++i) hits.prim[i] = kNoPrim, hits.t[i] = kInfinity;
     if (!packet.active) return;
@@ -107,14 +72,14 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     }
     switch (active_simd_path()) {
         case SimdPath::avx512:
-            packet_avx512::trace_packet(c, wide8_, hits);
+            packet_kernel::trace_packet<packet_kernel::kAvx512>(c, wide8_, hits);
             break;
         case SimdPath::avx2:
             // One AVX box test per ray and child set beats 16 rays per box in two halves.
             trace_packet8_avx2(packet, hits);
             break;
         case SimdPath::sse2:
-            packet_sse2::trace_packet(c, wide8_, hits);
+            packet_kernel::trace_packet<packet_kernel::kSse2>(c, wide8_, hits);
             break;
     }
     for (uint32_t m = packet.active; m; m &= m - 1) {

@@ -102,6 +102,10 @@ __attribute__((target("avx2"), always_inline)) inline uint32_t rays_in_box(const
 
 }  // namespace
 
+// A traversal kernel, long on purpose (about 145 lines): the setup of the per-ray and
+// frustum constants, the frustum node step and the per-ray leaf step share those
+// constants in one body, where they stay in registers and on the stack frame; split
+// into out-of-line helpers they would be passed and reloaded on every node.
 __attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPacket& p,
                                                                      HitPacket& out) const {
     // Per-lane single-ray constants; inactive lanes are never read.

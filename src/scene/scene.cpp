@@ -214,6 +214,28 @@ Vec3 box_normal(const Bounds3& b, const Vec3& p) {
     return n;
 }
 
+void interact_sphere(const Sphere& s, const Ray& ray, const Hit& hit, bool want_uv, SurfaceInteraction& si) {
+    const Vec3 c = s.center_at(ray.time);
+    // Reproject onto the surface: removes the error of origin + t * dir.
+    const Vec3d d = Vec3d(ray.origin) + Vec3d(ray.dir) * double(hit.t) - Vec3d(c);
+    const Vec3d n = d / length(d);
+    si.p = Vec3(Vec3d(c) + n * double(s.radius));
+    si.ng = si.ns = Vec3(n);
+    if (want_uv) si.uv = sphere_uv(Vec3(n));
+    si.material = s.material;
+}
+
+void interact_box(const Box& b, const Ray& ray, const Hit& hit, SurfaceInteraction& si) {
+    si.p = ray.at(hit.t);
+    si.ng = si.ns = box_normal(b.box, si.p);
+    // Snap onto the face: textures keyed on position (checkers) must not
+    // see the hit wander to either side of it.
+    const int axis = max_dimension(abs(si.ng));
+    si.p[axis] = si.ng[axis] > 0 ? b.box.hi[axis] : b.box.lo[axis];
+    si.uv = {0, 0};
+    si.material = b.material;
+}
+
 }  // namespace
 
 /// The runtime quadric of a parsed description: the description's local frame
@@ -252,31 +274,13 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
         case PrimKind::triangle:
             interact_triangle(triangles, idx, hit, si);
             break;
-        case PrimKind::sphere: {
-            const Sphere& s = spheres[idx];
-            const Vec3 c = s.center_at(ray.time);
-            // Reproject onto the surface: removes the error of origin + t * dir.
-            const Vec3d d = Vec3d(ray.origin) + Vec3d(ray.dir) * double(hit.t) - Vec3d(c);
-            const Vec3d n = d / length(d);
-            si.p = Vec3(Vec3d(c) + n * double(s.radius));
-            si.ng = si.ns = Vec3(n);
+        case PrimKind::sphere:
             // uv feeds image textures only (eval_color): without any, skip the atan2 and asin.
-            if (!textures.empty()) si.uv = sphere_uv(Vec3(n));
-            si.material = s.material;
+            interact_sphere(spheres[idx], ray, hit, !textures.empty(), si);
             break;
-        }
-        case PrimKind::box: {
-            const Box& b = boxes[idx];
-            si.p = ray.at(hit.t);
-            si.ng = si.ns = box_normal(b.box, si.p);
-            // Snap onto the face: textures keyed on position (checkers) must not
-            // see the hit wander to either side of it.
-            const int axis = max_dimension(abs(si.ng));
-            si.p[axis] = si.ng[axis] > 0 ? b.box.hi[axis] : b.box.lo[axis];
-            si.uv = {0, 0};
-            si.material = b.material;
+        case PrimKind::box:
+            interact_box(boxes[idx], ray, hit, si);
             break;
-        }
         case PrimKind::quadric: {
             // Hit has no part field: hit_at finds the part (side or cap) again.
             const Quadric& q = quadrics[idx];

@@ -1,95 +1,134 @@
-// Packet traversal kernel, included by packet.cpp once per instruction set
-// inside `#pragma GCC target(...)` regions with SAHARA_PACKET_ISA set to 128
-// (SSE2) or 512 (AVX-512F); the AVX2 path has its own kernel (packet_wide8.cpp). The arithmetic uses GCC vector
-// extensions of 16 floats, which the compiler maps onto the region's widest
-// registers; only the mask extraction needs intrinsics.
+#pragma once
+// Packet traversal kernel over the wide tree, as templates on the instruction set:
+// kIsa 128 (SSE2, four 4-lane quarters) or 512 (AVX-512F, one 16-lane register); the
+// AVX2 path has its own kernel (packet_wide8.cpp). packet.cpp includes this header for
+// PacketContext and the entry points; packet_sse2.cpp and packet_avx512.cpp include it
+// inside their `#pragma GCC target` regions, so the templates carry that target, and
+// instantiate trace_packet there. Every function is a template on kIsa, so the two
+// translation units never share a symbol compiled for different targets.
 //
-// Bit-identity with the single-ray code: each lane performs the float
-// operations of intersect_wide_sse / intersect_bvh_node (box tests) and
-// TriangleVerts::intersect (geometry/triangle.h) in the same order; the region is
-// compiled with fp-contract=off, so no fused multiply-add changes a rounding.
+// The arithmetic uses GCC vector extensions of 16 floats, which the compiler maps onto
+// the target's widest registers; only the mask extraction needs intrinsics.
+//
+// Bit-identity with the single-ray code: each lane performs the float operations of
+// intersect_wide_sse / intersect_bvh_node (box tests) and TriangleVerts::intersect
+// (geometry/triangle.h) in the same order, with fp-contract off, so no fused multiply-add
+// changes a rounding.
+#include <immintrin.h>
+
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+
+#include "accel/packet.h"
+#include "scene/accelerator.h"
+
+// The kernels pass 64-byte vectors between always-inline helpers only, so
+// GCC's note that such arguments change the ABI without AVX-512 is moot.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace sahara {
+
+/// What every ISA's kernel needs: the packet, the tree, and the permutation
+/// and plane choice shared by all active rays (see packet_eligible in packet.cpp).
+struct PacketContext {
+    const RayPacket* rays;
+    const TriangleBlock4* blocks;
+    const Accelerator* accel;
+    int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
+    int neg[3];       ///< direction sign per axis, common to all active rays
+    int near_off[3];  ///< offset of each axis's near planes in a node, in units of N floats
+    int far_off[3];   ///< offset of each axis's far planes, in units of N floats
+    int first;        ///< first active lane
+};
+
+namespace packet_kernel {
+
+inline constexpr int kSse2 = 128;
+inline constexpr int kAvx512 = 512;
 
 using F = float __attribute__((vector_size(64)));
 using I = int32_t __attribute__((vector_size(64)));
 
+template <int kIsa>
 [[gnu::always_inline]] inline uint32_t mask_of(I c) {
-#if SAHARA_PACKET_ISA == 512
-    __m512i x;
-    std::memcpy(&x, &c, sizeof x);
-    return uint32_t(_mm512_cmplt_epi32_mask(x, _mm512_setzero_si512()));
-#else
-    __m128 x[4];
-    std::memcpy(x, &c, sizeof x);
-    return uint32_t(_mm_movemask_ps(x[0])) | uint32_t(_mm_movemask_ps(x[1])) << 4 |
-           uint32_t(_mm_movemask_ps(x[2])) << 8 | uint32_t(_mm_movemask_ps(x[3])) << 12;
-#endif
+    if constexpr (kIsa == 512) {
+        __m512i x;
+        std::memcpy(&x, &c, sizeof x);
+        return uint32_t(_mm512_cmplt_epi32_mask(x, _mm512_setzero_si512()));
+    } else {
+        __m128 x[4];
+        std::memcpy(x, &c, sizeof x);
+        return uint32_t(_mm_movemask_ps(x[0])) | uint32_t(_mm_movemask_ps(x[1])) << 4 |
+               uint32_t(_mm_movemask_ps(x[2])) << 8 | uint32_t(_mm_movemask_ps(x[3])) << 12;
+    }
 }
 
+template <int kIsa>
 [[gnu::always_inline]] inline F load(const float* p) {
     F v;
     std::memcpy(&v, p, sizeof v);
     return v;
 }
 
+template <int kIsa>
 [[gnu::always_inline]] inline F splat(float x) { return F{} + x; }
 
 /// Lane-wise c ? a : b as bit operations (GCC lowers a vector `?:` wider than
 /// the registers lane by lane; the bit form stays in registers).
+template <int kIsa>
 [[gnu::always_inline]] inline F select(I c, F a, F b) {
-#if SAHARA_PACKET_ISA == 512
-    return c ? a : b;  // one masked blend
-#else
-    return std::bit_cast<F>((std::bit_cast<I>(a) & c) | (std::bit_cast<I>(b) & ~c));
-#endif
+    if constexpr (kIsa == 512) {
+        return c ? a : b;  // one masked blend
+    } else {
+        return std::bit_cast<F>((std::bit_cast<I>(a) & c) | (std::bit_cast<I>(b) & ~c));
+    }
 }
+template <int kIsa>
 [[gnu::always_inline]] inline I select(I c, I a, I b) {
-#if SAHARA_PACKET_ISA == 512
-    return c ? a : b;
-#else
-    return (a & c) | (b & ~c);
-#endif
+    if constexpr (kIsa == 512) {
+        return c ? a : b;
+    } else {
+        return (a & c) | (b & ~c);
+    }
 }
-
-#define SAHARA_PACKET_PART __m128
-#define SAHARA_PACKET_MAX _mm_max_ps
-#define SAHARA_PACKET_MIN _mm_min_ps
 
 /// a > b ? a : b lane-wise (b when either is NaN), as maxps. AVX-512 lowers
 /// the vector `?:` natively; narrower ISAs get the intrinsic per register.
+template <int kIsa>
 [[gnu::always_inline]] inline F vmax(F a, F b) {
-#if SAHARA_PACKET_ISA == 512
-    return a > b ? a : b;
-#else
-    constexpr int kParts = sizeof(F) / sizeof(SAHARA_PACKET_PART);
-    SAHARA_PACKET_PART x[kParts], y[kParts];
-    std::memcpy(x, &a, sizeof x);
-    std::memcpy(y, &b, sizeof y);
-    for (int k = 0; k < kParts; ++k) x[k] = SAHARA_PACKET_MAX(x[k], y[k]);
-    std::memcpy(&a, x, sizeof a);
-    return a;
-#endif
+    if constexpr (kIsa == 512) {
+        return a > b ? a : b;
+    } else {
+        constexpr int kParts = sizeof(F) / sizeof(__m128);
+        __m128 x[kParts], y[kParts];
+        std::memcpy(x, &a, sizeof x);
+        std::memcpy(y, &b, sizeof y);
+        for (int k = 0; k < kParts; ++k) x[k] = _mm_max_ps(x[k], y[k]);
+        std::memcpy(&a, x, sizeof a);
+        return a;
+    }
 }
 
 /// a < b ? a : b lane-wise (b when either is NaN), as minps.
+template <int kIsa>
 [[gnu::always_inline]] inline F vmin(F a, F b) {
-#if SAHARA_PACKET_ISA == 512
-    return a < b ? a : b;
-#else
-    constexpr int kParts = sizeof(F) / sizeof(SAHARA_PACKET_PART);
-    SAHARA_PACKET_PART x[kParts], y[kParts];
-    std::memcpy(x, &a, sizeof x);
-    std::memcpy(y, &b, sizeof y);
-    for (int k = 0; k < kParts; ++k) x[k] = SAHARA_PACKET_MIN(x[k], y[k]);
-    std::memcpy(&a, x, sizeof a);
-    return a;
-#endif
+    if constexpr (kIsa == 512) {
+        return a < b ? a : b;
+    } else {
+        constexpr int kParts = sizeof(F) / sizeof(__m128);
+        __m128 x[kParts], y[kParts];
+        std::memcpy(x, &a, sizeof x);
+        std::memcpy(y, &b, sizeof y);
+        for (int k = 0; k < kParts; ++k) x[k] = _mm_min_ps(x[k], y[k]);
+        std::memcpy(&a, x, sizeof a);
+        return a;
+    }
 }
 
-#undef SAHARA_PACKET_PART
-#undef SAHARA_PACKET_MAX
-#undef SAHARA_PACKET_MIN
-
 /// All-ones lanes where bit i of `bits` is set.
+template <int kIsa>
 [[gnu::always_inline]] inline I lanes_of(uint32_t bits) {
     const I lane_bit = {1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768};
     return (lane_bit & int32_t(bits)) != 0;
@@ -106,28 +145,31 @@ struct alignas(64) State {
 /// Slab test of one box against every lane; `near`/`far` are the box's planes
 /// per axis as seen by the packet's common direction signs. Same operations
 /// as intersect_wide_sse per lane.
+template <int kIsa>
 [[gnu::always_inline]] inline uint32_t box_test(const State& s, const float near[3], const float far[3],
                                                 F& t_near) {
     F t0 = s.tmin, t1 = s.tmax;
     for (int a = 0; a < 3; ++a) {
-        const F tn = (splat(near[a]) - s.org[a]) * s.inv[a];
-        const F tf = (splat(far[a]) - s.org[a]) * s.inv[a];
-        t0 = vmax(tn, t0);  // NaN tn leaves t0 (the NaN-ignoring order)
-        t1 = vmin(tf, t1);
+        const F tn = (splat<kIsa>(near[a]) - s.org[a]) * s.inv[a];
+        const F tf = (splat<kIsa>(far[a]) - s.org[a]) * s.inv[a];
+        t0 = vmax<kIsa>(tn, t0);  // NaN tn leaves t0 (the NaN-ignoring order)
+        t1 = vmin<kIsa>(tf, t1);
     }
     t_near = t0;
-    return mask_of(t0 <= t1 * kRobustFarScale);
+    return mask_of<kIsa>(t0 <= t1 * kRobustFarScale);
 }
 
 /// Lane i takes (t, prim, u, v) where `take` is set.
+template <int kIsa>
 [[gnu::always_inline]] inline void take_hits(State& s, I take, F t, int32_t prim, F u, F v) {
-    s.tmax = select(take, t, s.tmax);
-    s.prim = select(take, I{} + prim, s.prim);
-    s.hu = select(take, u, s.hu);
-    s.hv = select(take, v, s.hv);
+    s.tmax = select<kIsa>(take, t, s.tmax);
+    s.prim = select<kIsa>(take, I{} + prim, s.prim);
+    s.hu = select<kIsa>(take, u, s.hu);
+    s.hv = select<kIsa>(take, v, s.hv);
 }
 
 /// Lane i takes a scalar hit.
+template <int kIsa>
 [[gnu::always_inline]] inline void take_hit(State& s, int i, const Hit& h) {
     s.tmax[i] = h.t;
     s.prim[i] = int32_t(h.prim);
@@ -136,20 +178,21 @@ struct alignas(64) State {
 }
 
 /// One triangle (lane `l` of `b`, leaf slot `slot`) against the rays of `mask`.
+template <int kIsa>
 [[gnu::always_inline]] inline void test_triangle(State& s, const PacketContext& c, const TriangleBlock4& b,
                                                  int l, uint32_t mask) {
     F x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
-        const F rz = splat(b.p[v][c.kz][l]) - s.oz;
-        x[v] = (splat(b.p[v][c.kx][l]) - s.ox) - s.sx * rz;
-        y[v] = (splat(b.p[v][c.ky][l]) - s.oy) - s.sy * rz;
+        const F rz = splat<kIsa>(b.p[v][c.kz][l]) - s.oz;
+        x[v] = (splat<kIsa>(b.p[v][c.kx][l]) - s.ox) - s.sx * rz;
+        y[v] = (splat<kIsa>(b.p[v][c.ky][l]) - s.oy) - s.sy * rz;
         z[v] = s.sz * rz;
     }
     const F u = x[2] * y[1] - y[2] * x[1];
     const F v = x[0] * y[2] - y[0] * x[2];
     const F w = x[1] * y[0] - y[1] * x[0];
     const F zero = F{};
-    const uint32_t exact_zero = mask_of((u == zero) | (v == zero) | (w == zero)) & mask;
+    const uint32_t exact_zero = mask_of<kIsa>((u == zero) | (v == zero) | (w == zero)) & mask;
     const I any_neg = (u < zero) | (v < zero) | (w < zero);
     const I any_pos = (u > zero) | (v > zero) | (w > zero);
     const F det = (u + v) + w;
@@ -159,14 +202,14 @@ struct alignas(64) State {
     const F t_signed = std::bit_cast<F>(std::bit_cast<I>(t_scaled) ^ sign);
     const I ok =
         ~(any_neg & any_pos) & (det != zero) & (t_signed > s.tmin * abs_det) & (t_signed < s.tmax * abs_det);
-    const uint32_t bits = mask_of(ok) & mask & ~exact_zero;
+    const uint32_t bits = mask_of<kIsa>(ok) & mask & ~exact_zero;
     const uint32_t id = b.slot[l];  // a triangle lane holds its primitive id
     if (bits) {
         const F inv_det = 1.0f / det;
         const F t = t_scaled * inv_det;
         // Rounding of the division can push t onto the interval's boundary.
-        const I take = lanes_of(bits) & (t > s.tmin) & (t < s.tmax);
-        take_hits(s, take, t, int32_t(id), v * inv_det, w * inv_det);
+        const I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
+        take_hits<kIsa>(s, take, t, int32_t(id), v * inv_det, w * inv_det);
     }
     // Lanes with an exactly-zero edge function: the scalar test (double fallback included).
     for (uint32_t m = exact_zero; m; m &= m - 1) {
@@ -177,12 +220,13 @@ struct alignas(64) State {
                                  {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                  {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
         if (const std::optional<ShapeHit> th = tri.intersect(tr, s.tmin[i], s.tmax[i]))
-            take_hit(s, i, Hit{th->t, id, th->u, th->v});
+            take_hit<kIsa>(s, i, Hit{th->t, id, th->u, th->v});
     }
 }
 
 /// The leaf blocks [first, first + ceil(count / 4)) against the rays of `mask`:
 /// per block, triangle lanes in order, then other kinds per ray (the order of test_blocks).
+template <int kIsa>
 [[gnu::always_inline]] inline void test_leaf(State& s, const PacketContext& c, uint32_t first, uint32_t count,
                                              uint32_t mask) {
     for (uint32_t bi = first; bi < first + (count + 3) / 4; ++bi) {
@@ -194,7 +238,7 @@ struct alignas(64) State {
             if (slot & TriangleBlock4::kOtherKind)
                 other |= 1u << l;
             else
-                test_triangle(s, c, b, l, mask);
+                test_triangle<kIsa>(s, c, b, l, mask);
         }
         for (; other; other &= other - 1) {
             const uint32_t slot = b.slot[__builtin_ctz(other)] & ~TriangleBlock4::kOtherKind;
@@ -203,26 +247,27 @@ struct alignas(64) State {
                 Ray r = c.rays->ray(i);
                 r.tmax = s.tmax[i];
                 Hit h;
-                if (c.accel->intersect_slot(r, slot, h)) take_hit(s, i, h);
+                if (c.accel->intersect_slot(r, slot, h)) take_hit<kIsa>(s, i, h);
             }
         }
     }
 }
 
 /// Sets up the per-ray constants of the active lanes (inactive lanes copy lane `first`).
+template <int kIsa>
 [[gnu::always_inline]] inline void init_state(State& s, const PacketContext& c) {
     const RayPacket& p = *c.rays;
-    const I act = lanes_of(p.active);
+    const I act = lanes_of<kIsa>(p.active);
     for (int a = 0; a < 3; ++a) {
-        s.org[a] = select(act, load(p.org[a]), splat(p.org[a][c.first]));
-        const F d = select(act, load(p.dir[a]), splat(p.dir[a][c.first]));
+        s.org[a] = select<kIsa>(act, load<kIsa>(p.org[a]), splat<kIsa>(p.org[a][c.first]));
+        const F d = select<kIsa>(act, load<kIsa>(p.dir[a]), splat<kIsa>(p.dir[a][c.first]));
         s.inv[a] = 1.0f / d;  // +-inf for +-0, as in BvhRay
     }
-    s.tmin = select(act, load(p.tmin), splat(p.tmin[c.first]));
-    s.tmax = select(act, load(p.tmax), splat(p.tmax[c.first]));
-    const F dx = select(act, load(p.dir[c.kx]), splat(p.dir[c.kx][c.first]));
-    const F dy = select(act, load(p.dir[c.ky]), splat(p.dir[c.ky][c.first]));
-    const F dz = select(act, load(p.dir[c.kz]), splat(p.dir[c.kz][c.first]));
+    s.tmin = select<kIsa>(act, load<kIsa>(p.tmin), splat<kIsa>(p.tmin[c.first]));
+    s.tmax = select<kIsa>(act, load<kIsa>(p.tmax), splat<kIsa>(p.tmax[c.first]));
+    const F dx = select<kIsa>(act, load<kIsa>(p.dir[c.kx]), splat<kIsa>(p.dir[c.kx][c.first]));
+    const F dy = select<kIsa>(act, load<kIsa>(p.dir[c.ky]), splat<kIsa>(p.dir[c.ky][c.first]));
+    const F dz = select<kIsa>(act, load<kIsa>(p.dir[c.kz]), splat<kIsa>(p.dir[c.kz][c.first]));
     s.ox = s.org[c.kx], s.oy = s.org[c.ky], s.oz = s.org[c.kz];
     s.sz = 1.0f / dz, s.sx = dx * s.sz, s.sy = dy * s.sz;  // as in TriangleRay::shear
     s.hu = s.hv = F{};
@@ -235,21 +280,38 @@ struct PacketEntry {
     float order;  ///< entry distance of a representative ray (ordering only)
 };
 
-/// Nearest hits of the active rays over an N-wide tree; see Accelerator::intersect_packet.
-template <int N>
-inline void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacket& out) {
-    State s;
-    init_state(s, c);
-    uint32_t mask = c.rays->active;
-    {
-        float near[3], far[3];
-        for (int a = 0; a < 3; ++a) {
-            near[a] = bvh.root.bounds[2 * a + c.neg[a]];
-            far[a] = bvh.root.bounds[2 * a + 1 - c.neg[a]];
-        }
-        F tn;
-        mask &= box_test(s, near, far, tn);
+/// The rays that enter the root's box.
+template <int kIsa, int N>
+[[gnu::always_inline]] inline uint32_t root_mask(const State& s, const PacketContext& c, const BvhWide<N>& bvh) {
+    float near[3], far[3];
+    for (int a = 0; a < 3; ++a) {
+        near[a] = bvh.root.bounds[2 * a + c.neg[a]];
+        far[a] = bvh.root.bounds[2 * a + 1 - c.neg[a]];
     }
+    F tn;
+    return box_test<kIsa>(s, near, far, tn);
+}
+
+/// Copies the nearest hits out; a lane without one gets t = infinity.
+template <int kIsa>
+[[gnu::always_inline]] inline void store_hits(const State& s, HitPacket& out) {
+    const I hit = s.prim != int32_t(kNoPrim);
+    const F t = select<kIsa>(hit, s.tmax, splat<kIsa>(kInfinity));
+    std::memcpy(out.t, &t, sizeof t);
+    std::memcpy(out.u, &s.hu, sizeof s.hu);
+    std::memcpy(out.v, &s.hv, sizeof s.hv);
+    std::memcpy(out.prim, &s.prim, sizeof s.prim);
+}
+
+/// Nearest hits of the active rays over an N-wide tree; see Accelerator::intersect_packet.
+/// A traversal kernel, long on purpose (about 65 lines): the node step, the child
+/// ordering and the pop share the packet state in one body, which GCC keeps in
+/// registers only while nothing in the loop is an out-of-line call.
+template <int kIsa, int N>
+void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacket& out) {
+    State s;
+    init_state<kIsa>(s, c);
+    uint32_t mask = c.rays->active & root_mask<kIsa>(s, c, bvh);
     // nodes[0] holds the root's children; a leaf root's index is its first block.
     PacketEntry cur{bvh.root.is_leaf() ? bvh.root.index : 0u, bvh.root.is_leaf() ? bvh.root.count : 0u, mask,
                     0.0f};
@@ -258,7 +320,7 @@ inline void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacke
     int top = 0;
     while (mask) {
         if (cur.count) {
-            test_leaf(s, c, cur.index, cur.count, cur.mask);
+            test_leaf<kIsa>(s, c, cur.index, cur.count, cur.mask);
         } else {
             const BvhWideNode<N>& n = bvh.node_at(cur.index);
             const float* base = reinterpret_cast<const float*>(&n);
@@ -273,7 +335,7 @@ inline void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacke
                     far[a] = base[N * c.far_off[a] + k];
                 }
                 F tn;
-                const uint32_t m = box_test(s, near, far, tn) & cur.mask;
+                const uint32_t m = box_test<kIsa>(s, near, far, tn) & cur.mask;
                 if (!m) continue;
                 // Insertion by the representative distance, nearest last.
                 const PacketEntry e{n.child_index(k), n.leaf_count(k), m, tn[__builtin_ctz(m)]};
@@ -302,7 +364,7 @@ inline void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacke
                 break;
             }
             --top;
-            const uint32_t m = stack[top].mask & mask_of(stack_t[top] <= s.tmax * kRobustFarScale);
+            const uint32_t m = stack[top].mask & mask_of<kIsa>(stack_t[top] <= s.tmax * kRobustFarScale);
             if (m) {
                 cur = stack[top];
                 cur.mask = m;
@@ -310,10 +372,12 @@ inline void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacke
             }
         }
     }
-    const I hit = s.prim != int32_t(kNoPrim);
-    const F t = select(hit, s.tmax, splat(kInfinity));
-    std::memcpy(out.t, &t, sizeof t);
-    std::memcpy(out.u, &s.hu, sizeof s.hu);
-    std::memcpy(out.v, &s.hv, sizeof s.hv);
-    std::memcpy(out.prim, &s.prim, sizeof s.prim);
+    store_hits<kIsa>(s, out);
 }
+
+// Instantiated once each, in packet_sse2.cpp and packet_avx512.cpp.
+extern template void trace_packet<kSse2, 8>(const PacketContext&, const BvhWide<8>&, HitPacket&);
+extern template void trace_packet<kAvx512, 8>(const PacketContext&, const BvhWide<8>&, HitPacket&);
+
+}  // namespace packet_kernel
+}  // namespace sahara
