@@ -28,7 +28,10 @@ const char* const kInfoUsage =
     "\n"
     "Describes a scene or model (the built-in default scene if none is given):\n"
     "objects, triangles, materials, textures, lights, bounds, estimated memory,\n"
-    "load and build times.\n"
+    "load and build times. Each material is listed by what it uses (type,\n"
+    "textures, vertex colours, emission, transmission, alpha, one-sided);\n"
+    "'Ignored inputs' names what the file gives that is not rendered (e.g. a\n"
+    "glTF occlusion map, unsupported extensions, volume attenuation).\n"
     "\n"
     "  --json       machine-readable output on stdout\n"
     "  -h, --help   this text\n";

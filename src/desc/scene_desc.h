@@ -83,6 +83,9 @@ struct MaterialDesc {
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
     bool double_sided = true;  ///< false: back faces are invisible
     bool thin_walled = false;  ///< transmission without refraction (no volume behind the surface)
+    /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
+    /// filled by the loaders so that `sahara info` can name them.
+    std::vector<std::string> ignored;
 };
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.

@@ -131,6 +131,7 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
         out.normal_texture = texture(ref, false, element + ".normalTexture");
         out.normal_scale = float(m.normalTexture.scale);
     }
+    if (m.occlusionTexture.index >= 0) out.ignored.push_back("occlusion map");
     set_emission(out, m, element);
     set_extensions(out, m, element);
     return out;
@@ -190,8 +191,10 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
             const float distance = float(number(value, "attenuationDistance", kInfinity));
             if (distance > 0.0f) out.attenuation_distance = distance;
             out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
-        } else if (name != "KHR_materials_emissive_strength" && ignored_.insert(name).second) {
-            log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
+        } else if (name != "KHR_materials_emissive_strength") {
+            out.ignored.push_back(name);
+            if (ignored_.insert(name).second)
+                log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
         }
     }
 }

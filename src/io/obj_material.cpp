@@ -7,6 +7,9 @@
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -317,6 +320,24 @@ void set_pbr(MaterialDesc& out, const tinyobj::material_t& m, const std::set<std
     }
 }
 
+/// MTL inputs with no counterpart in sahara's material, named by their keyword
+/// for `sahara info` (ambient Ka is left out: nearly every file writes it).
+std::vector<std::string> ignored_inputs(const tinyobj::material_t& m) {
+    std::vector<std::string> out;
+    const std::pair<const std::string*, const char*> maps[] = {{&m.ambient_texname, "map_Ka"},
+                                                               {&m.specular_texname, "map_Ks"},
+                                                               {&m.specular_highlight_texname, "map_Ns"},
+                                                               {&m.displacement_texname, "disp"},
+                                                               {&m.reflection_texname, "refl"},
+                                                               {&m.sheen_texname, "map_Ps"}};
+    for (const auto& [name, key] : maps)
+        if (!name->empty()) out.push_back(key);
+    if (m.sheen > 0) out.push_back("Ps (sheen)");
+    if (m.clearcoat_thickness > 0) out.push_back("Pc (clearcoat)");
+    if (m.anisotropy > 0) out.push_back("aniso (anisotropy)");
+    return out;
+}
+
 }  // namespace
 
 MaterialDesc convert_material(const tinyobj::material_t& m, const std::set<std::string>& keys,
@@ -342,6 +363,7 @@ MaterialDesc convert_material(const tinyobj::material_t& m, const std::set<std::
         out.type = MaterialType::emissive;
         out.radiance = glow;
     }
+    out.ignored = ignored_inputs(m);
     return out;
 }
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "pipeline/material_info.h"
 #include "render/features.h"
 
 namespace sahara {
@@ -12,22 +13,6 @@ namespace sahara {
 namespace fs = std::filesystem;
 
 namespace {
-
-const char* material_type_name(MaterialType t) {
-    switch (t) {
-        case MaterialType::lambertian:
-            return "lambertian";
-        case MaterialType::metal:
-            return "metal";
-        case MaterialType::dielectric:
-            return "dielectric";
-        case MaterialType::emissive:
-            return "emissive";
-        case MaterialType::pbr:
-            return "pbr";
-    }
-    return "?";
-}
 
 std::string vec_text(const Vec3& v) {
     char buf[96];
@@ -43,12 +28,7 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
     s.add_count("Objects", "Meshes", d.meshes.size());
     s.add_count("Objects", "Triangles", scene.triangles.size());
     s.add_count("Objects", "Vertices", scene.triangles.positions.size());
-    s.add_count("Materials", "Total", d.materials.size());
-    for (MaterialType t :
-         {MaterialType::lambertian, MaterialType::metal, MaterialType::dielectric, MaterialType::emissive})
-        s.add_count("Materials", material_type_name(t),
-                    uint64_t(std::count_if(d.materials.begin(), d.materials.end(),
-                                           [t](const MaterialDesc& m) { return m.type == t; })));
+    describe_materials(s, d);
     s.add_count("Textures", "Total", d.textures.size());
     for (size_t i = 0; i < d.textures.size(); ++i) {
         const TextureDesc& t = d.textures[i];
@@ -68,9 +48,7 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
                     return l.type == LightDesc::Type::directional;
                 })));
     s.add_count("Lights", "Emissive materials",
-                uint64_t(std::count_if(d.materials.begin(), d.materials.end(), [](const MaterialDesc& m) {
-                    return m.type == MaterialType::emissive;
-                })));
+                uint64_t(std::count_if(d.materials.begin(), d.materials.end(), emits_light)));
     const Bounds3 b = scene.bounds();
     if (scene.primitive_count() > scene.planes.size()) {
         s.add("Bounds", "Min", vec_text(b.lo), {b.lo.x, b.lo.y, b.lo.z});
