@@ -9,8 +9,9 @@ out=${FUZZ_OUT:-$root/build-fuzz}
 mkdir -p "$out"
 cxx="clang++-14 -std=c++20 -O1 -g -fsanitize=fuzzer,address -fno-omit-frame-pointer -DSAHARA_VERSION=\"fuzz\" -I$root/src -I/usr/include/opencv4"
 libs="-ltinyobjloader -ltinygltf -lOpenImageIO -lOpenImageIO_Util -ldl"
-srcs="$root/src/io/obj_loader.cpp $root/src/io/gltf_loader.cpp $root/src/io/gltf_scene.cpp $root/src/io/gltf_accessor.cpp
-      $root/src/io/gltf_material.cpp $root/src/io/model_loader.cpp $root/src/io/mesh_utils.cpp $root/src/io/image_bytes.cpp
+# Every OBJ and glTF source by pattern, so a loader split into a new file is linked too.
+srcs="$(ls "$root"/src/io/obj_*.cpp "$root"/src/io/gltf_*.cpp | tr '\n' ' ')
+      $root/src/io/model_loader.cpp $root/src/io/mesh_utils.cpp $root/src/io/image_bytes.cpp
       $root/src/io/files.cpp $root/src/base/log.cpp $root/src/base/pending_file.cpp"
 # The image codec is linked in (not loaded as a plugin): the fuzzers reach it directly.
 srcs="$srcs $root/src/io/image_io.cpp $root/src/io/image_codec.cpp $root/src/io/image_codec_oiio.cpp"
