@@ -147,18 +147,6 @@ ColorSource parse_color_source(const JsonValue& v, ParseContext& ctx) {
     return c;
 }
 
-/// "alpha": number in [0, 1] or {"texture": "file"} (the image's alpha channel, linear).
-void parse_alpha(const JsonValue& v, ParseContext& ctx, MaterialDesc& m) {
-    if (v.json().is_number()) {
-        m.alpha = v.number_f(NumberRange::closed(0, 1));
-        return;
-    }
-    if (!v.json().is_object()) v.fail_expected("a number in [0, 1] or {\"texture\": \"file\"}");
-    JsonObject o(v);
-    m.alpha_texture = ctx.texture(o.require("texture", "the alpha image file"), false);
-    o.finish();
-}
-
 MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext& ctx) {
     MaterialDesc m;
     m.name = name;
@@ -205,6 +193,18 @@ void parse_materials(JsonObject o, ParseContext& ctx) {
 }
 
 }  // namespace
+
+/// "alpha": number in [0, 1] or {"texture": "file"} (the image's alpha channel, linear).
+void parse_alpha(const JsonValue& v, ParseContext& ctx, MaterialDesc& m) {
+    if (v.json().is_number()) {
+        m.alpha = v.number_f(NumberRange::closed(0, 1));
+        return;
+    }
+    if (!v.json().is_object()) v.fail_expected("a number in [0, 1] or {\"texture\": \"file\"}");
+    JsonObject o(v);
+    m.alpha_texture = ctx.texture(o.require("texture", "the alpha image file"), false);
+    o.finish();
+}
 
 // --- ParseContext ------------------------------------------------------------------
 

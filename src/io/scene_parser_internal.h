@@ -33,4 +33,8 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m);
 void parse_objects(ParseContext& ctx, const JsonValue& objects);
 void parse_lights(ParseContext& ctx, const JsonValue& lights);
 
+/// "alpha": a number in [0, 1] or {"texture": FILE} (the image's alpha channel,
+/// linear); shared by the lambertian and pbr materials.
+void parse_alpha(const JsonValue& v, ParseContext& ctx, MaterialDesc& m);
+
 }  // namespace sahara

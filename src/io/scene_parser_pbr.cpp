@@ -35,18 +35,6 @@ int parse_data_texture(const JsonValue& v, ParseContext& ctx, const char* what, 
     return tex;
 }
 
-/// "alpha": a number in [0, 1] or {"texture": FILE} (its alpha channel).
-void parse_pbr_alpha(const JsonValue& v, ParseContext& ctx, MaterialDesc& m) {
-    if (v.json().is_number()) {
-        m.alpha = v.number_f(NumberRange::closed(0, 1));
-        return;
-    }
-    if (!v.json().is_object()) v.fail_expected("a number in [0, 1] or {\"texture\": \"file\"}");
-    JsonObject o(v);
-    m.alpha_texture = ctx.texture(o.require("texture", "the alpha image file"), false);
-    o.finish();
-}
-
 /// alpha_mode and its companions, with glTF's meaning: opaque ignores alpha,
 /// mask cuts at alpha_cutoff, blend is stochastic transparency. Without an
 /// alpha texture, the base colour texture's alpha is the alpha, as in glTF.
@@ -57,7 +45,7 @@ void parse_alpha_mode(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     std::optional<JsonValue> alpha = o.get("alpha"), cutoff = o.get("alpha_cutoff");
     if (cutoff && mode != mask) cutoff->fail("\"alpha_cutoff\" needs \"alpha_mode\": \"mask\"");
     if (mode == opaque) return;  // glTF OPAQUE: alpha is ignored
-    if (alpha) parse_pbr_alpha(*alpha, ctx, m);
+    if (alpha) parse_alpha(*alpha, ctx, m);
     if (m.alpha_texture < 0 && m.albedo.kind == ColorSource::Kind::texture)
         m.alpha_texture = m.albedo.texture;
     if (mode == mask) {
