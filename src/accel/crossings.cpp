@@ -40,8 +40,9 @@ void for_each_crossing(const Bvh8& tree, std::span<const TriangleBlock4> blocks,
 
 void collect_crossings(const Bvh8& tree, std::span<const TriangleBlock4> blocks, const Ray& ray,
                        std::vector<Hit>& out) {
-    for_each_crossing(tree, blocks, ray,
-                      [&](const ShapeHit& h, uint32_t prim) { out.push_back(Hit{h.t, prim, h.u, h.v}); });
+    for_each_crossing(tree, blocks, ray, [&](const ShapeHit& h, uint32_t prim) {
+        out.push_back(Hit{h.t, prim, h.u, h.v});
+    });
 }
 
 uint32_t count_crossings(const Bvh8& tree, std::span<const TriangleBlock4> blocks, const Ray& ray) {

@@ -66,8 +66,9 @@ int run_view_command(const std::vector<std::string>& args) {
         return 0;
     }
     const std::string model = *v.render.scene;
-    return run_render(v.render,
-                      [&] { return make_view_scene(load_model(model), file_kind(model) == FileKind::gltf, v.view, model); });
+    return run_render(v.render, [&] {
+        return make_view_scene(load_model(model), file_kind(model) == FileKind::gltf, v.view, model);
+    });
 }
 
 }  // namespace sahara

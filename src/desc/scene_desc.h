@@ -55,9 +55,9 @@ enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
-    ColorSource albedo;        ///< lambertian and metal; pbr: base colour (factor x texture)
-    float roughness = 0.0f;    ///< metal; pbr: perceptual roughness (alpha = roughness^2)
-    float ior = 1.5f;          ///< dielectric; pbr: ior of the dielectric layer (F0 0.04 at 1.5)
+    ColorSource albedo;      ///< lambertian and metal; pbr: base colour (factor x texture)
+    float roughness = 0.0f;  ///< metal; pbr: perceptual roughness (alpha = roughness^2)
+    float ior = 1.5f;        ///< dielectric; pbr: ior of the dielectric layer (F0 0.04 at 1.5)
     /// emissive: radiance of the front side; pbr: emission (factor x texture x
     /// strength) added to what the surface reflects.
     ColorSource radiance{ColorSource::Kind::constant, Rgb(0.0f)};
@@ -75,9 +75,9 @@ struct MaterialDesc {
     int metallic_roughness_texture = -1;  ///< G scales roughness, B scales metallic
     int normal_texture = -1;              ///< tangent-space normal map
     float normal_scale = 1.0f;
-    bool vertex_colors = false;           ///< base colour also times the mesh's COLOR_0
-    float transmission = 0.0f;            ///< KHR_materials_transmission
-    int transmission_texture = -1;        ///< R scales transmission
+    bool vertex_colors = false;     ///< base colour also times the mesh's COLOR_0
+    float transmission = 0.0f;      ///< KHR_materials_transmission
+    int transmission_texture = -1;  ///< R scales transmission
     /// KHR_materials_volume: light inside decays to attenuation_color after this distance.
     float attenuation_distance = kInfinity;
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
@@ -142,11 +142,11 @@ struct BoxDesc {
 struct TriangleMesh {
     std::string name;  ///< source file and element, for messages and stats
     std::vector<Vec3> positions;
-    std::vector<Vec3> normals;           ///< empty, or one per position
-    std::vector<Vec2> uvs;               ///< empty, or one per position (texCoord set 0)
-    std::vector<Vec2> uvs1;              ///< empty, or one per position (texCoord set 1)
-    std::vector<Rgb> colors;             ///< empty, or one per position (glTF COLOR_0, linear)
-    std::vector<float> color_alphas;     ///< empty, or one per position (COLOR_0's alpha)
+    std::vector<Vec3> normals;        ///< empty, or one per position
+    std::vector<Vec2> uvs;            ///< empty, or one per position (texCoord set 0)
+    std::vector<Vec2> uvs1;           ///< empty, or one per position (texCoord set 1)
+    std::vector<Rgb> colors;          ///< empty, or one per position (glTF COLOR_0, linear)
+    std::vector<float> color_alphas;  ///< empty, or one per position (COLOR_0's alpha)
     /// empty, or one per position: xyz the tangent, w (+1/-1) the sign of the
     /// bitangent (mirrored UVs), as glTF's TANGENT attribute.
     std::vector<std::array<float, 4>> tangents;

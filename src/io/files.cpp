@@ -35,7 +35,9 @@ Bytes read_all(const fs::path& file, const std::string& what) {
 
 }  // namespace
 
-std::string read_file(const fs::path& file, const std::string& what) { return read_all<std::string>(file, what); }
+std::string read_file(const fs::path& file, const std::string& what) {
+    return read_all<std::string>(file, what);
+}
 
 std::vector<unsigned char> read_file_bytes(const fs::path& file, const std::string& what) {
     return read_all<std::vector<unsigned char>>(file, what);

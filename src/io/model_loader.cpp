@@ -12,9 +12,9 @@ LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from
         case FileKind::gltf:
             return load_gltf(file, world_from_model);
         default:
-            throw input_error(file.string(), "",
-                              "unknown model format '" + file.extension().string() +
-                                  "' (expected .obj, .gltf or .glb)");
+            throw input_error(
+                file.string(), "",
+                "unknown model format '" + file.extension().string() + "' (expected .obj, .gltf or .glb)");
     }
 }
 

@@ -55,13 +55,14 @@ nlohmann::ordered_json primitive_kinds_json(const Scene& scene) {
 nlohmann::ordered_json wide_tree_json(const Accelerator& accel) {
     const uint32_t block = 4;
     const WideBvhStats w = compute_wide_bvh_stats(accel.bvh8(), block);
-    return {{"nodes", w.nodes},
-            {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
-            {"leaves", w.leaves},
-            {"leaf_block_size", block},
-            {"leaf_block_fill", w.leaf_blocks ? double(w.leaf_primitives) / double(w.leaf_blocks * block) : 0.0},
-            {"sah_nodes", w.sah_nodes},
-            {"sah_leaves", w.sah_leaves}};
+    return {
+        {"nodes", w.nodes},
+        {"children_per_node", w.nodes ? double(w.children) / double(w.nodes) : 0.0},
+        {"leaves", w.leaves},
+        {"leaf_block_size", block},
+        {"leaf_block_fill", w.leaf_blocks ? double(w.leaf_primitives) / double(w.leaf_blocks * block) : 0.0},
+        {"sah_nodes", w.sah_nodes},
+        {"sah_leaves", w.sah_leaves}};
 }
 
 }  // namespace

@@ -9,7 +9,8 @@ namespace sahara {
 SceneDesc read_scene_argument(const std::optional<std::string>& file) {
     if (!file) return default_scene();
     if (is_model_kind(file_kind(*file)))
-        throw input_error(*file, "", "a model, not a scene file (`sahara view " + *file + "` renders a model)");
+        throw input_error(*file, "",
+                          "a model, not a scene file (`sahara view " + *file + "` renders a model)");
     return parse_scene_file(*file);
 }
 

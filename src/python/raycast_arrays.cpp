@@ -23,13 +23,14 @@ bool is_float_array(const py::array& a) {
 
 void require_float(const py::array& a, const char* name) {
     if (!is_float_array(a))
-        throw py::type_error(std::string(name) + ": expected a float32 or float64 array, got " + dtype_name(a));
+        throw py::type_error(std::string(name) + ": expected a float32 or float64 array, got " +
+                             dtype_name(a));
 }
 
 void require_rows_of(const py::array& a, const char* name, py::ssize_t columns, const char* rows) {
     if (a.ndim() != 2 || a.shape(1) != columns)
-        throw py::value_error(std::string(name) + ": expected shape (" + rows + ", " + std::to_string(columns) +
-                              "), got " + shape_text(a));
+        throw py::value_error(std::string(name) + ": expected shape (" + rows + ", " +
+                              std::to_string(columns) + "), got " + shape_text(a));
 }
 
 /// Element (row, col) of a 2-D integer array of any width and sign, as int64 (uint64 above
@@ -38,10 +39,18 @@ int64_t integer_at(const py::array& a, py::ssize_t row, py::ssize_t col) {
     const char* p = static_cast<const char*>(a.data()) + row * a.strides(0) + col * a.strides(1);
     const bool is_signed = a.dtype().kind() == 'i';
     switch (a.itemsize()) {
-        case 1: return is_signed ? int64_t(*reinterpret_cast<const int8_t*>(p)) : int64_t(*reinterpret_cast<const uint8_t*>(p));
-        case 2: return is_signed ? int64_t(*reinterpret_cast<const int16_t*>(p)) : int64_t(*reinterpret_cast<const uint16_t*>(p));
-        case 4: return is_signed ? int64_t(*reinterpret_cast<const int32_t*>(p)) : int64_t(*reinterpret_cast<const uint32_t*>(p));
-        default: return is_signed ? *reinterpret_cast<const int64_t*>(p) : int64_t(*reinterpret_cast<const uint64_t*>(p));
+        case 1:
+            return is_signed ? int64_t(*reinterpret_cast<const int8_t*>(p))
+                             : int64_t(*reinterpret_cast<const uint8_t*>(p));
+        case 2:
+            return is_signed ? int64_t(*reinterpret_cast<const int16_t*>(p))
+                             : int64_t(*reinterpret_cast<const uint16_t*>(p));
+        case 4:
+            return is_signed ? int64_t(*reinterpret_cast<const int32_t*>(p))
+                             : int64_t(*reinterpret_cast<const uint32_t*>(p));
+        default:
+            return is_signed ? *reinterpret_cast<const int64_t*>(p)
+                             : int64_t(*reinterpret_cast<const uint64_t*>(p));
     }
 }
 
@@ -71,8 +80,8 @@ std::vector<Vec3> read_vertices(const py::array& a) {
             c[k] = f64 ? float(*reinterpret_cast<const double*>(p)) : *reinterpret_cast<const float*>(p);
             // Checked after the conversion: a float64 beyond float's range becomes inf.
             if (!std::isfinite(c[k]))
-                throw py::value_error("vertices: row " + std::to_string(i) +
-                                      " is not finite in float32 (" + std::to_string(c[k]) + ")");
+                throw py::value_error("vertices: row " + std::to_string(i) + " is not finite in float32 (" +
+                                      std::to_string(c[k]) + ")");
         }
         out[size_t(i)] = Vec3(c[0], c[1], c[2]);
     }
@@ -86,16 +95,16 @@ std::vector<uint32_t> read_triangles(const py::array& a, size_t vertex_count) {
     require_rows_of(a, "triangles", 3, "M");
     const py::ssize_t m = a.shape(0);
     if (size_t(m) > size_t(kPrimIndexMask) + 1)
-        throw py::value_error("triangles: at most " + std::to_string(kPrimIndexMask + 1) + " triangles, got " +
-                              std::to_string(m));
+        throw py::value_error("triangles: at most " + std::to_string(kPrimIndexMask + 1) +
+                              " triangles, got " + std::to_string(m));
     std::vector<uint32_t> out(size_t(m) * 3);
     for (py::ssize_t i = 0; i < m; ++i)
         for (int k = 0; k < 3; ++k) {
             const int64_t v = integer_at(a, i, k);
             if (v < 0 || uint64_t(v) >= vertex_count)
                 throw py::value_error("triangles: row " + std::to_string(i) + " refers to vertex " +
-                                      std::to_string(v) + ", but vertices has " + std::to_string(vertex_count) +
-                                      " rows");
+                                      std::to_string(v) + ", but vertices has " +
+                                      std::to_string(vertex_count) + " rows");
             out[size_t(i) * 3 + size_t(k)] = uint32_t(v);
         }
     return out;
@@ -107,7 +116,8 @@ RayBatch::RayBatch(const py::handle& rays, const py::handle& tmin, const py::han
     if (array_.ndim() < 1 || array_.shape(array_.ndim() - 1) != 6)
         throw py::value_error("rays: expected shape (..., 6) (origin, direction), got " + shape_text(array_));
     for (py::ssize_t d = 0; d + 1 < array_.ndim(); ++d) shape_.push_back(array_.shape(d));
-    if (array_.ndim() != 2) array_ = py::array(array_.attr("reshape")(-1, 6));  // a view where numpy can make one
+    if (array_.ndim() != 2)
+        array_ = py::array(array_.attr("reshape")(-1, 6));  // a view where numpy can make one
     data_ = static_cast<const char*>(array_.data());
     row_stride_ = array_.strides(0);
     col_stride_ = array_.strides(1);
@@ -127,7 +137,8 @@ RayBatch::Limit RayBatch::read_limit(const py::handle& obj, const char* name, fl
     }
     const py::array a = as_array(obj, name);
     if (a.dtype().kind() != 'f' && a.dtype().kind() != 'i' && a.dtype().kind() != 'u')
-        throw py::type_error(std::string(name) + ": expected a number or a float array, got " + dtype_name(a));
+        throw py::type_error(std::string(name) + ": expected a number or a float array, got " +
+                             dtype_name(a));
     if (a.ndim() == 0) {
         out.value = a.attr("item")().cast<float>();
         return out;

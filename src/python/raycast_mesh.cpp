@@ -38,8 +38,10 @@ Vec3 CastMesh::unit_normal(uint32_t triangle) const {
     const uint32_t* v = &indices_[3 * size_t(triangle)];
     // In double: a sliver's cross product loses most of its bits in float.
     const Vec3 &p0 = positions_[v[0]], &p1 = positions_[v[1]], &p2 = positions_[v[2]];
-    const double e1[3] = {double(p1.x) - double(p0.x), double(p1.y) - double(p0.y), double(p1.z) - double(p0.z)};
-    const double e2[3] = {double(p2.x) - double(p0.x), double(p2.y) - double(p0.y), double(p2.z) - double(p0.z)};
+    const double e1[3] = {double(p1.x) - double(p0.x), double(p1.y) - double(p0.y),
+                          double(p1.z) - double(p0.z)};
+    const double e2[3] = {double(p2.x) - double(p0.x), double(p2.y) - double(p0.y),
+                          double(p2.z) - double(p0.z)};
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                          e1[0] * e2[1] - e1[1] * e2[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);

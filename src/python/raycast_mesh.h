@@ -18,18 +18,18 @@ namespace sahara::python {
 
 /// Nearest-hit results, one entry per ray (caller-owned storage).
 struct NearestHits {
-    float* t;         ///< inf on a miss
-    int64_t* prim;    ///< -1 on a miss
-    float* uv;        ///< 2 per ray; 0 on a miss
-    float* normal;    ///< 3 per ray, unit geometric normal (counter-clockwise front); 0 on a miss
+    float* t;       ///< inf on a miss
+    int64_t* prim;  ///< -1 on a miss
+    float* uv;      ///< 2 per ray; 0 on a miss
+    float* normal;  ///< 3 per ray, unit geometric normal (counter-clockwise front); 0 on a miss
 };
 
 /// Every crossing of a batch, sorted by ray then t, collected per chunk of rays
 /// (so the caller can allocate the result arrays once it knows the total).
 struct Crossings {
-    std::vector<std::vector<Hit>> hits;       ///< per chunk
+    std::vector<std::vector<Hit>> hits;        ///< per chunk
     std::vector<std::vector<int64_t>> ray_of;  ///< per chunk, the ray of each hit
-    std::vector<size_t> offset;               ///< per chunk, its first hit in the result; then the total
+    std::vector<size_t> offset;                ///< per chunk, its first hit in the result; then the total
 
     size_t total() const { return offset.empty() ? 0 : offset.back(); }
     /// Fills the flat result arrays (total() entries, uv 2 per entry).

@@ -139,12 +139,14 @@ all OpenMP threads with the GIL released.)doc")
         .def_static("from_file", &mesh_from_file, py::arg("path"),
                     "A caster over every mesh of an OBJ or glTF file, merged; triangle ids count in the "
                     "order the loader reads them (the `triangles` property lists them).")
-        .def("cast_rays", &cast_rays, py::arg("rays"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(),
+        .def("cast_rays", &cast_rays, py::arg("rays"), py::arg("tmin") = py::none(),
+             py::arg("tmax") = py::none(),
              "Nearest hits: a dict of t_hit (float32, inf on a miss), primitive_ids (int64, -1 on a miss), "
              "primitive_uvs (float32 (..., 2): barycentric weights of the triangle's 2nd and 3rd vertex) and "
              "normals (float32 (..., 3): the unit geometric normal, counter-clockwise front, not flipped "
              "towards the ray; 0 on a miss).")
-        .def("occluded", &occluded, py::arg("rays"), py::arg("tmin") = py::none(), py::arg("tmax") = py::none(),
+        .def("occluded", &occluded, py::arg("rays"), py::arg("tmin") = py::none(),
+             py::arg("tmax") = py::none(),
              "Whether anything lies on each ray with tmin < t < tmax (bool array).")
         .def("intersect_all", &intersect_all, py::arg("rays"), py::arg("tmin") = py::none(),
              py::arg("tmax") = py::none(),

@@ -57,8 +57,8 @@ class AlphaFilter {
     /// One cut-out material: constant alpha times the optional texture's alpha.
     struct Cutout {
         float alpha = 1.0f;
-        float cutoff = -1.0f;  ///< < 0: stochastic
-        int texture = -1;      ///< into textures_
+        float cutoff = -1.0f;       ///< < 0: stochastic
+        int texture = -1;           ///< into textures_
         bool single_sided = false;  ///< back faces are invisible
     };
     /// One cut-out triangle: its vertex UVs and its material.

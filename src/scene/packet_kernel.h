@@ -73,7 +73,9 @@ template <int kIsa>
 }
 
 template <int kIsa>
-[[gnu::always_inline]] inline F splat(float x) { return F{} + x; }
+[[gnu::always_inline]] inline F splat(float x) {
+    return F{} + x;
+}
 
 /// Lane-wise c ? a : b as bit operations (GCC lowers a vector `?:` wider than
 /// the registers lane by lane; the bit form stays in registers).
@@ -282,7 +284,8 @@ struct PacketEntry {
 
 /// The rays that enter the root's box.
 template <int kIsa, int N>
-[[gnu::always_inline]] inline uint32_t root_mask(const State& s, const PacketContext& c, const BvhWide<N>& bvh) {
+[[gnu::always_inline]] inline uint32_t root_mask(const State& s, const PacketContext& c,
+                                                 const BvhWide<N>& bvh) {
     float near[3], far[3];
     for (int a = 0; a < 3; ++a) {
         near[a] = bvh.root.bounds[2 * a + c.neg[a]];

@@ -24,10 +24,10 @@ struct SurfaceInteraction {
     Vec3 ng;  ///< geometric normal, unit, facing against the incoming ray
     Vec3 ns;  ///< shading normal, unit, same hemisphere as ng
     Vec2 uv;
-    Vec2 uv1;                      ///< the second UV set (glTF TEXCOORD_1), or zero
-    Rgb color{1.0f, 1.0f, 1.0f};   ///< interpolated vertex colour (glTF COLOR_0), white without
+    Vec2 uv1;                        ///< the second UV set (glTF TEXCOORD_1), or zero
+    Rgb color{1.0f, 1.0f, 1.0f};     ///< interpolated vertex colour (glTF COLOR_0), white without
     Vec3 tangent{0.0f, 0.0f, 0.0f};  ///< interpolated tangent for normal maps; zero: none
-    float tangent_sign = 1;        ///< cross(normal, tangent) * sign points along increasing v
+    float tangent_sign = 1;          ///< cross(normal, tangent) * sign points along increasing v
     uint32_t material = 0;
     bool front_face = true;  ///< the ray hit the outward (front) side
 };
@@ -35,10 +35,10 @@ struct SurfaceInteraction {
 /// All triangles of all meshes, merged; triangle i uses indices[3i..3i+2].
 struct TriangleSoup {
     std::vector<Vec3> positions;
-    std::vector<Vec3> normals;  ///< empty or per position
-    std::vector<Vec2> uvs;      ///< empty or per position
-    std::vector<Vec2> uvs1;     ///< empty or per position (second UV set)
-    std::vector<Rgb> colors;    ///< empty or per position (vertex colours)
+    std::vector<Vec3> normals;                   ///< empty or per position
+    std::vector<Vec2> uvs;                       ///< empty or per position
+    std::vector<Vec2> uvs1;                      ///< empty or per position (second UV set)
+    std::vector<Rgb> colors;                     ///< empty or per position (vertex colours)
     std::vector<std::array<float, 4>> tangents;  ///< empty or per position (xyz, bitangent sign)
     std::vector<uint32_t> indices;
     std::vector<uint32_t> material;  ///< per triangle

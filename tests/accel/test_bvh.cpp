@@ -398,7 +398,8 @@ TEST_CASE("generic traversal of the canonical tree with a caller-supplied leaf t
             for (uint32_t s = first; s < first + count; ++s) {
                 const uint32_t t = bvh.prim_indices[s];
                 const uint32_t* v = &m.indices[3 * size_t(t)];
-                const TriangleVerts tri = TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]);
+                const TriangleVerts tri =
+                    TriangleVerts::of(m.positions[v[0]], m.positions[v[1]], m.positions[v[2]]);
                 if (const std::optional<ShapeHit> h = tri.intersect(tr, r0.tmin, tmax)) {
                     tmax = h->t;
                     best = t;

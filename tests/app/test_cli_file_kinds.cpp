@@ -59,9 +59,10 @@ TEST_CASE("cli: upper-case extensions work in every command") {
         << R"({"format": "scene/1", "camera": {"position": [0, -5, 0], "look_at": [0, 0, 0], "vfov": 40},
               "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]})";
     for (const char* args :
-         {"info MODEL.OBJ", "info Scene.GLB", "info SCENE.JSON", "bvh MODEL.OBJ --size 8", "bvh Scene.GLB --size 8",
-          "bvh SCENE.JSON --size 8", "bench Scene.GLB --size 8 --repeat 1 --no-embree",
-          "bench SCENE.JSON --size 8 --repeat 1", "view Scene.GLB --size 8 --spp 1 -q -o VIEW.PNG",
+         {"info MODEL.OBJ", "info Scene.GLB", "info SCENE.JSON", "bvh MODEL.OBJ --size 8",
+          "bvh Scene.GLB --size 8", "bvh SCENE.JSON --size 8",
+          "bench Scene.GLB --size 8 --repeat 1 --no-embree", "bench SCENE.JSON --size 8 --repeat 1",
+          "view Scene.GLB --size 8 --spp 1 -q -o VIEW.PNG",
           "render SCENE.JSON --size 8 --spp 1 -q -o OUT.EXR",
           "converge SCENE.JSON --size 8 --max-spp 2 --budget 1 -o conv"}) {
         INFO("sahara " << args);
@@ -81,7 +82,8 @@ TEST_CASE("cli: upper-case extensions work in every command") {
     for (const char* cmd : {"render", "converge"}) {
         const KindsRun r = run_in(dir, std::string(cmd) + " MODEL.OBJ --size 8");
         CHECK(r.code == 2);
-        CHECK(r.err.find("MODEL.OBJ: a model, not a scene file (`sahara view MODEL.OBJ`") != std::string::npos);
+        CHECK(r.err.find("MODEL.OBJ: a model, not a scene file (`sahara view MODEL.OBJ`") !=
+              std::string::npos);
     }
     // trace indexes OBJ triangles only, whatever the case of a glTF or scene extension.
     for (const char* file : {"Scene.GLB", "SCENE.JSON"}) {

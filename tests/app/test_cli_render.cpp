@@ -145,8 +145,7 @@ TEST_CASE("cli: a missing image codec exits 2 before rendering and writes nothin
     TempDir dir("nocodec");
     const std::string out = dir / "out.png";
     const std::string cmd = std::string(SAHARA_EXE) + " --image-codec " + (dir / "no-such-codec.so") +
-                            " render" + kSmall + "--spp 1 -o " + out +
-                            " >/dev/null 2>" + (dir / "err.txt");
+                            " render" + kSmall + "--spp 1 -o " + out + " >/dev/null 2>" + (dir / "err.txt");
     const int status = std::system(cmd.c_str());
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 2);

@@ -224,7 +224,8 @@ inline Vec3 random_unit(Pcg32& rng) { return sample_uniform_sphere({rng.next_flo
 
 /// A random instance of `form` of size ~scale, displaced by up to `offset`,
 /// with a random rigid user transform; fills the matching oracle.
-inline Quadric make_instance(QuadricForm form, Pcg32& rng, float scale, float offset, bool capped, Oracle& o) {
+inline Quadric make_instance(QuadricForm form, Pcg32& rng, float scale, float offset, bool capped,
+                             Oracle& o) {
     const Mat4 user = random_rigid(rng, offset);
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) o.rot[i][j] = LD(user.m[size_t(i)][size_t(j)]);

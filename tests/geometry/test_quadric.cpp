@@ -42,7 +42,8 @@ TEST_CASE("quadric: hand-checked cases") {
     SUBCASE("cone, paraboloid (linear case), hyperboloid, ellipsoid, general") {
         const Quadric cone = make_cone({0, 0, 0}, {0, 0, 1}, 45, 1, false);
         CHECK(cone.intersect(make_ray({-2, 0, 0.5f}, {1, 0, 0}))->t == doctest::Approx(1.5f));
-        CHECK_FALSE(cone.intersect(make_ray({-2, 0, -0.5f}, {1, 0, 0})).has_value());  // the other nappe is clipped
+        CHECK_FALSE(
+            cone.intersect(make_ray({-2, 0, -0.5f}, {1, 0, 0})).has_value());  // the other nappe is clipped
         const Quadric para = make_paraboloid({0, 0, 0}, {0, 0, 1}, 1, 1);
         const std::optional<ShapeHit> hp = para.intersect(make_ray({0.5f, 0, 5}, {0, 0, -1}));
         CHECK(hp->t == doctest::Approx(4.75f));

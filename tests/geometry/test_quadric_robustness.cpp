@@ -36,7 +36,8 @@ TEST_CASE("quadric: rays spawned from a hit towards either side never re-hit at 
                     const Vec3 dir =
                         Frame(n).to_world(sample_cosine_hemisphere({rng.next_float(), rng.next_float()}));
                     if (dot(dir, n) < 0.05f) continue;
-                    const std::optional<ShapeHit> again = q.intersect(make_ray(offset_ray_origin(s.p, n), dir));
+                    const std::optional<ShapeHit> again =
+                        q.intersect(make_ray(offset_ray_origin(s.p, n), dir));
                     ++spawned;
                     if (again && again->t < 1e-3f * scale) {
                         if (++rehits <= 5)

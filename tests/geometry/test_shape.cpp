@@ -86,9 +86,10 @@ struct ShapeCase<Plane> {
         using L = long double;
         const L denom = L(pl.normal.x) * ray.dir.x + L(pl.normal.y) * ray.dir.y + L(pl.normal.z) * ray.dir.z;
         if (denom == 0) return std::nullopt;
-        const L t = ((L(pl.point.x) - ray.origin.x) * pl.normal.x + (L(pl.point.y) - ray.origin.y) * pl.normal.y +
-                     (L(pl.point.z) - ray.origin.z) * pl.normal.z) /
-                    denom;
+        const L t =
+            ((L(pl.point.x) - ray.origin.x) * pl.normal.x + (L(pl.point.y) - ray.origin.y) * pl.normal.y +
+             (L(pl.point.z) - ray.origin.z) * pl.normal.z) /
+            denom;
         if (!(t > ray.tmin && t < ray.tmax)) return std::nullopt;
         return Reference{t};
     }
@@ -108,9 +109,11 @@ struct ShapeCase<TriangleVerts> {
             o[k] = ray.origin[k], d[k] = ray.dir[k];
         }
         L e1[3], e2[3], s[3];
-        for (int k = 0; k < 3; ++k) e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k], s[k] = o[k] - p[0][k];
+        for (int k = 0; k < 3; ++k)
+            e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k], s[k] = o[k] - p[0][k];
         auto cross = [](const L* a, const L* b, L* out) {
-            out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
+            out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2],
+            out[2] = a[0] * b[1] - a[1] * b[0];
         };
         auto dot = [](const L* a, const L* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
         L pv[3], qv[3];
@@ -138,7 +141,8 @@ struct ShapeCase<Quadric> {
         const auto& m = q.object_from_world.m;
         L o[3], d[3];
         for (int i = 0; i < 3; ++i) {
-            o[i] = m[i][0] * L(ray.origin.x) + m[i][1] * L(ray.origin.y) + m[i][2] * L(ray.origin.z) + m[i][3];
+            o[i] =
+                m[i][0] * L(ray.origin.x) + m[i][1] * L(ray.origin.y) + m[i][2] * L(ray.origin.z) + m[i][3];
             d[i] = m[i][0] * L(ray.dir.x) + m[i][1] * L(ray.dir.y) + m[i][2] * L(ray.dir.z);
         }
         std::optional<Reference> best;
@@ -175,7 +179,9 @@ Ray random_ray(Pcg32& rng) {
 }
 
 /// Agreement in t relative to the ray length to the hit.
-bool close(long double a, float b) { return std::fabs(double(a) - double(b)) <= 1e-4 * (1 + std::fabs(double(a))); }
+bool close(long double a, float b) {
+    return std::fabs(double(a) - double(b)) <= 1e-4 * (1 + std::fabs(double(a)));
+}
 
 }  // namespace
 
@@ -235,7 +241,7 @@ TEST_CASE_TEMPLATE("shape contract: intersect agrees with brute force and occlud
         }
     }
     INFO("hits " << hits << ", misses " << misses << ", disagreements " << disagree << ", window mismatches "
-                  << window_mismatch);
+                 << window_mismatch);
     CHECK(hits > checked / 20);
     CHECK(misses > checked / 10);
     CHECK(disagree <= checked / 1000);

@@ -29,9 +29,7 @@ TEST_CASE("sphere: the five workshop cases") {
     SUBCASE("ray starts inside: the exit point") {
         CHECK(sphere_t(make_ray({0, 0, 0.5f}, {0, 0, 1}), c, r) == doctest::Approx(0.5));
     }
-    SUBCASE("sphere behind the ray: no hit") {
-        CHECK(sphere_t(make_ray({0, 0, 5}, {0, 0, 1}), c, r) < 0);
-    }
+    SUBCASE("sphere behind the ray: no hit") { CHECK(sphere_t(make_ray({0, 0, 5}, {0, 0, 1}), c, r) < 0); }
     SUBCASE("tangent ray: touches at one point") {
         double t = sphere_t(make_ray({1, 0, -5}, {0, 0, 1}), c, r);
         CHECK(t == doctest::Approx(5.0).epsilon(1e-3));

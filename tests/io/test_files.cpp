@@ -62,7 +62,8 @@ TEST_CASE("file_kind decides by extension whatever its case") {
     CHECK(is_hdr_output("OUT.EXR"));
     CHECK_FALSE(is_hdr_output("OUT.PNG"));
     CHECK_FALSE(is_supported_output("out.jpg"));
-    CHECK_THROWS_WITH_AS(load_model("thing.ply"), doctest::Contains("unknown model format '.ply'"), InputError);
+    CHECK_THROWS_WITH_AS(load_model("thing.ply"), doctest::Contains("unknown model format '.ply'"),
+                         InputError);
 }
 
 TEST_CASE("read_file returns every byte and names the file when it cannot") {

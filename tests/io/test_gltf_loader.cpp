@@ -224,7 +224,8 @@ TEST_CASE("the glTF files in tests/data load with their published counts") {
     for (const Expect& e : expect) check_gltf_loads(kTestData / e.path, e.scene_tris, e.exact_box);
 }
 
-TEST_CASE("a Duck-like glTF (scaled root / camera child / interleaved strides) loads whole / .gltf and .glb") {
+TEST_CASE(
+    "a Duck-like glTF (scaled root / camera child / interleaved strides) loads whole / .gltf and .glb") {
     const auto [gltf, glb] = write_duck_like(scratch("duck_counts"), "duck");
     const size_t tris = make_icosphere(4).triangle_count();
     check_gltf_loads(gltf, tris, true);

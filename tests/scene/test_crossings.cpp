@@ -39,7 +39,8 @@ TEST_CASE("crossings: rays through icosphere vertices and edge midpoints cross o
         CHECK(f.count(p * -2.0f, p * 3.0f) == 2);
     }
     for (size_t t = 0; t < f.mesh.triangle_count(); ++t) {
-        const Vec3 a = f.mesh.positions[f.mesh.indices[3 * t]], b = f.mesh.positions[f.mesh.indices[3 * t + 1]];
+        const Vec3 a = f.mesh.positions[f.mesh.indices[3 * t]],
+                   b = f.mesh.positions[f.mesh.indices[3 * t + 1]];
         const Vec3 mid = (a + b) * 0.5f;
         CHECK(f.count(Vec3(0.0f), mid) == 1);
         CHECK(f.count(mid * 0.25f, mid) == 1);
