@@ -36,7 +36,8 @@ struct EmbreeReference::Impl {
 bool EmbreeReference::available() { return true; }
 
 EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices,
-                                 bool robust, int build_threads, std::string_view max_isa)
+                                 bool robust, int build_threads, std::string_view max_isa,
+                                 EmbreeQuality quality)
     : impl_(std::make_unique<Impl>()) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -56,7 +57,13 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
         impl_.get());
     impl_->scene = rtcNewScene(impl_->device);
     if (robust) rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+    const RTCBuildQuality build_quality = quality == EmbreeQuality::low    ? RTC_BUILD_QUALITY_LOW
+                                          : quality == EmbreeQuality::high ? RTC_BUILD_QUALITY_HIGH
+                                                                           : RTC_BUILD_QUALITY_MEDIUM;
+    rtcSetSceneBuildQuality(impl_->scene, build_quality);
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // The geometry's quality too: Embree picks its builder from both.
+    rtcSetGeometryBuildQuality(geom, build_quality);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), positions.size()));
     for (size_t i = 0; i < positions.size(); ++i) {
@@ -162,7 +169,7 @@ bool EmbreeReference::occluded(const Ray& ray) const {
 struct EmbreeReference::Impl {};
 bool EmbreeReference::available() { return false; }
 EmbreeReference::EmbreeReference(std::span<const Vec3>, std::span<const uint32_t>, bool, int,
-                                 std::string_view) {
+                                 std::string_view, EmbreeQuality) {
     throw std::runtime_error("this sahara was built without Embree");
 }
 EmbreeReference::~EmbreeReference() = default;

@@ -18,6 +18,12 @@ namespace sahara {
 /// name it does not know, so only names its device configuration documents are passed.
 inline constexpr std::string_view kEmbreeIsas[] = {"best", "sse2", "avx", "avx2", "avx512"};
 
+/// Embree's scene build quality (RTC_BUILD_QUALITY_*): low is its fast Morton build, medium
+/// its default binned SAH build, high adds spatial splits (references of one triangle in
+/// several leaves), which pays off on long thin triangles such as walls and floors.
+enum class EmbreeQuality : uint8_t { low, medium, high };
+inline constexpr std::string_view kEmbreeQualityNames[] = {"low", "medium", "high"};
+
 class EmbreeReference {
    public:
     /// Whether this build has Embree.
@@ -28,8 +34,10 @@ class EmbreeReference {
     /// `build_threads` > 0 limits Embree's build threads (0: Embree's default, all cores).
     /// `max_isa` (one of kEmbreeIsas but "best"; empty or "best": Embree's choice, the widest
     /// the CPU has) caps the instruction set of Embree's kernels, its `max_isa` device setting.
+    /// `quality` is the scene's build quality (rtcSetSceneBuildQuality).
     EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices, bool robust = false,
-                    int build_threads = 0, std::string_view max_isa = {});
+                    int build_threads = 0, std::string_view max_isa = {},
+                    EmbreeQuality quality = EmbreeQuality::medium);
     ~EmbreeReference();
     EmbreeReference(const EmbreeReference&) = delete;
     EmbreeReference& operator=(const EmbreeReference&) = delete;

@@ -28,6 +28,7 @@ constexpr const char* kBenchUsage =
     "                         [--json]\n"
     "                         [--builder binned|sweep|reinsert] [--layout L] [--size WxH|N] [--repeat K]\n"
     "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
+    "                         [--embree-quality low|medium|high]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
     "              its triangles, spheres, boxes and quadrics (planes are unbounded: not in the\n"
@@ -40,7 +41,7 @@ constexpr const char* kBenchUsage =
     "              sahara's single rays),\n"
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
-    "              the camera's up axis)\n"
+    "              the camera's up axis, or towards its first directional light, a sun)\n"
     "  --layout L  traversal structure: wide8 (default: 8-wide BVH, leaf triangles tested 4 at a\n"
     "              time, 8 with AVX2) or pairs (binary BVH, the reference); wide8 uses the widest\n"
     "              of AVX-512, AVX2 and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a\n"
@@ -57,6 +58,9 @@ constexpr const char* kBenchUsage =
     "              cap Embree's kernels at sse2, avx, avx2 or avx512 (default best: the widest the\n"
     "              CPU has); with SAHARA_SIMD=avx2 and --embree-isa avx2 an AVX-512 machine\n"
     "              compares both tracers as an AVX2-only machine would\n"
+    "  --embree-quality Q\n"
+    "              Embree's build quality: low (Morton build), medium (default: binned SAH) or\n"
+    "              high (SAH with spatial splits, Embree's best tree for long thin triangles)\n"
     "  --json      print one JSON object\n"
     "Both tracers run with flush-to-zero and denormals-are-zero (Embree's recommendation) on the\n"
     "same rays. Disagreements: hit/miss differ, t differs beyond 1e-4 relative, or a different\n"
@@ -82,6 +86,7 @@ struct BenchOptions {
     bool embree = true;
     bool embree_robust = false;
     std::string embree_isa = "best";
+    EmbreeQuality embree_quality = EmbreeQuality::medium;
     bool json = false;
 };
 
@@ -184,7 +189,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     const std::string embree_status = embree_plan(opt, scene);
     if (embree_status == "compared")
         embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust,
-                                                   opt.threads, opt.embree_isa);
+                                                   opt.threads, opt.embree_isa, opt.embree_quality);
     const BenchRaySets rays =
         make_bench_rays(scene, accel, opt.width, opt.height,
                         input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
@@ -197,6 +202,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"embree", embree_status},
         {"embree_mode", opt.embree_robust ? "robust" : "default"},
         {"embree_isa", opt.embree_isa},
+        {"embree_quality", kEmbreeQualityNames[size_t(opt.embree_quality)]},
         {"threads", opt.threads},
         {"builder", bvh_builder_name(opt.builder)},
         {"layout", bvh_layout_name(opt.layout)},
@@ -244,11 +250,12 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str(),
                 j["node_pairing"].get<bool>() ? ", node pairing" : "");
     if (j.contains("embree_build_ms"))
-        std::printf("\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s mode, %s%s",
-                    j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
-                    j["threads"].get<int>(), j["embree_mode"].get<std::string>().c_str(),
-                    j["embree_isa"] == "best" ? "" : "ISA up to ",
-                    j["embree_isa"].get<std::string>().c_str());
+        std::printf(
+            "\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s quality, %s mode, "
+            "%s%s",
+            j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(), j["threads"].get<int>(),
+            j["embree_quality"].get<std::string>().c_str(), j["embree_mode"].get<std::string>().c_str(),
+            j["embree_isa"] == "best" ? "" : "ISA up to ", j["embree_isa"].get<std::string>().c_str());
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)",
                 j["tree_bytes_per_primitive"].get<double>());
     if (j.contains("embree_bvh_bytes_per_primitive"))
@@ -357,6 +364,12 @@ void add_bench_options(CLI::App& app, BenchOptions& opt, bool& small_scenes) {
         if (std::find(std::begin(kEmbreeIsas), std::end(kEmbreeIsas), v) == std::end(kEmbreeIsas))
             throw UsageError("--embree-isa: expected best|sse2|avx|avx2|avx512, got '" + v + "'");
         opt.embree_isa = v;
+    });
+    app.add_option_function<std::string>("--embree-quality", [&opt](const std::string& v) {
+        const auto* q = std::find(std::begin(kEmbreeQualityNames), std::end(kEmbreeQualityNames), v);
+        if (q == std::end(kEmbreeQualityNames))
+            throw UsageError("--embree-quality: expected low|medium|high, got '" + v + "'");
+        opt.embree_quality = EmbreeQuality(q - std::begin(kEmbreeQualityNames));
     });
     app.add_flag("--json", opt.json);
     app.add_flag_callback("--no-embree", [&opt] { opt.embree = false; });

@@ -97,6 +97,15 @@ std::pair<int, float> up_axis(const Scene& scene, int width, int height, BenchAi
     return {axis, up[axis] < 0.0f ? -1.0f : 1.0f};
 }
 
+/// The scene's first directional light, or null. Shadow rays head for it instead of the
+/// square light: an interior's sun shines through the openings, and a light above the roof
+/// would only measure rays stopped by the ceiling.
+const LightDesc* first_sun(const Scene& scene) {
+    for (const LightDesc& l : scene.lights)
+        if (l.type == LightDesc::Type::directional) return &l;
+    return nullptr;
+}
+
 }  // namespace
 
 BenchRaySets make_bench_rays(const Scene& scene, const Accelerator& accel, int width, int height,
@@ -133,6 +142,7 @@ BenchRaySets make_bench_rays(const Scene& scene, const Accelerator& accel, int w
     light_corner[axis] = sign > 0.0f ? b.hi[axis] + 1.5f * radius : b.lo[axis] - 1.5f * radius;
     light_corner[au] = b.center()[au] - 0.5f * radius;
     light_corner[av] = b.center()[av] - 0.5f * radius;
+    const LightDesc* sun = aim == BenchAim::scene_camera ? first_sun(scene) : nullptr;
     sets.diffuse.resize(count);
     sets.shadow.resize(count);
     for (size_t i = 0; i < count; ++i) {
@@ -140,6 +150,10 @@ BenchRaySets make_bench_rays(const Scene& scene, const Accelerator& accel, int w
         IndexRng d(seed, 1, i), s(seed, 2, i);
         const float u1 = d.next(), u2 = d.next();
         sets.diffuse[i] = Ray{sp.p, cosine_direction(sp.n, u1, u2)};
+        if (sun) {
+            sets.shadow[i] = Ray{sp.p, -normalize(sun->direction)};
+            continue;
+        }
         const float l1 = s.next(), l2 = s.next();
         Vec3 target = light_corner;
         target[au] += l1 * radius;

@@ -2,7 +2,7 @@
 /// Fixed, seeded ray sets for `sahara bvh` and `sahara bench`: primary rays
 /// from a camera framing a mesh (or a scene file's own camera), diffuse-bounce
 /// rays from the primary hits and shadow rays from the same points towards a
-/// square light above the geometry.
+/// square light above the geometry (or a scene's sun).
 /// Every ray depends only on the seed and its index (same rays for any thread count).
 #include <cstdint>
 #include <vector>
@@ -24,8 +24,9 @@ enum class BenchAim : uint8_t {
     /// A pinhole camera framing the accelerator's bounds from (0.4, 0.3, 1), y up;
     /// spawn offset 1e-4 of the bounding radius (meshes: one object at one scale).
     frame_bounds,
-    /// scene.camera at width x height (lens centre, shutter open); the light sits
-    /// above the bounds along the camera's up axis; spawn offset by the renderer's
+    /// scene.camera at width x height (lens centre, shutter open); shadow rays go
+    /// towards the scene's first directional light (a sun), unbounded, or without
+    /// one to a light above the bounds along the camera's up axis; spawn offset by the renderer's
     /// rule (geometry/spawn.h, relative to the point's magnitude), since a scene
     /// can mix small objects with a huge ground sphere.
     scene_camera,

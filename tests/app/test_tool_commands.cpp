@@ -222,3 +222,39 @@ TEST_CASE("bench command compares with Embree: default, robust and ISA-capped mo
     CHECK(capped.second.find("\"embree_isa\":\"sse2\"") != std::string::npos);
     CHECK(capped.second.find("\"disagreements\":0") != std::string::npos);
 }
+
+TEST_CASE("bench --embree-quality: accepted names and bad values") {
+    const std::string& mesh = kToolMesh;
+    const TempDir tmp("embree_quality");
+    const CliRun bad = run_sahara("bench " + mesh + " --embree-quality best", tmp);
+    CHECK(bad.code == 2);
+    CHECK(bad.err.find("--embree-quality: expected low|medium|high, got 'best'") != std::string::npos);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-quality", "HIGH"}).first == 2);
+    CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-quality"}).first == 2);
+    // Without Embree the option is still accepted (and reported), the comparison skipped.
+    const auto noembree = run_captured(run_bench_command, {"bench", mesh, "--size", "8", "--repeat", "1",
+                                                           "--embree-quality", "low", "--no-embree", "--json"});
+    REQUIRE(noembree.first == 0);
+    CHECK(noembree.second.find("\"embree_quality\":\"low\"") != std::string::npos);
+}
+
+TEST_CASE("bench against Embree at each build quality: same hits [needs Embree]" *
+          doctest::skip(!EmbreeReference::available())) {
+    for (const char* quality : {"low", "medium", "high"}) {
+        CAPTURE(quality);
+        const auto bench = run_captured(run_bench_command, {"bench", kToolMesh, "--size", "32", "--repeat", "1",
+                                                            "--threads", "2", "--embree-quality", quality,
+                                                            "--json"});
+        REQUIRE(bench.first == 0);
+        CHECK(bench.second.find(std::string("\"embree_quality\":\"") + quality + "\"") != std::string::npos);
+        CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
+        // Every set (primary, packets, diffuse, shadow) agrees with sahara.
+        size_t sets = 0;
+        for (size_t at = bench.second.find("\"disagreements\":"); at != std::string::npos;
+             at = bench.second.find("\"disagreements\":", at + 1)) {
+            CHECK(bench.second.compare(at, 18, "\"disagreements\":0,") == 0);
+            ++sets;
+        }
+        CHECK(sets == 4);
+    }
+}
