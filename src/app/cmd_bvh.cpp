@@ -34,9 +34,9 @@ constexpr const char* kBvhUsage =
     "              (see `sahara bench --help`)\n"
     "  --threads N threads for the build (default: all cores)\n"
     "  --size WxH  primary rays W x H, N x N for one number (default 1024, i.e. 1M), as many\n"
-    "              diffuse-bounce rays and as many shadow rays (occlusion, to a light above; the sets\n"
-    "              of `sahara bench`); a mesh is framed from (0.4, 0.3, 1), a scene is seen through\n"
-    "              its own camera\n"
+    "              diffuse-bounce rays and as many shadow rays (occlusion, to a light above or a\n"
+    "              scene's sun; the sets of `sahara bench`); a mesh is framed from (0.4, 0.3, 1), a\n"
+    "              scene is seen through its own camera\n"
     "  --json      print one JSON object instead of text\n"
     "SAH costs: traversal 1, primitive intersection 1 (relative), normalised to the root's area.\n";
 
