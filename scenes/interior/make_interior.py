@@ -3,6 +3,7 @@
 (made by the sahara project).
 
     python3 scenes/interior/make_interior.py    # rewrites the files next to this script
+    build/sahara render scenes/interior.json --size 480x300 --spp 256 -o scenes/images/interior.png
 
 A furnished room of the kind architectural models hold, made to be seen from
 inside: walls with three windows, a tall window and a door (open, the leaf
