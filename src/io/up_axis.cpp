@@ -94,10 +94,10 @@ float ground_coverage(const LoadedModel& model, const Bounds3& box, int axis) {
 
 std::string percent(float share) { return std::to_string(int(std::lround(std::min(share, 9.99f) * 100))) + "%"; }
 
-/// Rule 2: a ground or floor at the bottom of y or z, clearly more than at the
+/// Rule 3: a ground or floor at the bottom of y or z, clearly more than at the
 /// bottom of the other (a box-like model has flat sides too).
 std::optional<UpAxisChoice> ground_rule(const LoadedModel& model, const Bounds3& box) {
-    constexpr float kGround = 0.25f, kMargin = 1.5f;
+    constexpr float kGround = 0.25f, kMargin = 1.25f;
     const float cover_y = ground_coverage(model, box, 1), cover_z = ground_coverage(model, box, 2);
     for (const bool z : {false, true}) {
         const float mine = z ? cover_z : cover_y, other = z ? cover_y : cover_z;
@@ -122,14 +122,14 @@ UpAxisChoice guess_obj_up_axis(const LoadedModel& model, std::string_view header
     const Bounds3 box = model_bounds(model);
     if (box.empty()) return {UpAxis::y, "+y is the usual OBJ convention"};
     const Vec3 e = box.extent();
-    if (auto c = ground_rule(model, box)) return *c;
-    // Rule 3: modellers put the ground at 0, so a model whose lowest point is
+    // Rule 2: modellers put the ground at 0, so a model whose lowest point is
     // at y = 0 or z = 0 (but not both) stands on that plane.
     const float size = std::max({e.x, e.y, e.z});
     const bool on_y = std::abs(box.lo.y) <= 0.005f * size, on_z = std::abs(box.lo.z) <= 0.005f * size;
     if (on_y != on_z)
         return {on_z ? UpAxis::z : UpAxis::y,
                 std::string("the model stands on the plane ") + (on_z ? "z" : "y") + " = 0"};
+    if (auto c = ground_rule(model, box)) return *c;  // rule 3
     // Rule 4: a flat model (terrain, a site, a scan of a surface) lies across
     // its thin axis. A figure with spread arms is about 0.3 as deep as it is
     // wide, so the bar is below that.
@@ -141,7 +141,7 @@ UpAxisChoice guess_obj_up_axis(const LoadedModel& model, std::string_view header
                                                           (axis == 2 ? "z" : "y") + " (" +
                                                           percent(thin / others) + " of its width)"};
     }
-    return {UpAxis::y, "no exporter named, no ground, not standing on 0 and not flat: +y, the usual OBJ "
+    return {UpAxis::y, "no exporter named, not standing on 0, no ground, not flat: +y, the usual OBJ "
                        "convention"};
 }
 

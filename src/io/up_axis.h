@@ -1,8 +1,9 @@
 #pragma once
 /// Which way is up in a downloaded model. glTF says (+y, by the spec); an OBJ
 /// does not, so `sahara view` applies the documented rule of docs/view.md:
-/// the exporter named in the file's header comment, else a ground or floor at
-/// the bottom, else a flat model's thin axis, else +y.
+/// the exporter named in the file's header comment, else the zero plane the
+/// model stands on, else a ground or floor at its bottom, else a flat model's
+/// thin axis, else +y.
 #include <cstdint>
 #include <filesystem>
 #include <optional>

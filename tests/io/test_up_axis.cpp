@@ -83,8 +83,9 @@ ObjText z_up_figure(float feet) {
     return o;
 }
 
-/// A house from a Z-up tool: a 12 x 10 floor slab, walls flush with it, a
-/// pitched roof; 5 tall, so not flat. It sits at z = 2 (not on a zero plane).
+/// A house from a Z-up tool: a 12 x 10 floor slab, walls flush with it, a door
+/// frame standing out of the front, a pitched roof; 5 tall, so not flat. It
+/// sits at z = 2 (not on a zero plane).
 ObjText z_up_house() {
     ObjText o;
     o.box({-6, -5, 0}, {6, 5, 0.3f});
@@ -92,6 +93,7 @@ ObjText z_up_house() {
     o.box({-6, 4.8f, 0.3f}, {6, 5, 3});
     o.box({-6, -4.8f, 0.3f}, {-5.8f, 4.8f, 3});
     o.box({5.8f, -4.8f, 0.3f}, {6, 4.8f, 3});
+    o.box({-1, -5.1f, 0.3f}, {1, -4.7f, 2.2f});
     o.polygon({{-6, -5, 3}, {6, -5, 3}, {6, 0, 5}, {-6, 0, 5}});
     o.polygon({{6, 5, 3}, {-6, 5, 3}, {-6, 0, 5}, {6, 0, 5}});
     o.map([](Vec3 p) { return p + Vec3(0, 0, 2); });
