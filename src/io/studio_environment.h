@@ -13,7 +13,8 @@ namespace sahara {
 /// gradient with panel seams near the horizon, a darker floor, a large key
 /// softbox front-left of `toward_viewer` and a strip light behind on the right.
 /// `toward_viewer` is any direction not parallel to `up`.
-std::shared_ptr<const Image> make_studio_environment(const Vec3& up, const Vec3& toward_viewer, int width = 512);
+std::shared_ptr<const Image> make_studio_environment(const Vec3& up, const Vec3& toward_viewer,
+                                                     int width = 512);
 
 /// A background that shows `image` (lat-long around `up`) and lights the scene with it.
 BackgroundDesc envmap_background(std::shared_ptr<const Image> image, const Vec3& up, float strength,

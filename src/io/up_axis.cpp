@@ -12,12 +12,18 @@ namespace sahara {
 
 Vec3 up_vector(UpAxis a) {
     switch (a) {
-        case UpAxis::x: return {1, 0, 0};
-        case UpAxis::y: return {0, 1, 0};
-        case UpAxis::z: return {0, 0, 1};
-        case UpAxis::neg_x: return {-1, 0, 0};
-        case UpAxis::neg_y: return {0, -1, 0};
-        case UpAxis::neg_z: return {0, 0, -1};
+        case UpAxis::x:
+            return {1, 0, 0};
+        case UpAxis::y:
+            return {0, 1, 0};
+        case UpAxis::z:
+            return {0, 0, 1};
+        case UpAxis::neg_x:
+            return {-1, 0, 0};
+        case UpAxis::neg_y:
+            return {0, -1, 0};
+        case UpAxis::neg_z:
+            return {0, 0, -1};
     }
     return {0, 1, 0};
 }
@@ -49,11 +55,11 @@ struct ExporterAxis {
     UpAxis up;
 };
 constexpr std::array<ExporterAxis, 5> kExporters = {{
-    {"blender", UpAxis::y},     // exporter default: forward -Z, up Y
-    {"milkshape", UpAxis::y},   // a Y-up modeller, written as is
-    {"cinema 4d", UpAxis::y},   // a Y-up modeller
-    {"rhino", UpAxis::z},       // Z-up; "Map Rhino Z to OBJ Y" is off unless chosen
-    {"freecad", UpAxis::z},     // Z-up CAD, written as is
+    {"blender", UpAxis::y},    // exporter default: forward -Z, up Y
+    {"milkshape", UpAxis::y},  // a Y-up modeller, written as is
+    {"cinema 4d", UpAxis::y},  // a Y-up modeller
+    {"rhino", UpAxis::z},      // Z-up; "Map Rhino Z to OBJ Y" is off unless chosen
+    {"freecad", UpAxis::z},    // Z-up CAD, written as is
 }};
 
 std::string lowercase(std::string_view s) {
@@ -92,7 +98,9 @@ float ground_coverage(const LoadedModel& model, const Bounds3& box, int axis) {
     return footprint > 0 ? float(area / double(footprint)) : 0.0f;
 }
 
-std::string percent(float share) { return std::to_string(int(std::lround(std::min(share, 9.99f) * 100))) + "%"; }
+std::string percent(float share) {
+    return std::to_string(int(std::lround(std::min(share, 9.99f) * 100))) + "%";
+}
 
 /// Rule 3: a ground or floor at the bottom of y or z, clearly more than at the
 /// bottom of the other (a box-like model has flat sides too).
@@ -138,11 +146,12 @@ UpAxisChoice guess_obj_up_axis(const LoadedModel& model, std::string_view header
         const float thin = e[axis], others = std::min(e[(axis + 1) % 3], e[(axis + 2) % 3]);
         if (thin < kFlat * others)
             return {axis == 2 ? UpAxis::z : UpAxis::y, std::string("the model is flat across ") +
-                                                          (axis == 2 ? "z" : "y") + " (" +
-                                                          percent(thin / others) + " of its width)"};
+                                                           (axis == 2 ? "z" : "y") + " (" +
+                                                           percent(thin / others) + " of its width)"};
     }
-    return {UpAxis::y, "no exporter named, not standing on 0, no ground, not flat: +y, the usual OBJ "
-                       "convention"};
+    return {UpAxis::y,
+            "no exporter named, not standing on 0, no ground, not flat: +y, the usual OBJ "
+            "convention"};
 }
 
 std::string obj_header_comments(const std::filesystem::path& file) {

@@ -24,12 +24,17 @@ Bounds3 model_bounds(const LoadedModel& model) {
 /// up (the front view of Z-up tools); the negative axes turn both around.
 Vec3 toward_viewer(UpAxis up) {
     switch (up) {
-        case UpAxis::y: return {0, 0, 1};
-        case UpAxis::neg_y: return {0, 0, -1};
-        case UpAxis::z: return {0, -1, 0};
-        case UpAxis::neg_z: return {0, 1, 0};
+        case UpAxis::y:
+            return {0, 0, 1};
+        case UpAxis::neg_y:
+            return {0, 0, -1};
+        case UpAxis::z:
+            return {0, -1, 0};
+        case UpAxis::neg_z:
+            return {0, 1, 0};
         case UpAxis::x:
-        case UpAxis::neg_x: return {0, 0, 1};
+        case UpAxis::neg_x:
+            return {0, 0, 1};
     }
     return {0, 0, 1};
 }
@@ -98,7 +103,8 @@ BackgroundDesc view_background(const ViewOptions& options, UpAxis up) {
     if (!options.env_file)
         return envmap_background(make_studio_environment(u, toward_viewer(up)), u, options.env_strength,
                                  "(built-in studio)");
-    return envmap_background(read_image(*options.env_file, false), u, options.env_strength, *options.env_file);
+    return envmap_background(read_image(*options.env_file, false), u, options.env_strength,
+                             *options.env_file);
 }
 
 }  // namespace

@@ -30,7 +30,8 @@ std::vector<double> top_row_mean(const std::string& file) {
     const auto img = read_image(file, false);
     std::vector<double> mean(3, 0.0);
     for (int x = 0; x < img->width; ++x)
-        for (int c = 0; c < 3; ++c) mean[size_t(c)] += double(img->rgba[size_t(x) * 4 + size_t(c)]) / img->width;
+        for (int c = 0; c < 3; ++c)
+            mean[size_t(c)] += double(img->rgba[size_t(x) * 4 + size_t(c)]) / img->width;
     return mean;
 }
 

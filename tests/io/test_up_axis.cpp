@@ -34,7 +34,9 @@ struct ObjText {
         faces.push_back(f);
     }
     void box(Vec3 lo, Vec3 hi) {
-        const auto p = [&](int i) { return Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z); };
+        const auto p = [&](int i) {
+            return Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+        };
         polygon({p(0), p(2), p(3), p(1)});  // -z
         polygon({p(4), p(5), p(7), p(6)});  // +z
         polygon({p(0), p(1), p(5), p(4)});  // -y
@@ -66,11 +68,11 @@ struct ObjText {
 /// deep (as flat as a T-pose gets), its feet at y = -1.2 (not on a zero plane).
 ObjText y_up_figure() {
     ObjText o;
-    o.box({-0.3f, 1.0f, -0.3f}, {0.3f, 2.0f, 0.3f});         // torso
-    o.box({-0.15f, 2.0f, -0.15f}, {0.15f, 2.35f, 0.15f});    // head
-    o.box({-0.25f, 0.0f, -0.15f}, {-0.05f, 1.0f, 0.15f});    // legs
+    o.box({-0.3f, 1.0f, -0.3f}, {0.3f, 2.0f, 0.3f});       // torso
+    o.box({-0.15f, 2.0f, -0.15f}, {0.15f, 2.35f, 0.15f});  // head
+    o.box({-0.25f, 0.0f, -0.15f}, {-0.05f, 1.0f, 0.15f});  // legs
     o.box({0.05f, 0.0f, -0.15f}, {0.25f, 1.0f, 0.15f});
-    o.box({-1.0f, 1.75f, -0.1f}, {-0.3f, 1.95f, 0.1f});      // arms
+    o.box({-1.0f, 1.75f, -0.1f}, {-0.3f, 1.95f, 0.1f});  // arms
     o.box({0.3f, 1.75f, -0.1f}, {1.0f, 1.95f, 0.1f});
     o.map([](Vec3 p) { return p - Vec3(0, 1.2f, 0); });
     return o;
@@ -113,7 +115,9 @@ ObjText z_up_terrain() {
     return o;
 }
 
-UpAxisChoice guess(const fs::path& file) { return guess_obj_up_axis(load_obj(file), obj_header_comments(file)); }
+UpAxisChoice guess(const fs::path& file) {
+    return guess_obj_up_axis(load_obj(file), obj_header_comments(file));
+}
 
 }  // namespace
 
