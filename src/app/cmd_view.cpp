@@ -16,15 +16,19 @@ namespace sahara {
 namespace {
 
 const char* const kViewUsage =
-    "usage: sahara view MODEL [-o OUT.png] [--spp N] [--size WxH] [--up y|z] [--gltf-camera N] [render "
+    "usage: sahara view MODEL [-o OUT.png] [--spp N] [--size WxH] [--up AXIS] [--env FILE.exr] [render "
     "options]\n"
     "\n"
     "Renders a downloaded model (.obj with its .mtl, .gltf, .glb) with no scene file: a camera\n"
-    "framing it from a three-quarter view, a ground plane under it, the sky and a sun.\n"
+    "framing it from a three-quarter view, a ground plane under it, a studio environment and a sun.\n"
     "\n"
     "  -o, --output FILE   output image (default view.png)\n"
     "  --size WxH          image size (default 800x600; N: N x N)\n"
-    "  --up y|z            the model's up axis (default: y for glTF, guessed for OBJ)\n"
+    "  --up AXIS           the model's up axis: x, y, z, -x, -y or -z (default: +y for glTF;\n"
+    "                      for OBJ the rule of docs/view.md, said on stderr)\n"
+    "  --env FILE          light with this lat-long environment image (.exr, .hdr, ...)\n"
+    "                      instead of the built-in studio\n"
+    "  --env-strength S    multiplies the environment's radiance (default 1)\n"
     "  --gltf-camera N     look through the model's glTF camera N instead\n"
     "  --no-ground         no ground plane\n"
     "  every `sahara render` option (--spp, --threads, --preview, --integrator, ...) works too\n";
@@ -40,8 +44,12 @@ ViewArgs parse_view_args(const std::vector<std::string>& args) {
     v.render.auto_exposure = true;
     parse_render_args(args, v.render, [&v](CLI::App& app) {
         app.add_option_function<std::string>("--up", [&v](const std::string& s) {
-            if (s != "y" && s != "z") throw UsageError("--up: expected y or z, got '" + s + "'");
-            v.view.up = s == "y" ? UpAxis::y : UpAxis::z;
+            v.view.up = parse_up_axis(s);
+            if (!v.view.up) throw UsageError("--up: expected x, y, z, -x, -y or -z, got '" + s + "'");
+        });
+        app.add_option_function<std::string>("--env", [&v](const std::string& s) { v.view.env_file = s; });
+        app.add_option_function<std::string>("--env-strength", [&v](const std::string& s) {
+            v.view.env_strength = float(parse_real_value("--env-strength", s, 0.0, 1e6));
         });
         app.add_option_function<std::string>("--gltf-camera", [&v](const std::string& s) {
             v.view.gltf_camera = int(parse_int_value("--gltf-camera", s, 0, 1 << 20));

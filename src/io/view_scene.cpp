@@ -5,7 +5,9 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "math/bounds.h"
+#include "io/image_io.h"
 #include "io/scene_parser.h"
+#include "io/studio_environment.h"
 
 namespace sahara {
 
@@ -18,15 +20,30 @@ Bounds3 model_bounds(const LoadedModel& model) {
     return b;
 }
 
-Vec3 axis_vector(UpAxis a) { return a == UpAxis::y ? Vec3(0, 1, 0) : Vec3(0, 0, 1); }
+/// The model's front, towards the viewer: +z for y up (glTF's front), -y for z
+/// up (the front view of Z-up tools); the negative axes turn both around.
+Vec3 toward_viewer(UpAxis up) {
+    switch (up) {
+        case UpAxis::y:
+            return {0, 0, 1};
+        case UpAxis::neg_y:
+            return {0, 0, -1};
+        case UpAxis::z:
+            return {0, -1, 0};
+        case UpAxis::neg_z:
+            return {0, 1, 0};
+        case UpAxis::x:
+        case UpAxis::neg_x:
+            return {0, 0, 1};
+    }
+    return {0, 0, 1};
+}
 
 /// Camera looking at the box from the front-right and above, far enough that
 /// the bounding sphere fits the vertical field of view.
 CameraDesc frame_box(const Bounds3& box, UpAxis up_axis, float vfov, float aspect) {
-    const Vec3 up = axis_vector(up_axis);
-    // Horizontal axes: for y up, x right and +z towards the viewer (glTF's front);
-    // for z up, x right and -y towards the viewer.
-    const Vec3 right(1, 0, 0), toward = up_axis == UpAxis::y ? Vec3(0, 0, 1) : Vec3(0, -1, 0);
+    const Vec3 up = up_vector(up_axis), toward = toward_viewer(up_axis);
+    const Vec3 right = cross(up, toward);
     const Vec3 from_dir = normalize(right * 0.75f + toward * 1.0f + up * 0.55f);
     const float radius = 0.5f * length(box.extent());
     const float half = 0.5f * vfov * 3.14159265f / 180.0f;
@@ -40,31 +57,15 @@ CameraDesc frame_box(const Bounds3& box, UpAxis up_axis, float vfov, float aspec
     return cam;
 }
 
-}  // namespace
-
-UpAxis guess_up_axis(const LoadedModel& model, std::string& reason) {
-    const Vec3 e = model_bounds(model).extent();
-    // Models are usually Y-up; a model much taller along z than along y, with
-    // y its thinnest axis, is almost surely Z-up (a standing figure or building).
-    if (e.z > 1.5f * e.y && e.y <= e.x) {
-        reason = "the model is elongated along z";
-        return UpAxis::z;
-    }
-    reason = "most OBJ files are y-up";
-    return UpAxis::y;
-}
-
-namespace {
-
-/// The up axis: the user's, a glTF's (+y by the spec), or guessed for an OBJ.
-UpAxis choose_up_axis(const LoadedModel& model, bool is_gltf, const ViewOptions& options) {
+/// The up axis: the user's, a glTF's (+y by the spec), or the OBJ rule's; said on stderr.
+UpAxis choose_up_axis(const LoadedModel& model, bool is_gltf, const ViewOptions& options,
+                      const std::string& source) {
     if (options.up) return *options.up;
-    if (is_gltf) return UpAxis::y;
-    std::string reason;
-    const UpAxis up = guess_up_axis(model, reason);
-    log_info(std::string("up axis guessed as ") + (up == UpAxis::y ? "y" : "z") + " (" + reason +
-             "); use --up y|z to change it");
-    return up;
+    const UpAxisChoice c = is_gltf ? UpAxisChoice{UpAxis::y, "glTF is +y up by its specification"}
+                                   : guess_obj_up_axis(model, obj_header_comments(source));
+    log_info(std::string("up axis ") + up_axis_name(c.axis) + ": " + c.reason +
+             " (--up x|y|z|-x|-y|-z overrides it)");
+    return c.axis;
 }
 
 /// A checkered ground plane touching the lowest point of the model along `up`.
@@ -77,23 +78,33 @@ void add_ground(SceneDesc& scene, const Bounds3& box, UpAxis up) {
     ground.albedo.odd = {0.55f, 0.55f, 0.55f};
     ground.albedo.checker_scale = std::max(radius * 0.25f, 1e-6f);
     scene.materials.push_back(ground);
-    const float lowest = up == UpAxis::y ? box.lo.y : box.lo.z;
+    const Vec3 n = up_vector(up);
     PlaneDesc plane;
-    plane.point = box.center();
-    (up == UpAxis::y ? plane.point.y : plane.point.z) = lowest;
-    plane.normal = axis_vector(up);
+    plane.point = box.center() - n * (0.5f * std::abs(dot(box.extent(), n)));
+    plane.normal = n;
     plane.material = uint32_t(scene.materials.size() - 1);
     scene.planes.push_back(plane);
 }
 
-/// A warm sun from above, slightly to the side and front.
+/// A warm sun from above, slightly to the side and front: crisp contact shadows
+/// beside the environment's soft light.
 void add_sun(SceneDesc& scene, UpAxis up) {
+    const Vec3 u = up_vector(up), toward = toward_viewer(up);
     LightDesc sun;
     sun.type = LightDesc::Type::directional;
-    sun.direction = -normalize(axis_vector(up) * 1.0f + Vec3(0.4f, 0, 0) +
-                               (up == UpAxis::y ? Vec3(0, 0, 0.3f) : Vec3(0, -0.3f, 0)));
+    sun.direction = -normalize(u * 1.0f + cross(u, toward) * 0.4f + toward * 0.3f);
     sun.irradiance = {2.0f, 1.9f, 1.7f};
     scene.lights.push_back(sun);
+}
+
+/// The user's environment image, or the built-in studio.
+BackgroundDesc view_background(const ViewOptions& options, UpAxis up) {
+    const Vec3 u = up_vector(up);
+    if (!options.env_file)
+        return envmap_background(make_studio_environment(u, toward_viewer(up)), u, options.env_strength,
+                                 "(built-in studio)");
+    return envmap_background(read_image(*options.env_file, false), u, options.env_strength,
+                             *options.env_file);
 }
 
 }  // namespace
@@ -108,7 +119,8 @@ SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& op
     scene.render.height = 600;
     scene.render.spp = 64;
 
-    const UpAxis up = choose_up_axis(model, is_gltf, options);
+    const UpAxis up = choose_up_axis(model, is_gltf, options, source);
+    scene.background = view_background(options, up);
     const Bounds3 box = model_bounds(model);
     std::vector<CameraDesc> cameras = model.cameras;
     merge_loaded_model(scene, std::move(model), std::nullopt);
@@ -122,8 +134,6 @@ SceneDesc make_view_scene(LoadedModel model, bool is_gltf, const ViewOptions& op
     } else {
         scene.camera = frame_box(box, up, 35.0f, aspect);
     }
-    scene.background.type = BackgroundDesc::Type::gradient;
-    scene.background.up = axis_vector(up);
     if (options.ground) add_ground(scene, box, up);
     if (options.sun) add_sun(scene, up);
     return scene;

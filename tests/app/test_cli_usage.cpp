@@ -53,7 +53,7 @@ TEST_CASE("cli usage: missing and malformed values are one line too") {
     check_one_line_usage_error("render --spp lots", "render", "'lots'");
     check_one_line_usage_error("render a.json b.json", "render", "more than one scene");
     check_one_line_usage_error("view", "view", "no MODEL given");
-    check_one_line_usage_error("view m.obj --up x", "view", "--up");
+    check_one_line_usage_error("view m.obj --up w", "view", "--up");
     check_one_line_usage_error("info a.json b.json", "info", "more than one input");
     check_one_line_usage_error("converge --budget", "converge", "--budget: missing value");
     check_one_line_usage_error("bvh", "bvh", "expected one mesh or scene file");
