@@ -173,6 +173,8 @@ std::string embree_plan(const BenchOptions& opt, const Scene& scene) {
                " (Embree reference holds triangles only)";
     if (scene.accelerator() && scene.accelerator()->has_cutouts())
         return "skipped: scene has cut-out triangles (the Embree reference has no alpha test)";
+    if (scene.accelerator() && scene.accelerator()->one_sided_count())
+        return "skipped: scene has one-sided triangles (the Embree reference culls no back faces)";
     return "compared";
 }
 

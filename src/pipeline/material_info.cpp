@@ -88,6 +88,9 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     if (transmits)
         parts.push_back("transmission " + number_text(m.transmission) +
                         (m.thin_walled ? " (thin-walled)" : ", ior " + number_text(m.ior)));
+    value["volume_attenuation"] = transmits && !m.thin_walled && attenuates(m);
+    if (value["volume_attenuation"] == true)
+        parts.push_back("volume attenuation over " + number_text(m.attenuation_distance));
     const std::string alpha = alpha_mode(m);
     value["alpha_mode"] = alpha;
     if (m.alpha_cutoff) value["alpha_cutoff"] = *m.alpha_cutoff;
@@ -126,8 +129,6 @@ void describe_materials(StatsReport& s, const SceneDesc& d) {
         label.append(std::to_string(i)).append("] ").append(m.name);
         describe_material(s, label, m);
         std::vector<std::string> ignored = m.ignored;
-        if (m.type == MaterialType::pbr && attenuates(m))
-            ignored.push_back("volume attenuation (not rendered yet)");
         if (!ignored.empty()) s.add("Ignored inputs", label, join(ignored, ", "), ignored);
     }
 }

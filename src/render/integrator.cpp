@@ -1,5 +1,9 @@
 #include "render/integrator.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 #include "geometry/spawn.h"
 #include "math/sampling.h"
 #include "render/background.h"
@@ -108,6 +112,23 @@ Rgb hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const Surfa
     return eval_color(mat.radiance, scene.textures, si.p, si.uv) * w;
 }
 
+/// Emission of a glowing pbr surface. Its front is a sampled area light (MIS-weighted
+/// as in hit_emission); its back (a double-sided material glows on both sides) is
+/// never light-sampled, so BSDF sampling counts it in full.
+template <Strategy S>
+Rgb pbr_hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const SurfaceInteraction& si,
+                     const MaterialDesc& mat, const PrevVertex& prev) {
+    const Rgb le = pbr_emission(mat, si, scene.textures);
+    if constexpr (S == Strategy::mis || S == Strategy::light_only) {
+        if (si.front_face && !prev.delta && max_component(le) > 0) {
+            const uint32_t e = emitter_of_hit(scene, hit);
+            if (e != kNoEmitter)
+                return le * hit_weight<S>(prev.pdf, area_light_pdf(scene, e, prev.p, si.p, si.ng, ray.time));
+        }
+    }
+    return le;
+}
+
 /// The background seen by a path that leaves the scene, MIS-weighted against envmap sampling.
 template <Strategy S>
 Rgb escaped(const Scene& scene, const Ray& ray, const PrevVertex& prev) {
@@ -118,6 +139,35 @@ Rgb escaped(const Scene& scene, const Ray& ray, const PrevVertex& prev) {
     return eval_background(scene.background, ray.dir) * w;
 }
 
+/// The medium a path travels in: a pbr volume's Beer-Lambert absorption
+/// (KHR_materials_volume), or none. Entered by refraction into the front of an
+/// attenuating pbr surface, left by any other refraction (nested volumes are not tracked).
+struct Medium {
+    bool absorbs = false;
+    Rgb sigma{0.0f};  ///< per unit length: light decays to attenuation_color over attenuation_distance
+
+    /// The medium after a refraction through `m` (from its front when `entering`).
+    static Medium after_refraction(const MaterialDesc& m, bool entering) {
+        Medium out;
+        if (!entering || m.type != MaterialType::pbr || m.thin_walled || !std::isfinite(m.attenuation_distance) ||
+            !(m.attenuation_distance > 0.0f))
+            return out;
+        for (int c = 0; c < 3; ++c) {
+            const float color = std::clamp(m.attenuation_color[c], 0.0f, 1.0f);
+            // Colour 0 absorbs everything: -log(0) = inf, kept finite so that distance 0 gives 1.
+            out.sigma[c] = std::min(-std::log(color) / m.attenuation_distance, std::numeric_limits<float>::max());
+        }
+        out.absorbs = max_component(out.sigma) > 0.0f;
+        return out;
+    }
+    /// Transmittance over `distance` (infinite: the path left an open mesh from inside).
+    Rgb transmittance(float distance) const {
+        Rgb t;
+        for (int c = 0; c < 3; ++c) t[c] = sigma[c] > 0.0f ? std::exp(-sigma[c] * distance) : 1.0f;
+        return t;
+    }
+};
+
 /// One path. D rays at most, camera ray included; a shadow ray counts as the
 /// next ray, so direct light is gathered only below max_depth.
 template <Strategy S, bool kLambertOnly>
@@ -127,6 +177,7 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
     Rgb radiance(0.0f), beta(1.0f);
     float eta_scale = 1;  // undoes the 1/eta^2 of refraction for Russian roulette
     PrevVertex prev;
+    Medium medium;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
         bool found;
@@ -137,6 +188,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         } else {
             found = scene.intersect(ray, hit);
         }
+        if constexpr (!kLambertOnly)
+            if (medium.absorbs) beta *= medium.transmittance(found ? hit.t * length(ray.dir) : kInfinity);
         if (!found) {
             radiance += beta * escaped<S>(scene, ray, prev);
             break;
@@ -150,7 +203,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         if constexpr (kEmission)
             radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if constexpr (!kLambertOnly)
-            if (mat.type == MaterialType::pbr) radiance += beta * pbr_emission(mat, si, scene.textures);
+            if (mat.type == MaterialType::pbr)
+                radiance += beta * pbr_hit_emission<S>(scene, ray, hit, si, mat, prev);
         if (depth == max_depth) break;
 
         const Vec3 wo = -ray.dir;
@@ -165,6 +219,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         if (!sample_shading(bsdf, wo, sampler, bs)) break;
         beta *= bs.weight;
         eta_scale *= bs.eta_scale;
+        if constexpr (!kLambertOnly)
+            if (bs.transmit) medium = Medium::after_refraction(mat, si.front_face);
         prev = PrevVertex{si.p, bs.pdf, bs.delta};
         if (depth >= kRouletteStartDepth) {
             const float survive = std::min(1.0f, max_component(beta) * eta_scale);

@@ -5,6 +5,7 @@
 #include "geometry/spawn.h"
 #include "math/sampling.h"
 #include "render/background.h"
+#include "render/bsdf_pbr.h"
 #include "scene/texture.h"
 
 namespace sahara {
@@ -157,7 +158,8 @@ bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, floa
         const Ray r{p, d, 0.0f, 2.0f, time};
         const SurfaceInteraction si =
             scene.interact(r, Hit{1.0f, make_prim_id(prim_kind_of(e.kind), e.index), bary.x, bary.y});
-        ls.li = eval_color(m.radiance, scene.textures, si.p, si.uv);
+        ls.li = m.type == MaterialType::pbr ? pbr_emission(m, si, scene.textures)
+                                            : eval_color(m.radiance, scene.textures, si.p, si.uv);
     }
     ls.pdf *= pdf_solid;
     ls.delta = false;

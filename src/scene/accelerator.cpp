@@ -125,7 +125,12 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
 }
 
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
-    : spheres_(scene.spheres), boxes_(scene.boxes), quadrics_(scene.quadrics), alpha_(scene) {
+    : spheres_(scene.spheres),
+      boxes_(scene.boxes),
+      quadrics_(scene.quadrics),
+      alpha_(scene),
+      one_sided_(one_sided_triangles(scene)) {
+    one_sided_count_ = size_t(std::count(one_sided_.begin(), one_sided_.end(), uint8_t(1)));
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
     const PrimitiveList prims = collect_primitives(scene);
@@ -234,7 +239,7 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
 
 size_t Accelerator::bytes() const {
     const size_t other = spheres_.size() * sizeof(Sphere) + boxes_.size() * sizeof(Box) +
-                         quadrics_.size() * sizeof(Quadric) + alpha_.bytes();
+                         quadrics_.size() * sizeof(Quadric) + alpha_.bytes() + one_sided_.size();
     // The block layout keeps only the tree, the blocks (vertices and triangle ids) and the
     // ids of other kinds.
     if (layout_has_blocks(layout_))
@@ -362,6 +367,8 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
                                          {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                          {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
                 h = tri.intersect(tr, ray.tmin, tmax);
+                if (h && !one_sided_.empty() && culls(id, ray.dir, tri.vertex(0), tri.vertex(1), tri.vertex(2)))
+                    h.reset();
                 if (h && !alpha_.empty() && !keep_triangle_hit(ray, id, h->u, h->v)) h.reset();
             } else {
                 h = intersect_other(ray, id, tmax);

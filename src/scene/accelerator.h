@@ -8,6 +8,9 @@
 /// Scenes with cut-out triangles (scene/alpha_filter.h) run a second
 /// instantiation of the traversal whose triangle hits pass the alpha test
 /// before they count; the others run the traversal without it.
+/// One-sided triangles (a material with double_sided false) are not cut-outs:
+/// a hit on their back is dropped by a per-triangle flag at hit acceptance, in
+/// every traversal (single rays and packets), so they keep the fast paths.
 #include <algorithm>
 #include <string_view>
 #include <vector>
@@ -146,6 +149,8 @@ class Accelerator {
     bool has_cutouts() const { return !alpha_.empty(); }
     /// The alpha test applied to cut-out triangle hits.
     const AlphaFilter& alpha_filter() const { return alpha_; }
+    /// Triangles whose back faces rays pass through (one-sided materials).
+    size_t one_sided_count() const { return one_sided_count_; }
     /// Bytes of the traversal tree plus the leaf-ordered primitive data it tests.
     size_t bytes() const;
 
@@ -197,6 +202,14 @@ class Accelerator {
         const uint32_t e = alpha_.entry_of(prim_index(id));
         return e == AlphaFilter::kOpaque || alpha_.passes(e, ray, id, u, v);
     }
+    /// Whether triangle `id` is one-sided and `dir` meets its back (counter-clockwise
+    /// is the front; edge-on counts as the back, as a ray grazing it sees no front).
+    bool culls(uint32_t id, const Vec3& dir, const Vec3& a, const Vec3& b, const Vec3& c) const {
+        return one_sided_[prim_index(id)] && dot(cross(b - a, c - a), dir) >= 0.0f;
+    }
+    /// The hit lanes `mask` of blocks b0 (lanes 0-3) and b1 (lanes 4-7) without the
+    /// back faces of one-sided triangles (call only when the scene has any).
+    int cull_block_lanes(const Ray& ray, const TriangleBlock4* b0, const TriangleBlock4* b1, int mask) const;
     /// Of the hit lanes `mask` of the triangle blocks from `first` (lane l: lane
     /// l & 3 of block first + l / 4), the one kept lane (the nearest kept one; for
     /// kAnyHit the first) as a mask, or 0 when every hit is cut out.
@@ -229,6 +242,10 @@ class Accelerator {
     std::vector<Box> boxes_;         ///< copy of Scene::boxes (indexed by box index)
     std::vector<Quadric> quadrics_;  ///< copy of Scene::quadrics (indexed by quadric index)
     AlphaFilter alpha_;              ///< cut-out triangles (empty: traversal without the alpha test)
+    /// Per triangle (prim index): 1 for a one-sided one; empty when the scene has none,
+    /// so the traversals test emptiness once per hit and pay nothing else.
+    std::vector<uint8_t> one_sided_;
+    size_t one_sided_count_ = 0;
     Bounds3 bounds_;
     bool uses_tree_ = false;
     size_t primitive_count_ = 0;

@@ -48,21 +48,35 @@ float cutout_hash(const Ray& ray, uint32_t prim_id) {
 
 bool is_cutout_material(const MaterialDesc& m) { return m.alpha < 1.0f || m.alpha_texture >= 0; }
 
-bool needs_alpha_filter(const MaterialDesc& m) {
-    return is_cutout_material(m) || (m.type == MaterialType::pbr && !m.double_sided);
+std::vector<uint8_t> one_sided_triangles(const Scene& scene) {
+    std::vector<uint8_t> one_sided(scene.materials.size(), 0);
+    bool any = false;
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        one_sided[i] = scene.materials[i].double_sided ? 0 : 1;
+        any |= !scene.materials[i].double_sided;
+    }
+    if (!any) return {};
+    const TriangleSoup& soup = scene.triangles;
+    std::vector<uint8_t> out(soup.size(), 0);
+    bool used = false;
+    for (size_t t = 0; t < soup.size(); ++t) {
+        const uint32_t m = soup.material[t];
+        out[t] = m < one_sided.size() ? one_sided[m] : 0;
+        used |= out[t] != 0;
+    }
+    return used ? out : std::vector<uint8_t>{};
 }
 
 AlphaFilter::AlphaFilter(const Scene& scene) {
-    std::vector<bool> cut(scene.materials.size(), false), holes(scene.materials.size(), false);
+    std::vector<bool> cut(scene.materials.size(), false);
     std::vector<uint32_t> cutout_of(scene.materials.size(), kOpaque);
     bool any = false;
     for (size_t i = 0; i < scene.materials.size(); ++i) {
-        cut[i] = needs_alpha_filter(scene.materials[i]);
-        holes[i] = is_cutout_material(scene.materials[i]);
+        cut[i] = is_cutout_material(scene.materials[i]);
         any |= cut[i];
     }
     if (!any) return;
-    warn_untested_kinds(scene, holes);
+    warn_untested_kinds(scene, cut);
     const TriangleSoup& soup = scene.triangles;
     for (uint32_t t = 0; t < soup.size(); ++t) {
         const uint32_t m = soup.material[t];
@@ -72,7 +86,6 @@ AlphaFilter::AlphaFilter(const Scene& scene) {
             Cutout c;
             c.alpha = md.alpha;
             c.cutoff = md.alpha_cutoff ? *md.alpha_cutoff : -1.0f;
-            c.single_sided = md.type == MaterialType::pbr && !md.double_sided;
             if (md.alpha_texture >= 0 && size_t(md.alpha_texture) < scene.textures.size() &&
                 scene.textures[size_t(md.alpha_texture)].image) {
                 c.texture = int(textures_.size());
@@ -87,9 +100,6 @@ AlphaFilter::AlphaFilter(const Scene& scene) {
         const Vec2 bary[3] = {{0, 0}, {1, 0}, {0, 1}};
         for (int k = 0; k < 3; ++k)
             tri.uv[k] = soup.uvs.empty() ? bary[k] : soup.uvs[soup.indices[3 * size_t(t) + size_t(k)]];
-        const Vec3& p0 = soup.positions[soup.indices[3 * size_t(t)]];
-        tri.normal = cross(soup.positions[soup.indices[3 * size_t(t) + 1]] - p0,
-                           soup.positions[soup.indices[3 * size_t(t) + 2]] - p0);
         tri.cutout = cutout_of[m];
         entry_[t] = uint32_t(triangles_.size());
         triangles_.push_back(tri);
@@ -110,7 +120,6 @@ float AlphaFilter::alpha(uint32_t entry, float u, float v) const {
 
 bool AlphaFilter::passes(uint32_t entry, const Ray& ray, uint32_t prim_id, float u, float v) const {
     const Cutout& c = cutouts_[triangles_[entry].cutout];
-    if (c.single_sided && dot(triangles_[entry].normal, ray.dir) >= 0) return false;  // its back face
     const float cutoff = c.cutoff;
     const float a = alpha(entry, u, v);
     if (cutoff >= 0.0f) return a >= cutoff;

@@ -12,8 +12,9 @@
 /// renders are reproducible and independent of the thread count, and the
 /// closest-hit and shadow queries of one ray agree.
 ///
-/// Materials with `double_sided == false` (glTF) go through the same filter:
-/// a hit on the back of such a triangle never passes, so rays go through.
+/// One-sided materials (`double_sided == false`, glTF) are no cut-outs: the
+/// accelerator drops back-face hits by a per-triangle flag (one_sided_triangles),
+/// which costs the fast traversals nothing when a scene has none.
 ///
 /// Only triangles are filtered (they carry the UVs); other primitives with a
 /// cut-out material stay opaque, with a warning when the filter is built.
@@ -58,13 +59,11 @@ class AlphaFilter {
     struct Cutout {
         float alpha = 1.0f;
         float cutoff = -1.0f;       ///< < 0: stochastic
-        int texture = -1;           ///< into textures_
-        bool single_sided = false;  ///< back faces are invisible
+        int texture = -1;  ///< into textures_
     };
     /// One cut-out triangle: its vertex UVs and its material.
     struct Triangle {
         Vec2 uv[3];
-        Vec3 normal;  ///< unnormalised, counter-clockwise = front (for one-sided materials)
         uint32_t cutout;
     };
     std::vector<uint32_t> entry_;  ///< per scene triangle: index into triangles_, or kOpaque
@@ -75,7 +74,8 @@ class AlphaFilter {
 
 /// Whether a material cuts holes: alpha below 1 or an alpha texture.
 bool is_cutout_material(const MaterialDesc& m);
-/// Whether the filter must see a material's triangles: cut-outs and one-sided pbr.
-bool needs_alpha_filter(const MaterialDesc& m);
+/// Per scene triangle: 1 where its material is one-sided (back faces invisible);
+/// empty when no triangle is.
+std::vector<uint8_t> one_sided_triangles(const Scene& scene);
 
 }  // namespace sahara

@@ -34,6 +34,24 @@ __attribute__((always_inline)) inline int Accelerator::keep_block_lanes(const Ra
     return 0;
 }
 
+/// Vertex v of lane l of block b.
+inline Vec3 block_vertex(const TriangleBlock4& b, int v, int l) {
+    return Vec3(b.p[v][0][l], b.p[v][1][l], b.p[v][2][l]);
+}
+
+__attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ray& ray, const TriangleBlock4* b0,
+                                                                        const TriangleBlock4* b1,
+                                                                        int mask) const {
+    for (int m = mask; m; m &= m - 1) {
+        const int l = __builtin_ctz(unsigned(m));
+        const TriangleBlock4& b = l < 4 ? *b0 : *b1;
+        if (culls(b.slot[l & 3], ray.dir, block_vertex(b, 0, l & 3), block_vertex(b, 1, l & 3),
+                  block_vertex(b, 2, l & 3)))
+            mask &= ~(1 << l);
+    }
+    return mask;
+}
+
 /// Sign bits of a block's slots: its lanes of other kinds (padding has the sign bit clear).
 inline int other_lanes(const TriangleBlock4& block) {
     return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
@@ -74,6 +92,7 @@ __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(
     }
     if (exact_zero) return LeafResult::slow;
     paired = pair;
+    if (mask && !one_sided_.empty()) mask = cull_block_lanes(ray, b0, b1, mask);
     if (!mask) return LeafResult::miss;
     if constexpr (!kAnyHit) {
         const int best = nearest_lane(mask, t);
@@ -106,6 +125,7 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             else
                 mask = intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
         }
+        if (mask && !one_sided_.empty()) mask = cull_block_lanes(ray, &blocks_[b], &blocks_[b + (pair ? 1 : 0)], mask);
         if constexpr (kCutouts)
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
@@ -143,6 +163,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
         std::optional<ShapeHit> h;
         if (prim_kind(id) == PrimKind::triangle) {
             h = slots_[s].tri.intersect(tr, ray.tmin, tmax);
+            const TriangleVerts& v = slots_[s].tri;
+            if (h && !one_sided_.empty() && culls(id, ray.dir, v.vertex(0), v.vertex(1), v.vertex(2))) continue;
             if constexpr (kCutouts)
                 if (h && !keep_triangle_hit(ray, id, h->u, h->v)) continue;
         } else {

@@ -55,6 +55,7 @@ void Accelerator::intersect_packet(RayPacket& packet, HitPacket& hits) const {
     c.rays = &packet;
     c.blocks = blocks_.data();
     c.accel = this;
+    c.one_sided = one_sided_.empty() ? nullptr : one_sided_.data();
     // The pairs layout, scenes with cut-outs (the alpha test is single-ray only),
     // mixed directions and near-empty packets: single rays.
     if (!layout_has_blocks(layout_) || wide8_.empty || has_cutouts() || std::popcount(packet.active) < 2 ||

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "scene/scene.h"
+#include "scene/texture.h"
 
 namespace sahara {
 
@@ -25,8 +26,9 @@ float mean_color(const ColorSource& c) {
     return average(c.color);
 }
 
+/// Emissive materials and glowing pbr ones (glTF emissiveFactor) are area lights.
 bool is_sampled_emitter(const MaterialDesc& m) {
-    return m.type == MaterialType::emissive && mean_color(m.radiance) > 0;
+    return (m.type == MaterialType::emissive || m.type == MaterialType::pbr) && mean_color(m.radiance) > 0;
 }
 
 float triangle_area(const TriangleSoup& soup, size_t i) {
@@ -79,14 +81,47 @@ void collect_lights(const Scene& s, float disk, std::vector<Emitter>& emitters, 
 }
 
 /// Adds area emitter i if its material emits; a Lambertian emitter of area A
-/// and radiance L emits pi * A * L.
+/// and radiance L emits pi * A * L (`radiance`: L's estimate, mean_color by default).
 void add_area_emitter(std::vector<uint32_t>& map, size_t count, Emitter::Kind kind, uint32_t i, float area,
-                      const MaterialDesc& m, std::vector<Emitter>& emitters, std::vector<float>& power) {
+                      const MaterialDesc& m, std::vector<Emitter>& emitters, std::vector<float>& power,
+                      float radiance = -1.0f) {
     if (!is_sampled_emitter(m) || !(area > 0)) return;
+    if (radiance < 0.0f) radiance = mean_color(m.radiance);
+    if (!(radiance > 0.0f)) return;
     if (map.empty()) map.assign(count, kNoEmitter);
     map[i] = uint32_t(emitters.size());
     emitters.push_back({kind, i});
-    power.push_back(kPiF * area * mean_color(m.radiance));
+    power.push_back(kPiF * area * radiance);
+}
+
+/// The emission of a triangle with a textured pbr emission, averaged over seven points
+/// (corners, edge midpoints, centroid) in the UVs the texture reads: a triangle over a
+/// dark part of the texture draws few light samples, and one that is black at all seven
+/// is left to BSDF sampling (unbiased still: MIS gives hits on non-emitters weight 1).
+float textured_pbr_radiance(const Scene& s, uint32_t i, const MaterialDesc& m) {
+    const TriangleSoup& soup = s.triangles;
+    const Vec3 p0 = soup.positions[soup.indices[3 * size_t(i)]];
+    const Vec3 p1 = soup.positions[soup.indices[3 * size_t(i) + 1]];
+    const Vec3 p2 = soup.positions[soup.indices[3 * size_t(i) + 2]];
+    const Vec3 n = cross(p1 - p0, p2 - p0);
+    const Vec2 bary[7] = {{0, 0}, {1, 0}, {0, 1}, {0.5f, 0}, {0, 0.5f}, {0.5f, 0.5f}, {1 / 3.0f, 1 / 3.0f}};
+    const TextureDesc& tex = s.textures[size_t(m.radiance.texture)];
+    float sum = 0;
+    for (const Vec2& b : bary) {
+        const Vec3 p = p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y;
+        const SurfaceInteraction si =
+            s.interact(Ray{p + n, -n, 0.0f, 2.0f, 0.0f}, Hit{1.0f, make_prim_id(PrimKind::triangle, i), b.x, b.y});
+        sum += average(eval_color(m.radiance, s.textures, si.p, tex.texcoord == 1 ? si.uv1 : si.uv));
+    }
+    return sum / 7.0f;
+}
+
+/// The light-sampling radiance estimate of triangle i (mean_color but for textured pbr emission).
+float triangle_radiance(const Scene& s, uint32_t i, const MaterialDesc& m) {
+    const bool textured = m.type == MaterialType::pbr && m.radiance.kind == ColorSource::Kind::texture &&
+                          m.radiance.texture >= 0 && size_t(m.radiance.texture) < s.textures.size() &&
+                          s.textures[size_t(m.radiance.texture)].image;
+    return textured ? textured_pbr_radiance(s, i, m) : mean_color(m.radiance);
 }
 
 void collect_features(const Scene& s, SceneFeatures& f) {
@@ -134,9 +169,12 @@ void Scene::prepare_lighting(bool force_all_features) {
         add_area_emitter(sphere_emitter, spheres.size(), Emitter::Kind::sphere, i,
                          4.0f * kPiF * spheres[i].radius * spheres[i].radius, materials[spheres[i].material],
                          emitters, power);
-    for (uint32_t i = 0; i < triangles.size(); ++i)
+    for (uint32_t i = 0; i < triangles.size(); ++i) {
+        const MaterialDesc& m = materials[triangles.material[i]];
+        if (!is_sampled_emitter(m)) continue;
         add_area_emitter(triangle_emitter, triangles.size(), Emitter::Kind::triangle, i,
-                         triangle_area(triangles, i), materials[triangles.material[i]], emitters, power);
+                         triangle_area(triangles, i), m, emitters, power, triangle_radiance(*this, i, m));
+    }
     for (uint32_t i = 0; i < boxes.size(); ++i)
         add_area_emitter(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
                          materials[boxes[i].material], emitters, power);
