@@ -27,6 +27,10 @@ constexpr int64_t kRayChunk = 256;
 constexpr float kPacketMaxChord = 0.03f;
 constexpr float kPacketMaxOffset = 0.03f;
 
+/// Sorting pays for itself through the cache: a tree that fits in a core's L2 stays
+/// there whatever the ray order, and its rays are too cheap to carry the sort.
+constexpr size_t kMinSortedBvhBytes = size_t(2) << 20;
+
 int team_size(const RaySlice& slice) { return slice.threads > 0 ? slice.threads : omp_get_max_threads(); }
 
 /// Work items of a slice: kRayChunk rays, fewer when the slice is short (slow rays make
@@ -100,7 +104,7 @@ float CastMesh::packet_max_offset() const {
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
     TraceOrder out{rays, {}, {}, {}};
-    if (!accel_ || rays.size() < kMinSortedRays ||
+    if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
     out.order = ray_order(rays, threads);
