@@ -267,7 +267,7 @@ def main():
     scene.add_triangles(o3d.core.Tensor(vertices), o3d.core.Tensor(triangles))
     scene.cast_rays(o3d.core.Tensor(np.zeros((1, 6), np.float32)))  # Embree commits the scene lazily
     open3d_build = time.perf_counter() - start
-    print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {os.cpu_count()} threads; "
+    print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {args.threads or os.cpu_count()} threads; "
           f"build sahara {1e3 * sahara_build:.0f} ms (load included), open3d {1e3 * open3d_build:.0f} ms")
     threads = args.threads or None
     engines = {"sahara": lambda r: caster.cast_rays(r, threads=threads)["t_hit"],
