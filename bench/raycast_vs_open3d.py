@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Casts the same rays through sahara.RayCaster and Open3D's RaycastingScene.
 
-    PYTHONPATH=build/python python3 bench/raycast_vs_open3d.py MESH [--rays N]
+    PYTHONPATH=build/python python3 bench/raycast_vs_open3d.py MESH [--rays N] [--embree]
 
 Two ray sets: N random rays (origins on a sphere around the mesh, aimed at random
 points inside its box) and a pinhole camera's rays (sqrt(N) x sqrt(N) pixels).
@@ -9,19 +9,82 @@ Prints hit/miss agreement, t agreement and MRays/s of both engines with all
 threads (one warm-up call, then the best of --repeats). Rays on which the two
 disagree are re-tested in double precision against every triangle, which says
 which engine was right. --markdown prints the table row docs/performance.md uses.
+--threads N runs both engines on N threads (default: all).
+
+Open3D's ray masks: Open3D 0.16 (Debian bookworm's python3-open3d) leaves each
+ray's `mask` field at 0, and Debian's Embree 3 is built with ray masks
+(EMBREE_RAY_MASK), so every ray misses every geometry (whose mask is all ones).
+Before importing open3d the script therefore compiles a tiny interposer with `cc`
+into a temporary directory and loads it with RTLD_GLOBAL: it defines the two
+Embree entry points Open3D casts with, rtcIntersect1M and rtcOccluded1M (see
+`nm -D --undefined-only libOpen3D.so`), sets every ray's mask to 0xFFFFFFFF and
+calls Embree's own function. Symbols of the global scope come before a library's
+own dependencies, so Open3D binds to the interposer while everything else of
+Open3D and Embree runs unchanged. A probe ray checks that it took effect.
+--embree adds Embree 3 called directly through ctypes (the same rtcIntersect1M,
+on a Python thread pool) as a third column.
 """
 import argparse
+import ctypes
 import os
+import subprocess
+import tempfile
 import time
 
 import numpy as np
 
 import sahara
 
-try:
-    import open3d as o3d
-except ImportError:  # pragma: no cover
-    raise SystemExit("needs Open3D (Debian: apt-get install python3-open3d)")
+# The interposer. RTCRay keeps `mask` at byte 36 in Embree 3 (RTCRayHit starts with an RTCRay).
+UNMASK_C = r"""
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <stddef.h>
+#include <stdint.h>
+typedef void (*stream_fn)(void*, void*, void*, unsigned, size_t);
+static stream_fn embree(const char* name) {
+    void* lib = dlopen("libembree3.so.3", RTLD_NOW | RTLD_NOLOAD);
+    if (!lib) lib = dlopen("libembree3.so.3", RTLD_NOW);
+    return lib ? (stream_fn)dlsym(lib, name) : 0;
+}
+static void unmask(void* rays, unsigned n, size_t stride) {
+    for (unsigned i = 0; i < n; ++i) *(uint32_t*)((char*)rays + i * stride + 36) = 0xFFFFFFFFu;
+}
+void rtcIntersect1M(void* scene, void* context, void* rays, unsigned n, size_t stride) {
+    static stream_fn real;
+    if (!real) real = embree("rtcIntersect1M");
+    unmask(rays, n, stride);
+    real(scene, context, rays, n, stride);
+}
+void rtcOccluded1M(void* scene, void* context, void* rays, unsigned n, size_t stride) {
+    static stream_fn real;
+    if (!real) real = embree("rtcOccluded1M");
+    unmask(rays, n, stride);
+    real(scene, context, rays, n, stride);
+}
+"""
+
+
+def import_open3d_unmasked():
+    """open3d, with the ray-mask interposer loaded first (see the module docstring)."""
+    with tempfile.TemporaryDirectory(prefix="sahara-o3d-") as tmp:
+        src, lib = os.path.join(tmp, "unmask.c"), os.path.join(tmp, "unmask.so")
+        with open(src, "w") as f:
+            f.write(UNMASK_C)
+        subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", lib, src, "-ldl"], check=True)
+        ctypes.CDLL(lib, mode=ctypes.RTLD_GLOBAL)  # stays loaded after the file is gone
+    try:
+        import open3d as o3d
+    except ImportError:  # pragma: no cover
+        raise SystemExit("needs Open3D (Debian: apt-get install python3-open3d)")
+    probe = o3d.t.geometry.RaycastingScene()
+    probe.add_triangles(o3d.core.Tensor(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)),
+                        o3d.core.Tensor(np.array([[0, 1, 2]], np.uint32)))
+    t = probe.cast_rays(o3d.core.Tensor(np.array([[0.25, 0.25, -1, 0, 0, 1]], np.float32)))["t_hit"].numpy()
+    if not t[0] == 1.0:
+        raise SystemExit(f"Open3D still misses a ray straight at a triangle (t_hit {t[0]}): the interposer "
+                         "did not take effect")
+    return o3d
 
 
 def random_rays(vertices, count, rng):
@@ -98,9 +161,8 @@ def double_check(vertices, triangles, ray):
 
 class EmbreeDirect:
     """Embree 3 called through ctypes as Open3D's RaycastingScene calls it (default scene
-    flags, rtcIntersect on float32 rays), on all threads: ctypes releases the GIL, so a
-    thread pool runs one chunk of rays per thread. Used because Debian's Open3D 0.16
-    returns misses for every ray with Debian's Embree (built with ray masks)."""
+    flags, rtcIntersect1M on float32 rays) from a thread pool (ctypes releases the GIL):
+    Embree's speed without Open3D's tensor conversions around it."""
 
     RAYHIT = np.dtype({"names": ["org", "tnear", "dir", "time", "tfar", "mask", "id", "flags",
                                  "ng", "u", "v", "prim", "geom", "inst"],
@@ -108,7 +170,7 @@ class EmbreeDirect:
                                    ("<f4", 3), "<f4", "<f4", "<u4", "<u4", "<u4"],
                        "offsets": [0, 12, 16, 28, 32, 36, 40, 44, 48, 60, 64, 68, 72, 76], "itemsize": 80})
 
-    def __init__(self, vertices, triangles):
+    def __init__(self, vertices, triangles, threads):
         import ctypes
         self.ct = ctypes
         lib = self.lib = ctypes.CDLL("libembree3.so.3")
@@ -132,7 +194,7 @@ class EmbreeDirect:
         lib.rtcCommitScene(self.scene)
         # RTCIntersectContext: flags 0 (incoherent), no filter, instID[0] invalid.
         self.context = (ctypes.c_uint32 * 6)(0, 0, 0, 0, 0xFFFFFFFF, 0)
-        self.pool = __import__("concurrent.futures").futures.ThreadPoolExecutor(os.cpu_count())
+        self.pool = __import__("concurrent.futures").futures.ThreadPoolExecutor(threads)
 
     def cast_rays(self, rays):
         rh = np.zeros(len(rays), self.RAYHIT)
@@ -190,8 +252,11 @@ def main():
     ap.add_argument("--rays", type=int, default=1_000_000, help="rays per set (default 1M)")
     ap.add_argument("--repeats", type=int, default=5, help="timed runs per engine; the best counts")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--threads", type=int, default=0, help="threads per engine (default 0: all)")
+    ap.add_argument("--embree", action="store_true", help="add Embree called directly through ctypes")
     ap.add_argument("--markdown", action="store_true", help="also print docs/performance.md table rows")
     args = ap.parse_args()
+    o3d = import_open3d_unmasked()
 
     start = time.perf_counter()
     caster = sahara.RayCaster.from_file(args.mesh)
@@ -202,12 +267,13 @@ def main():
     scene.add_triangles(o3d.core.Tensor(vertices), o3d.core.Tensor(triangles))
     scene.cast_rays(o3d.core.Tensor(np.zeros((1, 6), np.float32)))  # Embree commits the scene lazily
     open3d_build = time.perf_counter() - start
-    embree = EmbreeDirect(vertices, triangles)
-    print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {os.cpu_count()} threads; "
+    print(f"{os.path.basename(args.mesh)}: {len(triangles)} triangles, {args.threads or os.cpu_count()} threads; "
           f"build sahara {1e3 * sahara_build:.0f} ms (load included), open3d {1e3 * open3d_build:.0f} ms")
-    engines = {"sahara": lambda r: caster.cast_rays(r)["t_hit"],
-               "open3d": lambda r: scene.cast_rays(o3d.core.Tensor(r))["t_hit"].numpy(),
-               "embree": embree.cast_rays}
+    threads = args.threads or None
+    engines = {"sahara": lambda r: caster.cast_rays(r, threads=threads)["t_hit"],
+               "open3d": lambda r: scene.cast_rays(o3d.core.Tensor(r), nthreads=args.threads)["t_hit"].numpy()}
+    if args.embree:
+        engines["embree"] = EmbreeDirect(vertices, triangles, args.threads or os.cpu_count()).cast_rays
     rng = np.random.default_rng(args.seed)
     rows = (compare("random", random_rays(vertices, args.rays, rng), engines, args.repeats, vertices, triangles)
             + compare("camera", camera_rays(vertices, args.rays), engines, args.repeats, vertices, triangles))

@@ -3,6 +3,10 @@
 /// image writing and the exception types.
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
+#include <optional>
+#include <string>
+
 #include "io/json_reader.h"
 
 namespace sahara::python {
@@ -11,6 +15,12 @@ namespace sahara::python {
 void bind_errors(pybind11::module_& m);
 /// sahara.Scene, render and write_image (the _sahara functions __init__.py wraps).
 void bind_render(pybind11::module_& m);
+
+/// The name of a value's type, for messages.
+std::string type_name(const pybind11::handle& h);
+/// An integer keyword argument in [lo, hi] (the command line's range), or nullopt for None;
+/// TypeError/ValueError naming `name` otherwise.
+std::optional<int64_t> int_arg(const pybind11::object& v, const char* name, int64_t lo, int64_t hi);
 
 /// A Python dict/list/str/number/bool/None tree as JSON, for the scene parser.
 /// Raises TypeError/ValueError naming `what` and the key path of a value that

@@ -1,11 +1,14 @@
 #include "python/raycast_mesh.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <span>
 
 #include "accel/crossings.h"
 #include "geometry/triangle.h"
+#include "python/ray_order.h"
 #include "scene/accelerator.h"
 #include "scene/scene.h"
 
@@ -16,6 +19,27 @@ namespace {
 /// Rays per OpenMP work item: large enough to amortise scheduling, small enough that
 /// uneven rays (long misses beside early hits) still balance across threads.
 constexpr int64_t kRayChunk = 256;
+
+/// Runs of kPacketSize rays take the packet traversal when their unit directions lie
+/// within this chord of the first ray's (about 1.7 degrees; a camera's neighbouring
+/// pixels are far closer) and their origins within this fraction of the mesh's
+/// diagonal. Less coherent packets (sorted random rays) trace faster ray by ray.
+constexpr float kPacketMaxChord = 0.03f;
+constexpr float kPacketMaxOffset = 0.03f;
+
+/// Sorting pays for itself through the cache: a tree that fits in a core's L2 stays
+/// there whatever the ray order, and its rays are too cheap to carry the sort.
+constexpr size_t kMinSortedBvhBytes = size_t(2) << 20;
+
+int team_size(const RaySlice& slice) { return slice.threads > 0 ? slice.threads : omp_get_max_threads(); }
+
+/// Work items of a slice: kRayChunk rays, fewer when the slice is short (slow rays make
+/// short slices, and every thread should still get several items), in multiples of `unit`.
+int64_t work_item(const RaySlice& slice, int threads, int64_t unit) {
+    const auto rays = int64_t(slice.last - slice.first);
+    const int64_t per_item = std::clamp<int64_t>(rays / (8 * int64_t(threads)), unit, kRayChunk);
+    return per_item / unit;
+}
 
 }  // namespace
 
@@ -28,6 +52,10 @@ CastMesh::CastMesh(std::vector<Vec3> positions, std::vector<uint32_t> indices) {
     if (scene.triangles.size() > 0) accel_ = std::make_unique<Accelerator>(scene);
     positions_ = std::move(scene.triangles.positions);
     indices_ = std::move(scene.triangles.indices);
+    normals_.resize(triangle_count());
+    const auto m = int64_t(normals_.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < m; ++i) normals_[size_t(i)] = unit_normal(uint32_t(i));
 }
 
 CastMesh::~CastMesh() = default;
@@ -62,38 +90,90 @@ void CastMesh::store(size_t k, const Hit& hit, const NearestHits& out) const {
     out.prim[k] = int64_t(tri);
     out.uv[2 * k] = hit.u;
     out.uv[2 * k + 1] = hit.v;
-    const Vec3 nrm = unit_normal(tri);
+    const Vec3 nrm = normals_[tri];
     out.normal[3 * k] = nrm.x;
     out.normal[3 * k + 1] = nrm.y;
     out.normal[3 * k + 2] = nrm.z;
 }
 
-void CastMesh::nearest(const RayBatch& rays, const NearestHits& out) const {
-    const auto n = int64_t(rays.size());
-    if (!accel_) {
-        for (int64_t i = 0; i < n; ++i) store(size_t(i), Hit{}, out);
-        return;
+float CastMesh::packet_max_offset() const {
+    if (!accel_) return 0.0f;
+    const Bounds3 box = accel_->bounds();
+    return kPacketMaxOffset * length(box.hi - box.lo);
+}
+
+TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
+    TraceOrder out{rays, {}, {}, {}};
+    if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
+        runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
+        return out;
+    out.order = ray_order(rays, threads);
+    if (!out.order.empty()) {
+        out.sorted = gather_rays(rays, out.order, threads);
+        out.hits.resize(out.order.size());
     }
-    // Runs of kPacketSize consecutive rays go through the packet traversal, which takes
-    // the coherent ones (camera rays in image order share directions and origins) as
-    // packets and traces the others ray by ray; the hits are the single-ray hits.
-    const int64_t packets = (n + kPacketSize - 1) / kPacketSize;
-#pragma omp parallel for schedule(dynamic, kRayChunk / kPacketSize)
-    for (int64_t p = 0; p < packets; ++p) {
-        RayPacket packet;
-        HitPacket hits;
-        const int64_t first = p * kPacketSize;
-        const int lanes = int(std::min<int64_t>(kPacketSize, n - first));
-        for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(first + l)));
-        accel_->intersect_packet(packet, hits);
-        for (int l = 0; l < lanes; ++l) store(size_t(first + l), hits.hit(l), out);
+    return out;
+}
+
+void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const {
+    if (rays.order.empty()) return;
+    const auto n = int64_t(rays.order.size());
+    std::vector<uint32_t> position(static_cast<size_t>(n));  // the inverse permutation
+    const int team = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel num_threads(team)
+    {
+#pragma omp for schedule(static)
+        for (int64_t k = 0; k < n; ++k) position[rays.order[size_t(k)]] = uint32_t(k);
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < n; ++i) store(size_t(i), rays.hits[position[size_t(i)]], out);
     }
 }
 
-void CastMesh::occluded(const RayBatch& rays, bool* out) const {
-    const auto n = int64_t(rays.size());
-#pragma omp parallel for schedule(dynamic, kRayChunk)
-    for (int64_t i = 0; i < n; ++i) out[i] = accel_ && accel_->occluded(rays.ray(size_t(i)));
+void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out) const {
+    const auto first = int64_t(slice.first), last = int64_t(slice.last);
+    Hit* sorted_hits = rays.order.empty() ? nullptr : rays.hits.data();
+    const auto put = [&](int64_t k, const Hit& h) {
+        if (sorted_hits)
+            sorted_hits[k] = h;
+        else
+            store(size_t(k), h, out);
+    };
+    if (!accel_) {
+        for (int64_t k = first; k < last; ++k) put(k, Hit{});
+        return;
+    }
+    const float max_offset = packet_max_offset();
+    const int64_t packets = (last - first + kPacketSize - 1) / kPacketSize;
+    const int threads = team_size(slice);
+    const int64_t item = work_item(slice, threads, kPacketSize);
+#pragma omp parallel for schedule(dynamic, item) num_threads(threads)
+    for (int64_t p = 0; p < packets; ++p) {
+        RayPacket packet;
+        HitPacket hits;
+        const int64_t start = first + p * kPacketSize;
+        const int lanes = int(std::min<int64_t>(kPacketSize, last - start));
+        for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(start + l)));
+        if (lanes > 1 && packet_is_coherent(packet, kPacketMaxChord, max_offset)) {
+            accel_->intersect_packet(packet, hits);
+            for (int l = 0; l < lanes; ++l) put(start + l, hits.hit(l));
+            continue;
+        }
+        for (int l = 0; l < lanes; ++l) {
+            Ray r = packet.ray(l);
+            Hit h;
+            accel_->intersect(r, h);
+            put(start + l, h);
+        }
+    }
+}
+
+void CastMesh::occluded(const TraceOrder& rays, RaySlice slice, bool* out) const {
+    const auto first = int64_t(slice.first), last = int64_t(slice.last);
+    const int threads = team_size(slice);
+    const int64_t item = work_item(slice, threads, 1);
+#pragma omp parallel for schedule(dynamic, item) num_threads(threads)
+    for (int64_t k = first; k < last; ++k)
+        out[rays.index(size_t(k))] = accel_ && accel_->occluded(rays.ray(size_t(k)));
 }
 
 void CastMesh::count_crossings(const RayBatch& rays, int32_t* out) const {

@@ -8,6 +8,7 @@
 
 #include "geometry/hit.h"
 #include "math/vec3.h"
+#include "python/ray_order.h"
 #include "python/raycast_arrays.h"
 
 namespace sahara {
@@ -22,6 +23,15 @@ struct NearestHits {
     int64_t* prim;  ///< -1 on a miss
     float* uv;      ///< 2 per ray; 0 on a miss
     float* normal;  ///< 3 per ray, unit geometric normal (counter-clockwise front); 0 on a miss
+};
+
+/// The rays [first, last) of a batch, run on `threads` OpenMP threads (0: OpenMP's
+/// default, all cores). The bindings cast a long batch as a series of slices so
+/// that Python's signal handlers (Ctrl-C) run between them.
+struct RaySlice {
+    size_t first = 0;
+    size_t last = 0;
+    int threads = 0;
 };
 
 /// Every crossing of a batch, sorted by ray then t, collected per chunk of rays
@@ -44,8 +54,15 @@ class CastMesh {
     CastMesh(const CastMesh&) = delete;
     CastMesh& operator=(const CastMesh&) = delete;
 
-    void nearest(const RayBatch& rays, const NearestHits& out) const;
-    void occluded(const RayBatch& rays, bool* out) const;
+    /// The order to trace a batch in: its own when it is short or its runs are already
+    /// coherent (a camera's rays), otherwise sorted (ray_order), which keeps neighbouring
+    /// rays on the same nodes. OpenMP on `threads` (0: all).
+    TraceOrder trace_order(const RayBatch& rays, int threads) const;
+    /// Positions [slice.first, slice.last) of `rays`; results go to each ray's batch index.
+    /// With a sorted order the hits wait in rays.hits until write_sorted_hits.
+    void nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out) const;
+    void write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const;
+    void occluded(const TraceOrder& rays, RaySlice slice, bool* out) const;
     void count_crossings(const RayBatch& rays, int32_t* out) const;
     Crossings crossings(const RayBatch& rays) const;
 
@@ -54,15 +71,24 @@ class CastMesh {
     size_t triangle_count() const { return indices_.size() / 3; }
     /// Bytes of the BVH and its leaf triangles.
     size_t bvh_bytes() const;
+    /// Threads of the queries that do not name their own (0: all).
+    int threads() const { return threads_; }
+    void set_threads(int threads) { threads_ = threads; }
 
    private:
     Vec3 unit_normal(uint32_t triangle) const;
+    /// The largest origin spread of a packet the packet traversal takes.
+    float packet_max_offset() const;
+    /// unit_normal of every triangle, computed once: a hit then reads one row instead of
+    /// three indices and three vertices.
+    std::vector<Vec3> normals_;
     /// Writes ray k's entry of `out` (a miss when !hit.hit()).
     void store(size_t k, const Hit& hit, const NearestHits& out) const;
 
     std::vector<Vec3> positions_;
     std::vector<uint32_t> indices_;
     std::unique_ptr<Accelerator> accel_;
+    int threads_ = 0;
 };
 
 }  // namespace sahara::python

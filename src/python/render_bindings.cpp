@@ -30,19 +30,8 @@ namespace py = pybind11;
 
 namespace sahara::python {
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-/// The name a dict scene carries in messages ("<dict>: objects[2].radius: ...");
-/// its empty parent directory makes relative paths resolve against the cwd.
-constexpr const char* kDictSceneName = "<dict>";
-
 std::string type_name(const py::handle& h) { return py::str(py::type::handle_of(h).attr("__name__")); }
 
-/// An integer keyword argument in [lo, hi] (the command line's range), or nullopt for None.
 std::optional<int64_t> int_arg(const py::object& v, const char* name, int64_t lo, int64_t hi) {
     if (v.is_none()) return std::nullopt;
     if (py::isinstance<py::bool_>(v) || !PyIndex_Check(v.ptr()))
@@ -59,6 +48,16 @@ std::optional<int64_t> int_arg(const py::object& v, const char* name, int64_t lo
                               std::to_string(hi) + "], got " + std::to_string(x));
     return x;
 }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// The name a dict scene carries in messages ("<dict>: objects[2].radius: ...");
+/// its empty parent directory makes relative paths resolve against the cwd.
+constexpr const char* kDictSceneName = "<dict>";
 
 std::optional<double> real_arg(const py::object& v, const char* name, double lo, double hi) {
     if (v.is_none()) return std::nullopt;

@@ -1,0 +1,57 @@
+#pragma once
+/// The order in which RayCaster traces a batch: rays sorted so that neighbours in
+/// the order start near each other and point the same way. Consecutive rays then
+/// walk mostly the same nodes and leaves, which stay in the cache, and coherent
+/// runs (a camera's rays) can go through the packet traversal. Results are still
+/// written at each ray's own index.
+#include <cstdint>
+#include <vector>
+
+#include "accel/packet.h"
+#include "geometry/hit.h"
+#include "python/raycast_arrays.h"
+
+namespace sahara::python {
+
+/// Batches shorter than this are traced in their own order: the rays are too
+/// sparse for neighbours to share much, and the sort would cost more than it saves.
+inline constexpr size_t kMinSortedRays = size_t(1) << 14;
+
+/// The batch's rays by a 30-bit Morton code of the unit direction and the origin
+/// (5 bits per coordinate, the origin relative to the batch's origin bounds),
+/// ties in batch order. Empty (meaning the identity) below kMinSortedRays or at
+/// 2^32 rays and more. OpenMP on `threads` (0: all).
+std::vector<uint32_t> ray_order(const RayBatch& rays, int threads);
+
+/// The rays of the batch in `order`, as one contiguous array (reading them through
+/// the permutation while tracing would cost a cache miss per ray).
+std::vector<Ray> gather_rays(const RayBatch& rays, const std::vector<uint32_t>& order, int threads);
+
+/// The rays a query traces, in the order it traces them: the batch itself, or the
+/// sorted copy whose position k holds the batch's ray order[k].
+struct TraceOrder {
+    const RayBatch& batch;
+    std::vector<uint32_t> order;  ///< empty: the batch's own order
+    std::vector<Ray> sorted;
+    /// Nearest hits in the sorted order (with `order` only): they reach the result
+    /// arrays in one pass in batch order, which reads one scattered hit per ray instead
+    /// of writing four scattered results.
+    std::vector<Hit> hits;
+
+    size_t size() const { return batch.size(); }
+    Ray ray(size_t k) const { return order.empty() ? batch.ray(k) : sorted[k]; }
+    /// The batch index of position k (where its result goes).
+    size_t index(size_t k) const { return order.empty() ? k : size_t(order[k]); }
+};
+
+/// Whether the active rays of a packet are close enough for the packet traversal to
+/// beat tracing them one by one: unit directions within `max_chord` of the first
+/// ray's and origins within `max_offset` of its origin.
+bool packet_is_coherent(const RayPacket& packet, float max_chord, float max_offset);
+
+/// Whether most runs of kPacketSize consecutive rays of the batch are coherent
+/// (packet_is_coherent), judged from a sample of runs spread over the batch: such
+/// a batch (a camera's rays in image order) is traced in its own order.
+bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset);
+
+}  // namespace sahara::python

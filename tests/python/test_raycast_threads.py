@@ -1,0 +1,118 @@
+"""sahara.RayCaster on large batches: sorted tracing, threads= arguments and Ctrl-C."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, os.path.dirname(__file__))
+import sahara  # noqa: E402
+from raycast_meshes import icosphere  # noqa: E402
+
+
+def random_rays(count, seed):
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(count, 3))
+    origins = 3 * d / np.linalg.norm(d, axis=1, keepdims=True)
+    return np.hstack([origins, rng.uniform(-1, 1, size=(count, 3)) - origins]).astype(np.float32)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return icosphere(3)
+
+
+def test_thread_counts_give_the_same_hits(sphere):
+    v, f = sphere
+    # More rays than one slice between signal checks, so several slices run.
+    rays = random_rays(150_000, seed=3)
+    reference = sahara.RayCaster(v, f, threads=1).cast_rays(rays)
+    assert 0.3 < np.isfinite(reference["t_hit"]).mean() < 1.0
+    caster = sahara.RayCaster(v, f)
+    for threads in (None, 0, 1, 2, 3):
+        got = caster.cast_rays(rays, threads=threads)
+        for key in reference:
+            np.testing.assert_array_equal(got[key], reference[key], err_msg=f"{key}, threads={threads}")
+        np.testing.assert_array_equal(caster.occluded(rays, threads=threads), np.isfinite(reference["t_hit"]))
+
+
+def test_a_large_batch_gives_what_small_batches_give():
+    # Large incoherent batches are traced in a sorted order, small ones (and coherent
+    # ones) in their own: the results must not depend on it, per-ray limits included.
+    v, f = icosphere(6)  # a tree larger than the caster's threshold for sorting
+    caster = sahara.RayCaster(v, f)
+    assert caster.bvh_bytes > 2 << 20
+    rays = random_rays(100_000, seed=5)
+    tmax = np.random.default_rng(6).uniform(1, 4, len(rays)).astype(np.float32)
+    whole = caster.cast_rays(rays, tmax=tmax)
+    parts = [caster.cast_rays(rays[i:i + 5000], tmax=tmax[i:i + 5000]) for i in range(0, len(rays), 5000)]
+    assert 0.2 < np.isfinite(whole["t_hit"]).mean() < 0.9
+    for key in whole:
+        np.testing.assert_array_equal(whole[key], np.concatenate([p[key] for p in parts]), err_msg=key)
+    occluded = np.concatenate([caster.occluded(rays[i:i + 5000], tmax=tmax[i:i + 5000])
+                               for i in range(0, len(rays), 5000)])
+    np.testing.assert_array_equal(caster.occluded(rays, tmax=tmax), occluded)
+    np.testing.assert_array_equal(occluded, np.isfinite(whole["t_hit"]))
+
+
+def test_threads_property_and_from_file(tmp_path, sphere):
+    v, f = sphere
+    assert sahara.RayCaster(v, f).threads is None
+    assert sahara.RayCaster(v, f, threads=0).threads is None
+    assert sahara.RayCaster(v, f, threads=2).threads == 2
+    path = tmp_path / "sphere.obj"
+    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n"
+                                                                           for a, b, c in f))
+    assert sahara.RayCaster.from_file(path, threads=1).threads == 1
+
+
+@pytest.mark.parametrize("threads, error", [(-1, ValueError), (1 << 20, ValueError), ("2", TypeError),
+                                            (2.0, TypeError), (True, TypeError)])
+def test_bad_thread_counts_raise_naming_the_argument(sphere, threads, error):
+    v, f = sphere
+    caster = sahara.RayCaster(v, f)
+    rays = random_rays(4, seed=1)
+    for call in (lambda: sahara.RayCaster(v, f, threads=threads), lambda: caster.cast_rays(rays, threads=threads),
+                 lambda: caster.occluded(rays, threads=threads)):
+        with pytest.raises(error, match="threads"):
+            call()
+
+
+# A cast that takes many seconds on one thread (every ray misses a stack of triangles but
+# passes through all their boxes), interrupted by SIGINT shortly after it starts. The cast's
+# full length is estimated from a short one first: a KeyboardInterrupt that only came after
+# the cast had finished would arrive after that time, not within half of it.
+CHILD = textwrap.dedent("""
+    import os, signal, sys, threading, time
+    import numpy as np
+    import sahara
+    n = 20000
+    v = np.tile(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), (n, 1))
+    v[:, 2] = np.repeat(np.arange(n, dtype=np.float32), 3)
+    caster = sahara.RayCaster(v, np.arange(3 * n).reshape(n, 3), threads=1)
+    ray = np.array([0.9, 0.9, -1, 0, 0, 1], np.float32)
+    caster.cast_rays(np.broadcast_to(ray, (500, 6)))  # warm-up
+    start = time.monotonic()
+    probe = caster.cast_rays(np.broadcast_to(ray, (5000, 6)))
+    per_ray = (time.monotonic() - start) / 5000
+    assert not np.isfinite(probe["t_hit"]).any()
+    count = int(min(4e6, max(1e5, 30 / per_ray)))
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    start = time.monotonic()
+    try:
+        caster.cast_rays(np.broadcast_to(ray, (count, 6)))
+    except KeyboardInterrupt:
+        print("interrupted", time.monotonic() - start, count * per_ray, flush=True)
+        sys.exit(42)
+    sys.exit(1)
+""")
+
+
+def test_sigint_stops_a_long_cast_with_keyboard_interrupt():
+    proc = subprocess.run([sys.executable, "-c", CHILD], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ))
+    assert proc.returncode == 42, proc.stdout + proc.stderr
+    _, elapsed, full = proc.stdout.split()
+    assert float(elapsed) < float(full) / 2, proc.stdout
