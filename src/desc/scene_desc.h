@@ -48,6 +48,10 @@ struct ColorSource {
     Rgb even{0.9f, 0.9f, 0.9f}, odd{0.1f, 0.1f, 0.1f};
     float checker_scale = 1.0f;  ///< size of one checker cell in scene units
     int texture = -1;            ///< index into SceneDesc::textures
+    /// Added to the (local) position before the checker test: the local origin's
+    /// world position modulo the checker period, so the cells stay where the
+    /// world coordinates put them.
+    Vec3 checker_offset{0, 0, 0};
 };
 
 enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr };
@@ -220,6 +224,12 @@ struct RenderSettings {
 
 struct SceneDesc {
     std::string source;  ///< scene file path, or "<default>" for the built-in scene
+    /// World position of the point every position in this description is
+    /// relative to (the local origin, docs/scene-format.md "Coordinates far from
+    /// the origin"): the parser subtracts it in double before rounding to float,
+    /// so geometry far from the world origin keeps its precision. Zero unless
+    /// the camera is far from the world origin.
+    Vec3d origin{0, 0, 0};
     RenderSettings render;
     CameraDesc camera;
     BackgroundDesc background;

@@ -259,6 +259,13 @@ Vec3 JsonValue::vec3(const NumberRange& range) const {
     return v;
 }
 
+Vec3d JsonValue::vec3d(const NumberRange& range) const {
+    vec3(range);  // the same checks and messages
+    Vec3d v;
+    for (int i = 0; i < 3; ++i) v[i] = JsonValue((*json_)[size_t(i)], *file_, path_).number();
+    return v;
+}
+
 Vec3 JsonValue::nonzero_vec3() const {
     Vec3 v = vec3();
     if (v.x == 0 && v.y == 0 && v.z == 0) fail_expected("a non-zero vector [x, y, z]");

@@ -66,6 +66,9 @@ class JsonValue {
     size_t one_of(std::initializer_list<const char*> names) const;
     /// [x, y, z] of finite float numbers, each in `range`.
     Vec3 vec3(const NumberRange& range = NumberRange::any()) const;
+    /// [x, y, z] as vec3() checks it, in double precision (positions, which
+    /// the parser moves to the local origin before rounding to float).
+    Vec3d vec3d(const NumberRange& range = NumberRange::any()) const;
     /// [x, y, z] with at least one non-zero component.
     Vec3 nonzero_vec3() const;
     /// An array; `min_size`..`max_size` elements.

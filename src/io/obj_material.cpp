@@ -348,7 +348,7 @@ MaterialDesc convert_material(const tinyobj::material_t& m, const std::set<std::
     if (!m.diffuse_texname.empty()) {
         const int t =
             textures.get(m.diffuse_texname, m.diffuse_texopt, ObjTextures::Use::color, "map_Kd of " + m.name);
-        if (t >= 0) out.albedo = {ColorSource::Kind::texture, Rgb(1.0f), {}, {}, 1.0f, t};
+        if (t >= 0) out.albedo = {ColorSource::Kind::texture, Rgb(1.0f), {}, {}, 1.0f, t, {}};
     }
     out.alpha = std::clamp(float(m.dissolve), 0.0f, 1.0f);
     if (!m.alpha_texname.empty())

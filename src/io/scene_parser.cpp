@@ -1,5 +1,6 @@
 #include "io/scene_parser.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -45,9 +46,9 @@ const char* first_present(const JsonObject& o, std::initializer_list<const char*
     return nullptr;
 }
 
-void parse_look_at_camera(JsonObject& o, CameraDesc& cam) {
+void parse_look_at_camera(JsonObject& o, const ParseContext& ctx, CameraDesc& cam) {
     JsonValue look = o.require("look_at", "the point [x, y, z] the camera looks at");
-    cam.look_at = look.vec3();
+    cam.look_at = ctx.local_point(look.vec3d());
     if (length(cam.look_at - cam.position) == 0.0f) look.fail("look_at must differ from position");
     auto up = o.get("up");
     if (up) cam.up = normalize(up->nonzero_vec3());
@@ -64,17 +65,21 @@ void parse_euler_camera(JsonObject& o, CameraDesc& cam) {
     if (auto v = o.get("focal_length")) cam.focal_length = v->number_f(NumberRange::positive());
 }
 
-void parse_camera(JsonObject o, CameraDesc& cam) {
+/// Reads the camera and, from its position, sets the scene's local origin.
+void parse_camera(JsonObject o, ParseContext& ctx) {
+    CameraDesc& cam = ctx.scene->camera;
     const char* look_key = first_present(o, {"look_at", "up", "vfov"});
     const char* euler_key = first_present(o, {"euler", "focal_length"});
     if (look_key && euler_key)
         o.value().fail(std::string("mixes the look-at form (\"") + look_key + "\") with the euler form (\"" +
                        euler_key + "\"); use either position/look_at/up/vfov or position/euler/focal_length");
-    cam.position = o.require("position", "the camera position [x, y, z]").vec3();
+    const Vec3d position = o.require("position", "the camera position [x, y, z]").vec3d();
+    ctx.origin = ctx.scene->origin = choose_local_origin(position);
+    cam.position = ctx.local_point(position);
     if (euler_key)
         parse_euler_camera(o, cam);
     else
-        parse_look_at_camera(o, cam);
+        parse_look_at_camera(o, ctx, cam);
     if (auto v = o.get("aperture")) cam.aperture = v->number_f(NumberRange::non_negative());
     if (auto v = o.get_non_null("focus_distance")) cam.focus_distance = v->number_f(NumberRange::positive());
     // The euler form has no target; its natural focus is the view plane.
@@ -137,6 +142,9 @@ ColorSource parse_color_source(const JsonValue& v, ParseContext& ctx) {
         if (auto e = co.get("even")) c.even = e->vec3(unit);
         if (auto e = co.get("odd")) c.odd = e->vec3(unit);
         if (auto e = co.get("scale")) c.checker_scale = e->number_f(NumberRange::positive());
+        // Cells repeat every two along each axis; the remainder is exact in double.
+        const double period = 2.0 * double(c.checker_scale);
+        for (int i = 0; i < 3; ++i) c.checker_offset[i] = float(std::fmod(ctx.origin[i], period));
         co.finish();
     } else if (auto tex = o.get("texture")) {
         c.kind = ColorSource::Kind::texture;
@@ -247,6 +255,13 @@ uint32_t ParseContext::material(const JsonValue& where) const {
 
 // --- entry points --------------------------------------------------------------------
 
+Vec3d choose_local_origin(const Vec3d& camera_position) {
+    const Vec3d& c = camera_position;
+    if (std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) < kLocalOriginRadius) return {0, 0, 0};
+    const auto snap = [](double v) { return std::round(v / kLocalOriginGrid) * kLocalOriginGrid; };
+    return {snap(c.x), snap(c.y), snap(c.z)};
+}
+
 SceneLoaders SceneLoaders::standard() {
     SceneLoaders l;
     l.load_model = [](const std::filesystem::path& f, const Mat4& m) { return sahara::load_model(f, m); };
@@ -285,7 +300,7 @@ SceneDesc parse_scene_value(const Json& root_json, const std::filesystem::path& 
     JsonObject root(JsonValue(root_json, ctx.file, ""));
     if (auto v = root.get("format")) v->one_of({"scene/1"});
     if (auto v = root.get("render")) parse_render(JsonObject(*v), scene.render);
-    parse_camera(JsonObject(root.require("camera", "the camera object")), scene.camera);
+    parse_camera(JsonObject(root.require("camera", "the camera object")), ctx);
     if (auto v = root.get("background")) parse_background(JsonObject(*v), ctx);
     if (auto v = root.get("materials")) parse_materials(JsonObject(*v), ctx);
     if (auto v = root.get("lights")) parse_lights(ctx, *v);  // before the objects' model lights

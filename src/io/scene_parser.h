@@ -50,6 +50,16 @@ SceneDesc default_scene();
 /// every triangle uses that material instead and the model's own are dropped.
 void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uint32_t> material_override);
 
+/// The local origin of a scene whose camera stands at `camera_position`
+/// (world coordinates): zero while the camera is within kLocalOriginRadius of
+/// the world origin on every axis (scenes there keep their exact floats), else
+/// the camera position rounded to the nearest multiple of kLocalOriginGrid on
+/// each axis (a camera moving within a cell keeps the origin, so the geometry's
+/// floats do not change from frame to frame).
+Vec3d choose_local_origin(const Vec3d& camera_position);
+inline constexpr double kLocalOriginRadius = 1024;
+inline constexpr double kLocalOriginGrid = 64;
+
 /// Inverse of an affine matrix (last row 0 0 0 1, invertible upper 3x3).
 Mat4 affine_inverse(const Mat4& m);
 

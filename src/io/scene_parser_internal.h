@@ -3,6 +3,7 @@
 /// camera, background, materials) and scene_parser_objects.cpp (objects, lights).
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -18,6 +19,14 @@ struct ParseContext {
     SceneDesc* scene = nullptr;
     std::unordered_map<std::string, uint32_t> material_by_name;
     std::map<std::pair<std::string, bool>, int> texture_by_path;  ///< (resolved path, srgb) -> index
+    Vec3d origin{0, 0, 0};  ///< the scene's local origin (SceneDesc::origin), set with the camera
+
+    /// A world point relative to the local origin, subtracted in double, then rounded.
+    Vec3 local_point(const Vec3d& world) const { return Vec3(world - origin); }
+    /// An object's transform (identity when absent) followed by the move to the local origin.
+    Mat4 local_from_object(const std::optional<Mat4>& object) const {
+        return Mat4::translate(-origin) * object.value_or(Mat4::identity());
+    }
 
     /// Resolves a relative path from `where` and checks that the file exists.
     std::filesystem::path resolve_existing(const JsonValue& where) const;

@@ -52,7 +52,7 @@ Mat4 parse_transform(const JsonValue& v) {
     if (matrix) return parse_matrix(*matrix);
     Mat4 s = scale ? Mat4::scale(parse_scale(*scale)) : Mat4::identity();
     Mat4 r = rotate ? Mat4::rotate_euler(Vec3d(rotate->vec3())) : Mat4::identity();
-    Mat4 t = translate ? Mat4::translate(Vec3d(translate->vec3())) : Mat4::identity();
+    Mat4 t = translate ? Mat4::translate(translate->vec3d()) : Mat4::identity();
     return t * r * s;
 }
 
@@ -72,11 +72,19 @@ Vec3 checked_point(const JsonValue& where, const Vec3& p) {
     return p;
 }
 
+/// A point read in double, moved by `local_from_object` (the object's transform
+/// and the move to the local origin) and only then rounded to float.
+Vec3 placed_point(const JsonValue& where, const Mat4& local_from_object, const Vec3d& p) {
+    return checked_point(where, Vec3(local_from_object.map_point(p)));
+}
+
 // --- sphere, plane, box ---------------------------------------------------------------
 
 void parse_sphere(JsonObject& o, ParseContext& ctx) {
     SphereDesc s;
-    if (auto v = o.get("center")) s.center = v->vec3();
+    Vec3d center(0.0);
+    if (auto v = o.get("center")) center = v->vec3d();
+    s.center = ctx.local_point(center);
     if (auto v = o.get("radius")) s.radius = v->number_f(NumberRange::positive());
     if (auto v = o.get("velocity")) s.velocity = v->vec3();
     s.material = object_material(o, ctx);
@@ -90,7 +98,7 @@ void parse_sphere(JsonObject& o, ParseContext& ctx) {
         JsonValue where(o.value().json().at("transform"), ctx.file, o.child_path("transform"));
         if (!similar)
             where.fail("a sphere only takes a uniform scale (use an ellipsoid for non-uniform scale)");
-        s.center = checked_point(where, m->apply_point(s.center));
+        s.center = placed_point(where, ctx.local_from_object(m), center);
         s.velocity = checked_point(where, m->apply_vector(s.velocity));
         double r = double(s.radius) * l;
         if (!(r <= double(FLT_MAX))) where.fail("the transformed radius overflows 32-bit floats");
@@ -101,12 +109,14 @@ void parse_sphere(JsonObject& o, ParseContext& ctx) {
 
 void parse_plane(JsonObject& o, ParseContext& ctx) {
     PlaneDesc p;
-    if (auto v = o.get("point")) p.point = v->vec3();
+    Vec3d point(0.0);
+    if (auto v = o.get("point")) point = v->vec3d();
+    p.point = ctx.local_point(point);
     if (auto v = o.get("normal")) p.normal = normalize(v->nonzero_vec3());
     p.material = object_material(o, ctx);
     if (auto m = object_transform(o)) {
         JsonValue where(o.value().json().at("transform"), ctx.file, o.child_path("transform"));
-        p.point = checked_point(where, m->apply_point(p.point));
+        p.point = placed_point(where, ctx.local_from_object(m), point);
         p.normal = m->apply_normal(p.normal);
     }
     ctx.scene->planes.push_back(p);
@@ -127,7 +137,7 @@ bool keeps_axis_aligned(const Mat4& m) {
 
 /// A transformed box that is no longer axis-aligned becomes 12 triangles
 /// (4 vertices per face so each face keeps flat normals and its own UVs).
-TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, const Mat4& m, const std::string& name) {
+TriangleMesh box_mesh(const Vec3d& lo, const Vec3d& hi, const Mat4& m, const std::string& name) {
     TriangleMesh mesh;
     mesh.name = name;
     // Each face: the axis it faces along, its sign; corners CCW seen from outside.
@@ -138,11 +148,11 @@ TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, const Mat4& m, const std::
             uint32_t base = uint32_t(mesh.positions.size());
             const float uc[4] = {0, 1, 1, 0}, vc[4] = {0, 0, 1, 1};
             for (int k = 0; k < 4; ++k) {
-                Vec3 p;
+                Vec3d p;
                 p[axis] = side ? hi[axis] : lo[axis];
                 p[u] = uc[k] > 0 ? hi[u] : lo[u];
                 p[v] = vc[k] > 0 ? hi[v] : lo[v];
-                mesh.positions.push_back(m.apply_point(p));
+                mesh.positions.push_back(Vec3(m.map_point(p)));
                 mesh.uvs.push_back(Vec2{uc[k], vc[k]});
             }
             for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) mesh.indices.push_back(base + i);
@@ -154,10 +164,10 @@ TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi, const Mat4& m, const std::
 }
 
 void parse_box(JsonObject& o, ParseContext& ctx, size_t index) {
-    Vec3 lo(-1.0f), hi(1.0f);
-    if (auto v = o.get("min")) lo = v->vec3();
+    Vec3d lo(-1.0), hi(1.0);
+    if (auto v = o.get("min")) lo = v->vec3d();
     auto max_v = o.get("max");
-    if (max_v) hi = max_v->vec3();
+    if (max_v) hi = max_v->vec3d();
     if (hi.x <= lo.x || hi.y <= lo.y || hi.z <= lo.z) {
         JsonValue where = max_v ? *max_v : o.value();
         where.fail("expected max > min in every component, got min [" + format_number(lo.x) + ", " +
@@ -167,19 +177,20 @@ void parse_box(JsonObject& o, ParseContext& ctx, size_t index) {
     uint32_t material = object_material(o, ctx);
     auto m = object_transform(o);
     if (!m) {
-        ctx.scene->boxes.push_back(BoxDesc{lo, hi, material});
+        ctx.scene->boxes.push_back(BoxDesc{ctx.local_point(lo), ctx.local_point(hi), material});
         return;
     }
+    const Mat4 placed = ctx.local_from_object(m);
     JsonValue where(o.value().json().at("transform"), ctx.file, o.child_path("transform"));
     if (keeps_axis_aligned(*m)) {
         Bounds3 b;
         for (int c = 0; c < 8; ++c)
-            b.extend(checked_point(
-                where, m->apply_point(Vec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z))));
+            b.extend(placed_point(where, placed,
+                                  Vec3d(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z)));
         ctx.scene->boxes.push_back(BoxDesc{b.lo, b.hi, material});
         return;
     }
-    TriangleMesh mesh = box_mesh(lo, hi, *m, ctx.file + ": objects[" + std::to_string(index) + "] (box)");
+    TriangleMesh mesh = box_mesh(lo, hi, placed, ctx.file + ": objects[" + std::to_string(index) + "] (box)");
     for (const Vec3& p : mesh.positions) checked_point(where, p);
     mesh.material = material;
     ctx.scene->meshes.push_back(std::move(mesh));
@@ -192,7 +203,8 @@ void parse_mesh(JsonObject& o, ParseContext& ctx) {
     std::filesystem::path path = ctx.resolve_existing(file);
     std::optional<uint32_t> material;
     if (auto v = o.get("material")) material = ctx.material(*v);
-    Mat4 m = object_transform(o).value_or(Mat4::identity());
+    // The loaders apply the whole matrix in double, so the model lands at the local origin.
+    const Mat4 m = ctx.local_from_object(object_transform(o));
     LoadedModel model;
     try {
         model = ctx.loaders->load_model(path, m);
@@ -212,7 +224,7 @@ void parse_mesh(JsonObject& o, ParseContext& ctx) {
 
 /// Local frame with +z along `axis` and the origin at `origin`; the tangents
 /// follow Duff et al., "Building an Orthonormal Basis, Revisited" (JCGT 2017).
-Mat4 axis_frame(const Vec3& origin, const Vec3& axis) {
+Mat4 axis_frame(const Vec3d& origin, const Vec3& axis) {
     Vec3d n = normalize(Vec3d(axis));
     double sign = std::copysign(1.0, n.z);
     double a = -1.0 / (sign + n.z), b = n.x * n.y * a;
@@ -222,7 +234,7 @@ Mat4 axis_frame(const Vec3& origin, const Vec3& axis) {
         f.m[r][0] = t1[r];
         f.m[r][1] = t2[r];
         f.m[r][2] = n[r];
-        f.m[r][3] = double(origin[r]);
+        f.m[r][3] = origin[r];
     }
     return f;
 }
@@ -232,9 +244,13 @@ void set_disc_bounds(QuadricDesc& q, double r, double z0, double z1) {
 }
 
 /// Reads the named form's keys and derives its canonical coefficients and clip box.
-void parse_named_quadric(JsonObject& o, QuadricDesc& q, const char* origin_key) {
+/// `origin` receives the named point in double (q.origin keeps it as written, in float).
+void parse_named_quadric(JsonObject& o, QuadricDesc& q, const char* origin_key, Vec3d& origin) {
     const NumberRange pos = NumberRange::positive();
-    if (auto v = o.get(origin_key)) q.origin = v->vec3();
+    if (auto v = o.get(origin_key)) {
+        origin = v->vec3d();
+        q.origin = v->vec3();
+    }
     if (q.type != QuadricDesc::Type::ellipsoid)
         if (auto v = o.get("axis")) q.axis = normalize(v->nonzero_vec3());
     auto& c = q.coefficients;  // A B C D E F G H I J
@@ -313,15 +329,17 @@ void parse_quadric(JsonObject& o, ParseContext& ctx, QuadricDesc::Type type) {
     QuadricDesc q;
     q.type = type;
     static const char* origin_keys[] = {"center", "base", "apex", "vertex", "center", ""};
+    Vec3d origin(0.0);
     if (type == QuadricDesc::Type::general)
         parse_general_quadric(o, q);
     else
-        parse_named_quadric(o, q, origin_keys[int(type)]);
+        parse_named_quadric(o, q, origin_keys[int(type)], origin);
     q.material = object_material(o, ctx);
     Mat4 frame = type == QuadricDesc::Type::general     ? Mat4::identity()
-                 : type == QuadricDesc::Type::ellipsoid ? Mat4::translate(Vec3d(q.origin))
-                                                        : axis_frame(q.origin, q.axis);
-    q.world_from_local = object_transform(o).value_or(Mat4::identity()) * frame;
+                 : type == QuadricDesc::Type::ellipsoid ? Mat4::translate(origin)
+                                                        : axis_frame(origin, q.axis);
+    // "world" here is the scene's local frame (SceneDesc::origin).
+    q.world_from_local = ctx.local_from_object(object_transform(o)) * frame;
     q.local_from_world = affine_inverse(q.world_from_local);
     const Bounds3& lb = q.local_bounds;
     for (int c = 0; c < 8; ++c)
@@ -361,7 +379,7 @@ void parse_light(JsonObject o, ParseContext& ctx) {
     l.type =
         LightDesc::Type(o.require("type", "\"point\" or \"directional\"").one_of({"point", "directional"}));
     if (l.type == LightDesc::Type::point) {
-        if (auto v = o.get("position")) l.position = v->vec3();
+        if (auto v = o.get("position")) l.position = ctx.local_point(v->vec3d());
         l.intensity = Rgb(1.0f);
         if (auto v = o.get("intensity")) l.intensity = v->vec3(NumberRange::non_negative());
     } else {

@@ -68,12 +68,14 @@ struct Mat4 {
         return r;
     }
 
-    Vec3 apply_point(const Vec3& pf) const {
-        const Vec3d p(pf);
-        return Vec3(float(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3]),
-                    float(m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3]),
-                    float(m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]));
+    /// The point in double precision: far-away inputs (1e7 plus a small
+    /// offset) keep their digits until the caller rounds the result.
+    Vec3d map_point(const Vec3d& p) const {
+        return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+                m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+                m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
     }
+    Vec3 apply_point(const Vec3& pf) const { return Vec3(map_point(Vec3d(pf))); }
     Vec3 apply_vector(const Vec3& vf) const {
         const Vec3d v(vf);
         return Vec3(float(m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z),

@@ -14,9 +14,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string vec_text(const Vec3& v) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "[%g, %g, %g]", double(v.x), double(v.y), double(v.z));
+/// `digits` significant digits: 6 (printf's default) unless the values sit
+/// far from the origin, where 6 would hide everything but the offset.
+std::string vec_text(const Vec3d& v, int digits = 6) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "[%.*g, %.*g, %.*g]", digits, v.x, digits, v.y, digits, v.z);
     return buf;
 }
 
@@ -50,9 +52,14 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
     s.add_count("Lights", "Emissive materials",
                 uint64_t(std::count_if(d.materials.begin(), d.materials.end(), emits_light)));
     const Bounds3 b = scene.bounds();
+    // World coordinates: the scene is stored relative to its local origin.
+    const int digits = d.origin == Vec3d(0, 0, 0) ? 6 : 12;
+    if (d.origin != Vec3d(0, 0, 0))
+        s.add("Bounds", "Local origin", vec_text(d.origin, digits), {d.origin.x, d.origin.y, d.origin.z});
     if (scene.primitive_count() > scene.planes.size()) {
-        s.add("Bounds", "Min", vec_text(b.lo), {b.lo.x, b.lo.y, b.lo.z});
-        s.add("Bounds", "Max", vec_text(b.hi), {b.hi.x, b.hi.y, b.hi.z});
+        const Vec3d lo = Vec3d(b.lo) + d.origin, hi = Vec3d(b.hi) + d.origin;
+        s.add("Bounds", "Min", vec_text(lo, digits), {lo.x, lo.y, lo.z});
+        s.add("Bounds", "Max", vec_text(hi, digits), {hi.x, hi.y, hi.z});
     }
 }
 

@@ -19,8 +19,9 @@ inline Rgb eval_color(const ColorSource& src, const std::vector<TextureDesc>& te
             return src.color;
         case ColorSource::Kind::checker: {
             const float inv = 1.0f / src.checker_scale;
+            const Vec3 q = p + src.checker_offset;
             const long sum =
-                long(std::floor(p.x * inv)) + long(std::floor(p.y * inv)) + long(std::floor(p.z * inv));
+                long(std::floor(q.x * inv)) + long(std::floor(q.y * inv)) + long(std::floor(q.z * inv));
             return (sum & 1) ? src.odd : src.even;
         }
         case ColorSource::Kind::texture:
