@@ -65,7 +65,7 @@ __attribute__((always_inline)) inline void walk_crossings(const Bvh8& tree,
         return false;  // keeps tmax and the traversal going
     };
     NoTraversalCounters counters;
-    traverse_wide<true, kAvx>(tree, box_ray, fast_leaf, slow_leaf, counters);
+    traverse_wide<true, kAvx, false, kAvx>(tree, box_ray, fast_leaf, slow_leaf, counters);
 }
 
 template <bool kCountInFastLeaf, class OnHit>
@@ -74,7 +74,8 @@ void walk_crossings_sse2(const Bvh8& tree, std::span<const TriangleBlock4> block
     walk_crossings<false, kCountInFastLeaf>(tree, blocks, ray, fast_count, on_hit);
 }
 
-/// The same walk compiled for AVX2: 8-wide node tests and two leaf blocks in one step.
+/// The same walk compiled for AVX2: 8-wide node tests, two leaf blocks in one step, and
+/// node pairing as occlusion rays have it (nothing culls a pushed node here either).
 template <bool kCountInFastLeaf, class OnHit>
 __attribute__((target("avx2"))) void walk_crossings_avx2(const Bvh8& tree,
                                                          std::span<const TriangleBlock4> blocks,
