@@ -5,7 +5,9 @@
 /// exactly the float operations of TriangleVerts::intersect (geometry/triangle.h),
 /// in the same order and without fused multiply-adds, so the answers are
 /// bit-identical; a lane whose edge function is exactly 0 is redone by the
-/// scalar test (which then falls back to double, as the paper requires).
+/// scalar test (which then falls back to double, as the paper requires). Only
+/// those lanes can depend on the tie-break policy (geometry/triangle.h), so the
+/// scalar redo takes it as a parameter and the SIMD steps need none.
 ///
 /// Lanes that hold no triangle (another primitive kind, or padding) have NaN
 /// vertices, which every comparison rejects; the caller tests those kinds itself.
@@ -35,9 +37,15 @@ struct alignas(16) TriangleBlock4 {
 };
 static_assert(sizeof(TriangleBlock4) == 160, "40 bytes per triangle, like a leaf slot");
 
+/// Sign bits of a block's slots: its lanes of other kinds (padding has the sign bit clear).
+inline int other_lanes(const TriangleBlock4& block) {
+    return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
+}
+
 /// Scalar redo of the lanes of `b` in `lanes` (bit l: lane l) whose edge
 /// function was exactly 0 (double fallback included); returns the hit lanes as
 /// bits `shift + l`, their answers written to t/u/v_out[shift + l].
+template <class TieBreak = EdgesInclusive>
 __attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRay& tr,
                                                                 const TriangleBlock4& b, int lanes, int shift,
                                                                 float tmin, float tmax, float* t_out,
@@ -49,7 +57,7 @@ __attribute__((always_inline)) inline int redo_exact_zero_lanes(const TriangleRa
         const TriangleVerts tri{{{b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]},
                                  {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                  {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
-        if (const std::optional<ShapeHit> h = tri.intersect(tr, tmin, tmax)) {
+        if (const std::optional<ShapeHit> h = tri.intersect<TieBreak>(tr, tmin, tmax)) {
             t_out[shift + l] = h->t, u_out[shift + l] = h->u, v_out[shift + l] = h->v;
             result |= 1 << (shift + l);
         }

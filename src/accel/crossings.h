@@ -1,9 +1,10 @@
 #pragma once
 /// Every triangle a ray crosses, not only the nearest: the all-hits query of the
-/// Python ray caster (intersect_all, count_intersections). It walks the wide8
-/// tree and its leaf blocks as the closest-hit traversal does, but never lowers
-/// tmax, and tests triangles with cross_triangle (geometry/triangle_crossing.h),
-/// so a ray through a shared edge or vertex crosses there exactly once.
+/// Python ray caster (intersect_all, count_intersections). It walks the wide8 tree
+/// with the any-hit traversal, whose leaves here never report a hit, so no child is
+/// culled and tmax never shrinks; leaves are tested with the renderer's SIMD block
+/// test and the EdgesPerturbed tie-break (geometry/triangle.h), so a ray through a
+/// shared edge or vertex crosses there exactly once.
 #include <span>
 #include <vector>
 

@@ -8,7 +8,9 @@
 /// triangle into a space where the ray is the +z axis through the origin and
 /// evaluates 2-D edge functions there; when an edge function is exactly 0 in
 /// float it is recomputed in double, so neighbouring triangles agree on the
-/// sign of the shared edge.
+/// sign of the shared edge. What an edge function that is 0 even in double means
+/// (the ray passes exactly through an edge or a vertex) is the test's tie-break
+/// policy: EdgesInclusive (the renderer's) or EdgesPerturbed (crossing counts).
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -91,6 +93,46 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
 }
 }  // namespace detail
 
+/// Tie-break policies of the watertight test: what an edge function that is 0 even in
+/// double means (a ray exactly through an edge or a vertex). With kDecidesZeros the
+/// policy's inside(u, v, w, sheared vertices) decides such a hit; without, the sign
+/// test counts 0 as either sign.
+
+/// A ray through an edge or a vertex hits every triangle that shares it: a nearest
+/// hit then never slips between neighbours (the renderer's test).
+struct EdgesInclusive {
+    static constexpr bool kDecidesZeros = false;
+};
+
+/// A ray through an edge or a vertex hits exactly one of the triangles that share it,
+/// for counting crossings. An edge function that is exactly 0 takes the sign it would
+/// have with the ray moved by (eps, eps^2) in the sheared plane (simulation of
+/// simplicity, Edelsbrunner and Muecke 1990): the sign of its derivative along x, or
+/// along y when that is 0. The two triangles of a shared edge see the edge reversed,
+/// so exactly one keeps the point; at a vertex exactly one triangle of the fan does.
+/// A ray that only touches the surface (a silhouette edge or vertex) gets 0 or 2
+/// crossings there, so parity stays exact on closed meshes. Shared vertices must have
+/// bit-identical coordinates (welded or not), which any exported mesh has.
+struct EdgesPerturbed {
+    static constexpr bool kDecidesZeros = true;
+    /// Sign of an edge function f, or, when f is 0, of f at the perturbed ray: of gx,
+    /// else of gy. 0 only for an edge whose ends project to one point.
+    static int perturbed_sign(float f, float gx, float gy) {
+        if (f != 0.0f) return f > 0.0f ? 1 : -1;
+        if (gx != 0.0f) return gx > 0.0f ? 1 : -1;
+        if (gy != 0.0f) return gy > 0.0f ? 1 : -1;
+        return 0;
+    }
+    static bool inside(float u, float v, float w, float ax, float ay, float bx, float by, float cx, float cy) {
+        // The edge function p1 x p2 of a ray at (px, py) is (p1 - p) x (p2 - p): its
+        // derivatives are (y1 - y2, x2 - x1). A float difference has an exact sign.
+        const int su = perturbed_sign(u, cy - by, bx - cx);
+        const int sv = perturbed_sign(v, ay - cy, cx - ax);
+        const int sw = perturbed_sign(w, by - ay, ax - bx);
+        return (su > 0 && sv > 0 && sw > 0) || (su < 0 && sv < 0 && sw < 0);
+    }
+};
+
 /// The triangle shape: its three vertices as plain arrays (indexable by a runtime axis).
 struct TriangleVerts {
     static constexpr bool kBounded = true;
@@ -112,7 +154,8 @@ struct TriangleVerts {
     }
     bool occluded(const Ray& ray) const { return intersect(ray).has_value(); }
     /// intersect() with the ray's constants computed once per ray (`tr`), as the
-    /// BVH leaves call it, over (tmin, tmax).
+    /// BVH leaves call it, over (tmin, tmax); edges and vertices as TieBreak decides.
+    template <class TieBreak = EdgesInclusive>
     std::optional<ShapeHit> intersect(const TriangleRay& tr, float tmin, float tmax) const;
 };
 static_assert(sizeof(TriangleVerts) == 36);
@@ -120,6 +163,7 @@ static_assert(Shape<TriangleVerts>);
 
 /// Watertight test of one triangle; a hit needs tmin < t < tmax. Degenerate
 /// (zero-area) triangles never hit.
+template <class TieBreak>
 inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, float tmin, float tmax) const {
     const TriangleVerts& tri = *this;
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
@@ -142,6 +186,8 @@ inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, f
         u = detail::edge_function_double(cx, cy, bx, by);
         v = detail::edge_function_double(ax, ay, cx, cy);
         w = detail::edge_function_double(bx, by, ax, ay);
+        if constexpr (TieBreak::kDecidesZeros)
+            if (!TieBreak::inside(u, v, w, ax, ay, bx, by, cx, cy)) return std::nullopt;
     }
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return std::nullopt;
     const float det = u + v + w;

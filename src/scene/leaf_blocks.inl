@@ -52,11 +52,6 @@ __attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ra
     return mask;
 }
 
-/// Sign bits of a block's slots: its lanes of other kinds (padding has the sign bit clear).
-inline int other_lanes(const TriangleBlock4& block) {
-    return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
-}
-
 /// The common leaf, one or two blocks of triangles, without a call: a leaf with
 /// other kinds or more blocks, a lane with an exactly-zero edge function (the
 /// scalar redo) and every leaf of a scene with cut-outs (the alpha test) are

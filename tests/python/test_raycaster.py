@@ -169,6 +169,28 @@ def test_rays_through_icosphere_vertices_and_edges_cross_once(welded):
     assert np.all(caster.count_intersections(rays) == 1)
 
 
+@pytest.mark.parametrize("welded", [True, False])
+def test_rays_exactly_through_cube_vertices_and_edges_give_the_parity(welded):
+    """Corners and dyadic points of every edge (face diagonals included) as targets,
+    directions with power-of-two components, origins a dyadic step back: every float
+    operation of the triangle test is then exact, so each ray passes exactly through
+    its target, where only the tie-break decides."""
+    v, f = cube()
+    caster = sahara.RayCaster(*((v, f) if welded else unwelded(v, f)))
+    rng = np.random.default_rng(9)
+    n = 20000
+    tri, k = f[rng.integers(0, len(f), n)], rng.integers(0, 3, n)
+    a, b = v[tri[np.arange(n), k]], v[tri[np.arange(n), (k + 1) % 3]]
+    targets = a + (b - a) * rng.integers(0, 8, (n, 1)) / 8
+    dirs = rng.choice([-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0], size=(n, 3))
+    origins = targets - dirs * rng.integers(1, 17, (n, 1)) / 32
+    extent = np.abs(origins).max(1)
+    keep = (np.abs(dirs).max(1) > 0) & (extent != 1)  # not on a face plane
+    counts = caster.count_intersections(rays_from(origins[keep], dirs[keep]))
+    np.testing.assert_array_equal(counts % 2 == 1, extent[keep] < 1)
+    assert (extent[keep] < 1).sum() > 1000
+
+
 @pytest.mark.parametrize("mesh", ["cube", "icosphere"])
 def test_inside_outside_by_parity(mesh):
     v, f = cube() if mesh == "cube" else icosphere(3)
