@@ -50,7 +50,4 @@ SceneDesc default_scene();
 /// every triangle uses that material instead and the model's own are dropped.
 void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uint32_t> material_override);
 
-/// Inverse of an affine matrix (last row 0 0 0 1, invertible upper 3x3).
-Mat4 affine_inverse(const Mat4& m);
-
 }  // namespace sahara

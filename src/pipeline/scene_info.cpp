@@ -7,6 +7,7 @@
 
 #include "pipeline/material_info.h"
 #include "render/features.h"
+#include "scene/instances.h"
 
 namespace sahara {
 
@@ -49,8 +50,15 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
                 })));
     s.add_count("Lights", "Emissive materials",
                 uint64_t(std::count_if(d.materials.begin(), d.materials.end(), emits_light)));
+    if (const InstanceSet* in = scene.instances()) {
+        s.add_count("Instances", "Prototypes", in->prototype_count());
+        s.add_count("Instances", "Instances", in->instance_count());
+        s.add_count("Instances", "Triangles stored", in->unique_triangle_count());
+        s.add_count("Instances", "Triangles drawn", in->instanced_triangle_count());
+        s.add_bytes("Instances", "Trees", in->bytes());
+    }
     const Bounds3 b = scene.bounds();
-    if (scene.primitive_count() > scene.planes.size()) {
+    if (scene.primitive_count() > scene.planes.size() || scene.instances()) {
         s.add("Bounds", "Min", vec_text(b.lo), {b.lo.x, b.lo.y, b.lo.z});
         s.add("Bounds", "Max", vec_text(b.hi), {b.hi.x, b.hi.y, b.hi.z});
     }
