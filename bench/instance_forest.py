@@ -45,21 +45,25 @@ def main():
     rng = random.Random(args.seed)
     n, spacing = args.grid, 3.0
     half = (n - 1) * spacing / 2
+    # The named mesh stands at the origin, on grid cell (n // 2, n // 2); an instance's
+    # transform applies after the mesh's own, so every other cell is scale, rotate
+    # about the mesh's foot, then move there.
     objects = [
         {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "material": "ground"},
-        {"type": "mesh", "file": "blob.obj", "material": "blob", "name": "blob",
-         "transform": {"translate": [-half, -half, 0]}},
+        {"type": "mesh", "file": "blob.obj", "material": "blob", "name": "blob"},
     ]
-    for k in range(1, n * n):
+    for k in range(n * n):
         i, j = divmod(k, n)
+        if i == n // 2 and j == n // 2:
+            continue
         s = rng.uniform(0.6, 1.2)
         objects.append({"type": "instance", "of": "blob", "transform": {
             "scale": [s, s, s * rng.uniform(0.8, 1.5)],
             "rotate": [rng.uniform(-15, 15), rng.uniform(-15, 15), rng.uniform(0, 360)],
-            "translate": [i * spacing, j * spacing, 0]}})
+            "translate": [(i - n // 2) * spacing, (j - n // 2) * spacing, 0]}})
     scene = {
         "render": {"width": 320, "height": 240, "spp": 4, "max_depth": 4},
-        "camera": {"position": [-half - 20, -half - 20, 25], "look_at": [0, 0, 0], "up": [0, 0, 1], "vfov": 50},
+        "camera": {"position": [-half - 10, -half - 10, 30], "look_at": [0, 0, 0], "up": [0, 0, 1], "vfov": 50},
         "background": {"type": "gradient", "bottom": [1, 1, 1], "top": [0.5, 0.7, 1.0]},
         "materials": {"ground": {"type": "lambertian", "albedo": [0.4, 0.4, 0.35]},
                       "blob": {"type": "lambertian", "albedo": [0.3, 0.6, 0.3]}},
