@@ -114,7 +114,11 @@ SurfaceInteraction InstanceSet::interact(const Ray& ray, const Hit& hit) const {
     si.p = m.apply_point(si.p);
     si.ng = m.apply_normal(si.ng);
     si.ns = m.apply_normal(si.ns);
-    if (si.tangent != Vec3(0.0f)) si.tangent = m.apply_vector(si.tangent);
+    if (si.tangent != Vec3(0.0f)) {
+        si.tangent = m.apply_vector(si.tangent);
+        // A mirror flips the bitangent cross(n, t) against the uv direction (as transform_mesh does).
+        if (m.determinant3() < 0) si.tangent_sign = -si.tangent_sign;
+    }
     return si;
 }
 
