@@ -138,7 +138,8 @@ class SceneBuilder {
     }
 
     /// The primitive's triangles in the mesh's space (read once per key).
-    const std::optional<TriangleMesh>& cached_primitive(int mesh, size_t p, const std::vector<double>& weights) {
+    const std::optional<TriangleMesh>& cached_primitive(int mesh, size_t p,
+                                                        const std::vector<double>& weights) {
         const auto key = std::make_tuple(mesh, int(p), weights);
         if (!primitives_.count(key)) primitives_[key] = primitive(size_t(mesh), p, weights);
         return primitives_[key];

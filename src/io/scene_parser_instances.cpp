@@ -29,7 +29,8 @@ NamedObject parse_instance(JsonObject& o, ParseContext& ctx) {
     if (auto v = o.get("transform")) {
         m = parse_object_transform(*v);
         const double det = m.determinant3();
-        if (!(std::isfinite(det) && det != 0.0)) v->fail("is singular (an instance's transform must be invertible)");
+        if (!(std::isfinite(det) && det != 0.0))
+            v->fail("is singular (an instance's transform must be invertible)");
     }
     make_prototype(ctx, target, it->second);
     NamedObject placed;

@@ -423,7 +423,8 @@ void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uin
         }
         for (TextureDesc& t : model.textures) scene.textures.push_back(std::move(t));
     }
-    const auto mesh_offset = uint32_t(scene.meshes.size()), prototype_offset = uint32_t(scene.prototypes.size());
+    const auto mesh_offset = uint32_t(scene.meshes.size()),
+               prototype_offset = uint32_t(scene.prototypes.size());
     for (PrototypeDesc& p : model.prototypes) {
         for (uint32_t& m : p.meshes) m += mesh_offset;
         scene.prototypes.push_back(std::move(p));

@@ -42,12 +42,14 @@ Bounds3 transformed_bounds(const Bounds3& b, const Mat4& m) {
 
 InstanceSet::InstanceSet(const SceneDesc& desc) {
     prototypes_.reserve(desc.prototypes.size());
-    for (const PrototypeDesc& p : desc.prototypes) prototypes_.push_back(build_scene(prototype_desc(desc, p)));
+    for (const PrototypeDesc& p : desc.prototypes)
+        prototypes_.push_back(build_scene(prototype_desc(desc, p)));
     instances_.reserve(desc.instances.size());
     std::vector<Bounds3> boxes;
     std::vector<Vec3> centers;
     for (const InstanceDesc& in : desc.instances) {
-        instances_.push_back({Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.world_from_object});
+        instances_.push_back(
+            {Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.world_from_object});
         const Bounds3 b = transformed_bounds(prototypes_[in.prototype].bounds(), in.world_from_object);
         boxes.push_back(b);
         centers.push_back(b.lo.x <= b.hi.x ? b.center() : Vec3(0.0f));

@@ -98,7 +98,8 @@ uint64_t Scene::traversal_steps(const Ray& ray) const {
 }
 
 bool Scene::packets_pay_off() const {
-    if (!accel_ || instances_ || !layout_has_blocks(accel_->layout()) || !accel_->uses_tree() || accel_->has_cutouts())
+    if (!accel_ || instances_ || !layout_has_blocks(accel_->layout()) || !accel_->uses_tree() ||
+        accel_->has_cutouts())
         return false;
     return active_simd_path() != SimdPath::sse2;
 }

@@ -24,7 +24,8 @@ TEST_CASE("instances: a glTF whose two nodes share one mesh loads as one mesh an
     d.node({{"mesh", mesh}, {"translation", {2, 0, 0}}, {"scale", {1, 3, 1}}});
     TempDir dir("cli_instances_gltf");
     d.write(dir.path / "pair.gltf");
-    gltf::write_text(dir.path / "scene.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "up": [0, 1, 0]},
+    gltf::write_text(dir.path / "scene.json",
+                     R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "up": [0, 1, 0]},
                          "objects": [{"type": "mesh", "file": "pair.gltf"}]})");
 
     const SceneDesc desc = parse_scene_file(dir.path / "scene.json");
@@ -46,7 +47,7 @@ TEST_CASE("instances: a glTF whose two nodes share one mesh loads as one mesh an
 TEST_CASE("instances: an instance of an unknown name exits 2 naming it") {
     TempDir dir("cli_instances_bad_of");
     gltf::write_text(dir.path / "scene.json",
-               R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 1]},
+                     R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 1]},
                    "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "name": "ball"},
                                {"type": "instance", "of": "bal"}]})");
     const CliRun r = run_sahara("render scene.json -o out.png", dir);

@@ -35,8 +35,10 @@ SceneDesc camera_scene(int w, int h) {
     return d;
 }
 
-const Mat4 kFirst = Mat4::translate({-1.5, 0.3, 0}) * Mat4::rotate_euler({20, 35, 0}) * Mat4::scale({1, 0.6, 1.2});
-const Mat4 kSecond = Mat4::translate({1.6, -0.4, 1}) * Mat4::rotate_euler({0, -50, 15}) * Mat4::scale({0.7, 1.4, 0.9});
+const Mat4 kFirst =
+    Mat4::translate({-1.5, 0.3, 0}) * Mat4::rotate_euler({20, 35, 0}) * Mat4::scale({1, 0.6, 1.2});
+const Mat4 kSecond =
+    Mat4::translate({1.6, -0.4, 1}) * Mat4::rotate_euler({0, -50, 15}) * Mat4::scale({0.7, 1.4, 0.9});
 
 /// An icosphere with vertex normals (the shading normals get tested too).
 TriangleMesh smooth_ball() {
@@ -92,8 +94,9 @@ TEST_CASE("instances: an instanced mesh renders the same pixels as the same mesh
     // Vertex normals only under similarity transforms: under a non-uniform scale a
     // flattened mesh interpolates normals normalised after the transform, an instance
     // before it, which is a different (equally valid) shading normal, not rounding.
-    const Mat4 rigid[2] = {Mat4::translate({-1.5, 0.3, 0}) * Mat4::rotate_euler({20, 35, 0}) * Mat4::scale({1.2, 1.2, 1.2}),
-                           Mat4::translate({1.6, -0.4, 1}) * Mat4::rotate_euler({0, -50, 15})};
+    const Mat4 rigid[2] = {
+        Mat4::translate({-1.5, 0.3, 0}) * Mat4::rotate_euler({20, 35, 0}) * Mat4::scale({1.2, 1.2, 1.2}),
+        Mat4::translate({1.6, -0.4, 1}) * Mat4::rotate_euler({0, -50, 15})};
     const Mat4 stretched[2] = {kFirst, kSecond};
     for (bool smooth : {false, true})
         for (IntegratorType integrator : {IntegratorType::normals, IntegratorType::path}) {
@@ -192,9 +195,9 @@ TEST_CASE("instances: a name alone changes nothing and bad instances name the pr
     CHECK(build_scene(named).instances() == nullptr);
     auto error_of = [&](const std::string& objects) -> std::string {
         try {
-            parse_scene_json(R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 0]}, "objects": )" +
-                                 objects + "}",
-                             dir / "scene.json");
+            parse_scene_json(
+                R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 0]}, "objects": )" + objects + "}",
+                dir / "scene.json");
         } catch (const std::exception& e) {
             return e.what();
         }
@@ -205,6 +208,8 @@ TEST_CASE("instances: a name alone changes nothing and bad instances name the pr
     CHECK(error_of("[" + mesh + R"(, {"type": "instance", "of": "a", "transform": {"scale": [1, 0, 1]}}])")
               .find("objects[1].transform") != std::string::npos);
     CHECK(error_of("[" + mesh + ", " + mesh + "]").find("already names") != std::string::npos);
-    CHECK(error_of(R"([{"type": "sphere", "name": "s", "center": [0, 0, 0], "radius": 1}, {"type": "instance", "of": "s"}])")
-              .find("only those can be instanced") != std::string::npos);
+    CHECK(
+        error_of(
+            R"([{"type": "sphere", "name": "s", "center": [0, 0, 0], "radius": 1}, {"type": "instance", "of": "s"}])")
+            .find("only those can be instanced") != std::string::npos);
 }
