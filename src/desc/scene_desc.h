@@ -222,6 +222,21 @@ struct RenderSettings {
     bool packets = true;
 };
 
+/// Meshes drawn only through instances, in the prototype's own space: an instance
+/// places all of them with its transform. Every instance of a prototype shares one
+/// bottom-level tree (scene/instances.h).
+struct PrototypeDesc {
+    std::string name;             ///< for messages and `sahara info`
+    std::vector<uint32_t> meshes;  ///< indices into SceneDesc::meshes (each in one prototype at most)
+};
+
+/// One placement of a prototype. Nested instances are resolved while parsing: every
+/// instance here places a prototype directly, with the composed transform.
+struct InstanceDesc {
+    uint32_t prototype = 0;
+    Mat4 world_from_object;  ///< invertible (the parser checks)
+};
+
 struct SceneDesc {
     std::string source;  ///< scene file path, or "<default>" for the built-in scene
     /// World position of the point every position in this description is
@@ -241,6 +256,8 @@ struct SceneDesc {
     std::vector<TriangleMesh> meshes;
     std::vector<QuadricDesc> quadrics;  ///< bounded quadrics (ellipsoid, cylinder, cone, ...)
     std::vector<LightDesc> lights;
+    std::vector<PrototypeDesc> prototypes;  ///< empty unless something is instanced
+    std::vector<InstanceDesc> instances;
 };
 
 /// The default material of the scene format: lambertian [0.5, 0.5, 0.5].

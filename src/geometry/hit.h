@@ -1,5 +1,5 @@
 #pragma once
-/// The cheap result of a ray-primitive test (16 bytes). Rich surface data is
+/// The cheap result of a ray-primitive test (20 bytes). Rich surface data is
 /// computed once, for the accepted hit only (see scene/scene.h).
 #include <cstdint>
 
@@ -8,6 +8,8 @@
 namespace sahara {
 
 inline constexpr uint32_t kNoPrim = 0xFFFFFFFFu;
+/// Hit::instance of a hit on geometry that is not instanced.
+inline constexpr uint32_t kNoInstance = 0xFFFFFFFFu;
 
 /// Primitive ids carry their kind in the top three bits so that a leaf can hold
 /// mixed primitives and dispatch with a switch (no virtual call per test); the
@@ -25,8 +27,11 @@ struct Hit {
     float t = kInfinity;
     uint32_t prim = kNoPrim;  ///< made by make_prim_id; kNoPrim = miss
     float u = 0, v = 0;       ///< triangle barycentrics (of v1, v2); unused by spheres
+    /// The instance whose prototype holds `prim` (scene/instances.h); kNoInstance for
+    /// the scene's own primitives. Only the instance level writes it.
+    uint32_t instance = kNoInstance;
     bool hit() const { return prim != kNoPrim; }
 };
-static_assert(sizeof(Hit) == 16);
+static_assert(sizeof(Hit) == 20);
 
 }  // namespace sahara

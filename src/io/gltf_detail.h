@@ -82,7 +82,7 @@ void apply_skin(const Source& src, const tinygltf::Primitive& prim, const std::s
 
 /// Walks the default scene (node transforms, then `world_from_model`) into
 /// meshes, cameras and lights of `out`; drops zero-area triangles.
-void build_scene(const Source& src, const Mat4& world_from_model, LoadedModel& out);
+void build_scene(const Source& src, const Mat4& world_from_model, SharedMeshes shared, LoadedModel& out);
 
 /// Percent-decodes a URI reference ("my%20file.bin" -> "my file.bin").
 std::string uri_decode(const std::string& uri);

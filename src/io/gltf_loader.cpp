@@ -171,7 +171,7 @@ void parse(Source& src, const std::vector<unsigned char>& bytes) {
 
 }  // namespace
 
-LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model) {
+LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared) {
     Source src;
     src.file = file.string();
     src.dir = file.parent_path();
@@ -179,7 +179,7 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     precheck(src.file, src.dir, json_part(src.file, bytes));
     parse(src, bytes);
     LoadedModel out;
-    gltf::build_scene(src, world_from_model, out);
+    gltf::build_scene(src, world_from_model, shared, out);
     if (out.dropped_degenerate > 0)
         log_info(src.file + ": dropped " + std::to_string(out.dropped_degenerate) + " zero-area triangles");
     return out;

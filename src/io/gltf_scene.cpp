@@ -24,10 +24,19 @@ class SceneBuilder {
     SceneBuilder(const Source& src, const Mat4& world_from_model, LoadedModel& out)
         : src_(src), m_(src.model), world_from_model_(world_from_model), out_(out), materials_(src, out) {}
 
-    /// Node world matrices first (skins need their joints' matrices), then the meshes.
-    void build() {
+    /// Node world matrices first (skins need their joints' matrices), then the meshes:
+    /// a mesh that several unskinned nodes draw (with the same morph weights) is
+    /// loaded once, as a prototype, and each node places an instance of it.
+    void build(SharedMeshes shared) {
         for (int root : roots()) walk(root);
-        for (const auto& [node, world] : drawn_) add_mesh(node, world);
+        std::map<InstanceKey, int> uses;
+        for (const auto& [node, world] : drawn_)
+            if (auto key = instance_key(node); key && shared == SharedMeshes::instance) ++uses[*key];
+        for (const auto& [node, world] : drawn_) {
+            const std::optional<InstanceKey> key = instance_key(node);
+            if (key && uses[*key] > 1 && add_instance(*key, world)) continue;
+            add_mesh(node, world);
+        }
     }
 
    private:
@@ -117,6 +126,56 @@ class SceneBuilder {
         return w;
     }
 
+    using InstanceKey = std::pair<int, std::vector<double>>;  ///< mesh, morph weights
+
+    /// What makes two nodes draw the same triangles; none for skinned nodes (posed
+    /// each on its own) and for nodes whose mesh does not exist (add_mesh says so).
+    std::optional<InstanceKey> instance_key(int node_index) const {
+        const tinygltf::Node& node = m_.nodes[size_t(node_index)];
+        if (node.skin >= 0 || size_t(node.mesh) >= m_.meshes.size()) return std::nullopt;
+        return InstanceKey{node.mesh, morph_weights(node, m_.meshes[size_t(node.mesh)],
+                                                    indexed("nodes", size_t(node_index)))};
+    }
+
+    /// The primitive's triangles in the mesh's space (read once per key).
+    const std::optional<TriangleMesh>& cached_primitive(int mesh, size_t p,
+                                                        const std::vector<double>& weights) {
+        const auto key = std::make_tuple(mesh, int(p), weights);
+        if (!primitives_.count(key)) primitives_[key] = primitive(size_t(mesh), p, weights);
+        return primitives_[key];
+    }
+
+    /// Places the prototype of `key` (made at its first use) with `world`; false when the
+    /// transform cannot be inverted (the caller then copies the triangles).
+    bool add_instance(const InstanceKey& key, const Mat4& world) {
+        const double det = world.determinant3();
+        if (!(std::isfinite(det) && det != 0.0)) return false;
+        auto it = prototype_of_.find(key);
+        if (it == prototype_of_.end()) {
+            const auto [mesh, weights] = key;
+            PrototypeDesc proto;
+            proto.name = src_.file + ": " + indexed("meshes", size_t(mesh));
+            for (size_t p = 0; p < m_.meshes[size_t(mesh)].primitives.size(); ++p) {
+                const std::optional<TriangleMesh>& cached = cached_primitive(mesh, p, weights);
+                if (!cached) continue;
+                TriangleMesh copy = *cached;
+                copy.name = proto.name + "." + indexed("primitives", p);
+                out_.dropped_degenerate += remove_degenerate(copy);
+                if (copy.indices.empty()) continue;
+                proto.meshes.push_back(uint32_t(out_.meshes.size()));
+                out_.meshes.push_back(std::move(copy));
+            }
+            int index = -1;
+            if (!proto.meshes.empty()) {
+                index = int(out_.prototypes.size());
+                out_.prototypes.push_back(std::move(proto));
+            }
+            it = prototype_of_.emplace(key, index).first;
+        }
+        if (it->second >= 0) out_.instances.push_back({uint32_t(it->second), world});
+        return true;
+    }
+
     void add_mesh(int node_index, const Mat4& world) {
         const tinygltf::Node& node = m_.nodes[size_t(node_index)];
         const std::string node_element = indexed("nodes", size_t(node_index));
@@ -128,9 +187,7 @@ class SceneBuilder {
         const std::vector<double> weights = morph_weights(node, gmesh, node_element);
         const std::optional<std::vector<Mat4>> joints = joint_matrices(node, node_element);
         for (size_t p = 0; p < gmesh.primitives.size(); ++p) {
-            const auto key = std::make_tuple(mesh, int(p), weights);
-            if (!primitives_.count(key)) primitives_[key] = primitive(size_t(mesh), p, weights);
-            const std::optional<TriangleMesh>& cached = primitives_[key];
+            const std::optional<TriangleMesh>& cached = cached_primitive(mesh, p, weights);
             if (!cached) continue;
             TriangleMesh instance = *cached;
             instance.name = src_.file + ": " + node_element + " " + indexed("meshes", size_t(mesh)) + "." +
@@ -277,12 +334,13 @@ class SceneBuilder {
     std::map<int, Mat4> node_world_;           ///< world matrix of every node in the scene
     std::vector<std::pair<int, Mat4>> drawn_;  ///< nodes with a mesh, in walk order
     std::map<std::tuple<int, int, std::vector<double>>, std::optional<TriangleMesh>> primitives_;
+    std::map<InstanceKey, int> prototype_of_;  ///< prototype index per shared mesh; -1: no triangles
 };
 
 }  // namespace
 
-void build_scene(const Source& src, const Mat4& world_from_model, LoadedModel& out) {
-    SceneBuilder(src, world_from_model, out).build();
+void build_scene(const Source& src, const Mat4& world_from_model, SharedMeshes shared, LoadedModel& out) {
+    SceneBuilder(src, world_from_model, out).build(shared);
 }
 
 }  // namespace sahara::gltf

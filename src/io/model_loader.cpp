@@ -5,12 +5,12 @@
 
 namespace sahara {
 
-LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model) {
+LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared) {
     switch (file_kind(file)) {
         case FileKind::obj:
             return load_obj(file, world_from_model);
         case FileKind::gltf:
-            return load_gltf(file, world_from_model);
+            return load_gltf(file, world_from_model, shared);
         default:
             throw input_error(
                 file.string(), "",

@@ -17,12 +17,22 @@ struct LoadedModel {
     std::vector<TextureDesc> textures;
     std::vector<LightDesc> lights;    ///< KHR_lights_punctual
     std::vector<CameraDesc> cameras;  ///< glTF cameras, world space
+    /// glTF meshes that several nodes draw: each one prototype (mesh indices into
+    /// `meshes`, in the mesh's own space) placed by one instance per node.
+    std::vector<PrototypeDesc> prototypes;
+    std::vector<InstanceDesc> instances;
     size_t dropped_degenerate = 0;    ///< zero-area triangles removed
 };
 
+/// What a loader does with a glTF mesh that several nodes draw: copy it per node
+/// (every consumer of plain meshes), or load it once as a prototype placed by
+/// LoadedModel::instances (scene files, which the renderer instances).
+enum class SharedMeshes : uint8_t { copy, instance };
+
 /// Picks the loader by extension. Throws InputError naming the file and element.
 /// `world_from_model` is applied to positions/normals (and glTF node transforms before it).
-LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity(),
+                       SharedMeshes shared = SharedMeshes::copy);
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
 
 /// How load_obj reads a file for the BVH tools (io/mesh_triangles.h) rather than for rendering.
@@ -33,6 +43,7 @@ struct ObjReadOptions {
 };
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model,
                      const ObjReadOptions& options);
-LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
+LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity(),
+                      SharedMeshes shared = SharedMeshes::copy);
 
 }  // namespace sahara

@@ -198,7 +198,7 @@ void parse_box(JsonObject& o, ParseContext& ctx, size_t index) {
 
 // --- mesh --------------------------------------------------------------------------------
 
-void parse_mesh(JsonObject& o, ParseContext& ctx) {
+NamedObject parse_mesh(JsonObject& o, ParseContext& ctx) {
     JsonValue file = o.require("file", "a mesh file (.obj, .gltf or .glb)");
     std::filesystem::path path = ctx.resolve_existing(file);
     std::optional<uint32_t> material;
@@ -217,7 +217,19 @@ void parse_mesh(JsonObject& o, ParseContext& ctx) {
     if (!model.cameras.empty())
         log_info(path.string() + ": ignoring " + std::to_string(model.cameras.size()) +
                  " camera(s); the scene's camera is used");
-    merge_loaded_model(*ctx.scene, std::move(model), material);
+    SceneDesc& scene = *ctx.scene;
+    const size_t first_mesh = scene.meshes.size(), first_prototype = scene.prototypes.size(),
+                 first_instance = scene.instances.size();
+    merge_loaded_model(scene, std::move(model), material);
+    NamedObject named;
+    named.instanceable = true;
+    std::vector<bool> prototyped(scene.meshes.size() - first_mesh, false);
+    for (size_t p = first_prototype; p < scene.prototypes.size(); ++p)
+        for (uint32_t mesh : scene.prototypes[p].meshes) prototyped[mesh - first_mesh] = true;
+    for (size_t k = 0; k < prototyped.size(); ++k)
+        if (!prototyped[k]) named.pending_meshes.push_back(uint32_t(first_mesh + k));
+    named.parts.assign(scene.instances.begin() + ptrdiff_t(first_instance), scene.instances.end());
+    return named;
 }
 
 // --- quadrics ------------------------------------------------------------------------------
@@ -352,8 +364,9 @@ void parse_quadric(JsonObject& o, ParseContext& ctx, QuadricDesc::Type type) {
 
 void parse_object(JsonObject o, ParseContext& ctx, size_t index) {
     size_t type = o.require("type", "the object type")
-                      .one_of({"sphere", "plane", "box", "mesh", "ellipsoid", "cylinder", "cone",
+                      .one_of({"sphere", "plane", "box", "mesh", "instance", "ellipsoid", "cylinder", "cone",
                                "paraboloid", "hyperboloid", "quadric"});
+    NamedObject named;
     switch (type) {
         case 0:
             parse_sphere(o, ctx);
@@ -365,11 +378,20 @@ void parse_object(JsonObject o, ParseContext& ctx, size_t index) {
             parse_box(o, ctx, index);
             break;
         case 3:
-            parse_mesh(o, ctx);
+            named = parse_mesh(o, ctx);
+            break;
+        case 4:
+            named = parse_instance(o, ctx);
             break;
         default:
-            parse_quadric(o, ctx, QuadricDesc::Type(type - 4));
+            parse_quadric(o, ctx, QuadricDesc::Type(type - 5));
             break;
+    }
+    // Read last, so that unknown-key messages list the type's own keys first.
+    if (std::optional<JsonValue> name = o.get("name")) {
+        const std::string text = name->string();
+        if (ctx.named.count(text)) name->fail("\"" + text + "\" already names an earlier object");
+        ctx.named[text] = std::move(named);
     }
     o.finish();
 }
@@ -402,24 +424,7 @@ void parse_lights(ParseContext& ctx, const JsonValue& lights) {
     for (const JsonValue& v : lights.array()) parse_light(JsonObject(v), ctx);
 }
 
-Mat4 affine_inverse(const Mat4& m) {
-    // Inverse 3x3 = adjugate / determinant; translation = -inverse3x3 * t.
-    const auto& a = m.m;
-    double det = m.determinant3();
-    Mat4 r;
-    r.m[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) / det;
-    r.m[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) / det;
-    r.m[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) / det;
-    r.m[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) / det;
-    r.m[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) / det;
-    r.m[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) / det;
-    r.m[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
-    r.m[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
-    r.m[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
-    for (int i = 0; i < 3; ++i)
-        r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
-    return r;
-}
+Mat4 parse_object_transform(const JsonValue& v) { return parse_transform(v); }
 
 void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uint32_t> material_override) {
     const uint32_t material_offset = uint32_t(scene.materials.size());
@@ -435,6 +440,16 @@ void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uin
             scene.materials.push_back(std::move(m));
         }
         for (TextureDesc& t : model.textures) scene.textures.push_back(std::move(t));
+    }
+    const auto mesh_offset = uint32_t(scene.meshes.size()),
+               prototype_offset = uint32_t(scene.prototypes.size());
+    for (PrototypeDesc& p : model.prototypes) {
+        for (uint32_t& m : p.meshes) m += mesh_offset;
+        scene.prototypes.push_back(std::move(p));
+    }
+    for (InstanceDesc& in : model.instances) {
+        in.prototype += prototype_offset;
+        scene.instances.push_back(in);
     }
     for (TriangleMesh& mesh : model.meshes) {
         if (material_override) {

@@ -106,4 +106,24 @@ struct Mat4 {
     }
 };
 
+/// Inverse of an affine matrix (last row 0 0 0 1, invertible upper 3x3).
+inline Mat4 affine_inverse(const Mat4& m) {
+    // Inverse 3x3 = adjugate / determinant; translation = -inverse3x3 * t.
+    const auto& a = m.m;
+    double det = m.determinant3();
+    Mat4 r;
+    r.m[0][0] = (a[1][1] * a[2][2] - a[1][2] * a[2][1]) / det;
+    r.m[0][1] = (a[0][2] * a[2][1] - a[0][1] * a[2][2]) / det;
+    r.m[0][2] = (a[0][1] * a[1][2] - a[0][2] * a[1][1]) / det;
+    r.m[1][0] = (a[1][2] * a[2][0] - a[1][0] * a[2][2]) / det;
+    r.m[1][1] = (a[0][0] * a[2][2] - a[0][2] * a[2][0]) / det;
+    r.m[1][2] = (a[0][2] * a[1][0] - a[0][0] * a[1][2]) / det;
+    r.m[2][0] = (a[1][0] * a[2][1] - a[1][1] * a[2][0]) / det;
+    r.m[2][1] = (a[0][1] * a[2][0] - a[0][0] * a[2][1]) / det;
+    r.m[2][2] = (a[0][0] * a[1][1] - a[0][1] * a[1][0]) / det;
+    for (int i = 0; i < 3; ++i)
+        r.m[i][3] = -(r.m[i][0] * a[0][3] + r.m[i][1] * a[1][3] + r.m[i][2] * a[2][3]);
+    return r;
+}
+
 }  // namespace sahara

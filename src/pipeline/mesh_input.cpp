@@ -1,6 +1,7 @@
 #include "pipeline/mesh_input.h"
 
 #include "base/error.h"
+#include "base/log.h"
 #include "io/files.h"
 #include "io/scene_parser.h"
 
@@ -23,6 +24,9 @@ ToolInput read_tool_input(const std::filesystem::path& file) {
     }
     if (!std::filesystem::is_regular_file(file)) throw input_error(file.string(), "", "no such file");
     in.scene = build_scene(parse_scene_file(file));
+    if (in.scene.instances())
+        log_warning(file.string() +
+                    ": its instances are left out (bvh and bench measure the flat tree only)");
     in.from_scene_file = true;
     in.triangles.name = file.string();
     in.triangles.positions = in.scene.triangles.positions;

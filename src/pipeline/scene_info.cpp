@@ -7,6 +7,7 @@
 
 #include "pipeline/material_info.h"
 #include "render/features.h"
+#include "scene/instances.h"
 
 namespace sahara {
 
@@ -51,12 +52,19 @@ void describe_contents(StatsReport& s, const SceneDesc& d, const Scene& scene) {
                 })));
     s.add_count("Lights", "Emissive materials",
                 uint64_t(std::count_if(d.materials.begin(), d.materials.end(), emits_light)));
+    if (const InstanceSet* in = scene.instances()) {
+        s.add_count("Instances", "Prototypes", in->prototype_count());
+        s.add_count("Instances", "Instances", in->instance_count());
+        s.add_count("Instances", "Triangles stored", in->unique_triangle_count());
+        s.add_count("Instances", "Triangles drawn", in->instanced_triangle_count());
+        s.add_bytes("Instances", "Trees", in->bytes());
+    }
     const Bounds3 b = scene.bounds();
     // World coordinates: the scene is stored relative to its local origin.
     const int digits = d.origin == Vec3d(0, 0, 0) ? 6 : 12;
     if (d.origin != Vec3d(0, 0, 0))
         s.add("Bounds", "Local origin", vec_text(d.origin, digits), {d.origin.x, d.origin.y, d.origin.z});
-    if (scene.primitive_count() > scene.planes.size()) {
+    if (scene.primitive_count() > scene.planes.size() || scene.instances()) {
         const Vec3d lo = Vec3d(b.lo) + d.origin, hi = Vec3d(b.hi) + d.origin;
         s.add("Bounds", "Min", vec_text(lo, digits), {lo.x, lo.y, lo.z});
         s.add("Bounds", "Max", vec_text(hi, digits), {hi.x, hi.y, hi.z});

@@ -213,6 +213,8 @@ bool sample_light(const Scene& scene, const Vec3& p, float time, float u_select,
 }
 
 uint32_t emitter_of_hit(const Scene& scene, const Hit& hit) {
+    // Instanced emitters are not light-sampled: found by BSDF sampling alone (MIS weight 1).
+    if (hit.instance != kNoInstance) return kNoEmitter;
     const uint32_t i = prim_index(hit.prim);
     switch (prim_kind(hit.prim)) {
         case PrimKind::sphere:

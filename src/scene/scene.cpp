@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <stdexcept>
 
 #include "scene/accelerator.h"
+#include "scene/instances.h"
 #include "scene/tangents.h"
 #include "accel/packet.h"
 #include "accel/simd_path.h"
@@ -28,7 +30,10 @@ void Scene::build_accelerator() {
     options.layout = render.bvh_layout;
     accel_ = std::make_unique<Accelerator>(*this, options);
     bounds_ = accel_->bounds();
+    if (instances_) bounds_.extend(instances_->bounds());
 }
+
+void Scene::set_instances(std::unique_ptr<InstanceSet> instances) { instances_ = std::move(instances); }
 
 namespace {
 
@@ -51,11 +56,13 @@ bool intersect_planes(const std::vector<Plane>& planes, Ray& ray, Hit& hit) {
 bool Scene::intersect(Ray& ray, Hit& hit) const {
     count_ray(RayKind::closest_hit);
     bool found = accel_ ? accel_->intersect(ray, hit) : false;
+    if (instances_) found |= instances_->intersect(ray, hit);
     found |= intersect_planes(planes, ray, hit);
     return found;
 }
 
 void Scene::intersect_packet(RayPacket& packet, HitPacket& hits) const {
+    if (instances_) throw std::logic_error("Scene::intersect_packet: the scene has instances");
     if (accel_) {
         accel_->intersect_packet(packet, hits);
     } else {
@@ -77,6 +84,7 @@ void Scene::intersect_packet(RayPacket& packet, HitPacket& hits) const {
 bool Scene::occluded(const Ray& ray) const {
     count_ray(RayKind::shadow);
     if (accel_ && accel_->occluded(ray)) return true;
+    if (instances_ && instances_->occluded(ray)) return true;
     return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
 }
 
@@ -90,7 +98,8 @@ uint64_t Scene::traversal_steps(const Ray& ray) const {
 }
 
 bool Scene::packets_pay_off() const {
-    if (!accel_ || !layout_has_blocks(accel_->layout()) || !accel_->uses_tree() || accel_->has_cutouts())
+    if (!accel_ || instances_ || !layout_has_blocks(accel_->layout()) || !accel_->uses_tree() ||
+        accel_->has_cutouts())
         return false;
     return active_simd_path() != SimdPath::sse2;
 }
@@ -267,6 +276,7 @@ Quadric make_quadric(const QuadricDesc& d) {
 }
 
 SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
+    if (hit.instance != kNoInstance) return instances_->interact(ray, hit);
     SurfaceInteraction si;
     const uint32_t idx = prim_index(hit.prim);
     switch (prim_kind(hit.prim)) {
@@ -311,8 +321,10 @@ SurfaceInteraction Scene::interact(const Ray& ray, const Hit& hit) const {
     return si;
 }
 
-Scene build_scene(const SceneDesc& desc) {
-    Scene scene;
+namespace {
+
+/// Everything but the trees: the runtime copies of the description's primitives.
+void fill_scene(const SceneDesc& desc, Scene& scene) {
     scene.source = desc.source;
     scene.render = desc.render;
     scene.camera = desc.camera;
@@ -354,6 +366,40 @@ Scene build_scene(const SceneDesc& desc) {
         for (uint32_t idx : m.indices) soup.indices.push_back(base + idx);
         for (size_t t = 0; t < m.triangle_count(); ++t)
             soup.material.push_back(m.material_ids.empty() ? m.material : m.material_ids[t]);
+    }
+}
+
+/// The description without its prototypes' meshes and its instances: what the flat tree holds.
+SceneDesc uninstanced_part(const SceneDesc& desc) {
+    std::vector<bool> in_prototype(desc.meshes.size(), false);
+    for (const PrototypeDesc& p : desc.prototypes)
+        for (uint32_t m : p.meshes) in_prototype[m] = true;
+    SceneDesc flat;
+    flat.source = desc.source;
+    flat.render = desc.render;
+    flat.camera = desc.camera;
+    flat.background = desc.background;
+    flat.materials = desc.materials;
+    flat.textures = desc.textures;
+    flat.spheres = desc.spheres;
+    flat.planes = desc.planes;
+    flat.boxes = desc.boxes;
+    flat.quadrics = desc.quadrics;
+    flat.lights = desc.lights;
+    for (size_t m = 0; m < desc.meshes.size(); ++m)
+        if (!in_prototype[m]) flat.meshes.push_back(desc.meshes[m]);
+    return flat;
+}
+
+}  // namespace
+
+Scene build_scene(const SceneDesc& desc) {
+    Scene scene;
+    if (desc.prototypes.empty()) {
+        fill_scene(desc, scene);  // the flat scene as it always was: nothing copied
+    } else {
+        fill_scene(uninstanced_part(desc), scene);
+        if (!desc.instances.empty()) scene.set_instances(std::make_unique<InstanceSet>(desc));
     }
     scene.build_accelerator();
     scene.prepare_lighting(false);

@@ -71,6 +71,7 @@ struct Emitter {
 inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
 
 class Accelerator;  // scene/accelerator.h: the BVH over bounded primitives
+class InstanceSet;  // scene/instances.h: the instance level of a two-level BVH
 
 class Scene {
    public:
@@ -83,6 +84,8 @@ class Scene {
     bool intersect(Ray& ray, Hit& hit) const;
     /// intersect() for the active lanes of a 16-ray packet (accel/packet.h):
     /// the same hits, up to ties between primitives at exactly the same distance.
+    /// Not for scenes with instances (a HitPacket has no instance id; packets_pay_off()
+    /// is false there): throws std::logic_error.
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
     /// Whether anything blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
@@ -96,15 +99,15 @@ class Scene {
     /// before build_accelerator(). For the bvh-cost image.
     uint64_t traversal_steps(const Ray& ray) const;
     /// Whether intersect_packet() traces camera rays faster than single rays
-    /// here: packets are enabled (accel/packet.h), the tree has the block
-    /// layout (wide8) without cut-outs, and the instruction set is AVX2 or
+    /// here: packets are enabled (accel/packet.h), the scene has no instances, the
+    /// tree has the block layout (wide8) without cut-outs, and the instruction set is AVX2 or
     /// AVX-512 (the SSE2 packet kernel is slower than single rays).
     bool packets_pay_off() const;
     /// Triangles whose hits pass the alpha test (cut-outs); 0 when traversal
     /// runs without it.
     size_t cutout_triangle_count() const;
 
-    /// Bounds of all bounded primitives (planes excluded).
+    /// Bounds of all bounded primitives (planes excluded), instances included.
     Bounds3 bounds() const { return bounds_; }
     size_t primitive_count() const;
 
@@ -140,16 +143,22 @@ class Scene {
     /// feature set; `force_all_features` turns every feature on.
     void prepare_lighting(bool force_all_features);
     const Accelerator* accelerator() const { return accel_.get(); }
+    /// The instance level; null for scenes without instances (the flat tree alone).
+    const InstanceSet* instances() const { return instances_.get(); }
+    /// Adds the instance level; call before build_accelerator() (bounds include it).
+    void set_instances(std::unique_ptr<InstanceSet> instances);
 
    private:
     std::unique_ptr<Accelerator> accel_;
+    std::unique_ptr<InstanceSet> instances_;
     Bounds3 bounds_;
 };
 
 /// The runtime quadric for a parsed quadric object.
 Quadric make_quadric(const QuadricDesc& desc);
 
-/// Builds the runtime scene from plain data (merges meshes, builds the BVH).
+/// Builds the runtime scene from plain data (merges the meshes that are not in a
+/// prototype, builds the BVH; with instances, also the instance level).
 Scene build_scene(const SceneDesc& desc);
 
 }  // namespace sahara

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "scene/instances.h"
 #include "scene/scene.h"
 #include "scene/texture.h"
 
@@ -42,6 +43,7 @@ float bounding_radius(const Scene& s) {
     for (const Sphere& sp : s.spheres) b.extend(sp.bounds(s.camera.shutter_open, s.camera.shutter_close));
     for (const Vec3& p : s.triangles.positions) b.extend(p);
     for (const Box& bx : s.boxes) b.extend(bx.box);
+    if (s.instances()) b.extend(s.instances()->bounds());
     if (b.empty()) return 1.0f;
     const float r = 0.5f * length(b.extent());
     return r > 0 && std::isfinite(r) ? r : 1.0f;

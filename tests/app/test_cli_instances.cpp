@@ -1,0 +1,58 @@
+// Instances through the command line: a glTF whose nodes share a mesh, and the
+// scene format's `instance` object with a name that does not exist.
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+
+#include "app/cmd_info.h"
+#include "cli_test_util.h"
+#include "io/gltf_test_doc.h"
+#include "io/model_loader.h"
+#include "io/scene_parser.h"
+
+using namespace sahara;
+using namespace sahara::test;
+using nlohmann::json;
+
+TEST_CASE("instances: a glTF whose two nodes share one mesh loads as one mesh and two instances") {
+    gltf::Doc d;
+    const int mesh = d.mesh(d.positions(gltf::kTriangle));
+    d.node({{"mesh", mesh}, {"translation", {-2, 0, 0}}});
+    d.node({{"mesh", mesh}, {"translation", {2, 0, 0}}, {"scale", {1, 3, 1}}});
+    TempDir dir("cli_instances_gltf");
+    d.write(dir.path / "pair.gltf");
+    gltf::write_text(dir.path / "scene.json",
+                     R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "up": [0, 1, 0]},
+                         "objects": [{"type": "mesh", "file": "pair.gltf"}]})");
+
+    const SceneDesc desc = parse_scene_file(dir.path / "scene.json");
+    CHECK(desc.meshes.size() == 1);
+    REQUIRE(desc.prototypes.size() == 1);
+    CHECK(desc.instances.size() == 2);
+    // A plain model load (sahara view, the BVH tools) still copies per node.
+    CHECK(load_model(dir.path / "pair.gltf").meshes.size() == 2);
+
+    const json j = scene_info(dir / "scene.json").to_json();
+    CHECK(j["Instances"]["Prototypes"] == 1);
+    CHECK(j["Instances"]["Instances"] == 2);
+    CHECK(j["Instances"]["Triangles stored"] == 1);
+    CHECK(j["Instances"]["Triangles drawn"] == 2);
+    CHECK(j["Bounds"]["Max"][0].get<double>() == doctest::Approx(3));
+    CHECK(j["Bounds"]["Max"][1].get<double>() == doctest::Approx(3));
+}
+
+TEST_CASE("instances: an instance of an unknown name exits 2 naming it") {
+    TempDir dir("cli_instances_bad_of");
+    gltf::write_text(dir.path / "scene.json",
+                     R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 1]},
+                   "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "name": "ball"},
+                               {"type": "instance", "of": "bal"}]})");
+    const CliRun r = run_sahara("render scene.json -o out.png", dir);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("\"bal\"") != std::string::npos);
+    CHECK(r.err.find("objects[1].of") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir.path / "out.png"));
+}
