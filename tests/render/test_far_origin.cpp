@@ -60,7 +60,15 @@ std::string far_scene(const Vec3d& offset, const std::filesystem::path& dir) {
         {{"type", "mesh"},
          {"file", "pyramid.obj"},
          {"material", "green"},
+         {"name", "pyramid"},
          {"transform", {{"translate", at(o, -0.2, 1.2, 0)}, {"rotate", {0, 0, 17}}}}},
+        // Placed again, turned 90 degrees about the vertical through `o` and
+        // shifted by (0.6, -0.2, 0): a rotation whose pivot is far from the
+        // world origin, which the local frame must conjugate exactly.
+        {{"type", "instance"},
+         {"of", "pyramid"},
+         {"transform",
+          {{"matrix", {0, -1, 0, o.x + o.y + 0.6, 1, 0, 0, o.y - o.x - 0.2, 0, 0, 1, 0, 0, 0, 0, 1}}}}},
         {{"type", "mesh"}, {"file", "tetra.gltf"}, {"material", "red"}},
         {{"type", "cylinder"},
          {"base", at(o, 1.6, -0.4, 0)},
