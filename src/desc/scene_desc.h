@@ -73,6 +73,7 @@ struct MaterialDesc {
     float alpha = 1.0f;
     int alpha_texture = -1;
     std::optional<float> alpha_cutoff;  ///< set: MASK; unset with alpha < 1 or texture: stochastic
+    bool vertex_alpha = false;          ///< alpha also times the mesh's COLOR_0 alpha (glTF MASK/BLEND)
 
     // --- pbr only: glTF 2.0 metallic-roughness (see docs/scene-format.md) ---
     float metallic = 1.0f;

@@ -210,24 +210,18 @@ class SceneBuilder {
         const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
         const std::string element = indexed("meshes", mesh) + "." + indexed("primitives", p);
         out->material = materials_.get(prim.material, element + ".material", !out->colors.empty());
-        note_vertex_alpha(*out, prim.material, element);
+        mark_vertex_alpha(*out, prim.material);
         return out;
     }
 
-    /// COLOR_0's alpha would scale a MASK or BLEND material's alpha; the renderer
-    /// does not use it yet, so it is named (once per material) rather than dropped silently.
-    void note_vertex_alpha(const TriangleMesh& mesh, int material, const std::string& element) {
-        if (material < 0) return;  // the default material is OPAQUE: glTF ignores alpha there
+    /// COLOR_0's alpha scales a MASK or BLEND material's alpha (the specification's
+    /// base colour is factor x texture x COLOR_0, alpha included); OPAQUE ignores it.
+    void mark_vertex_alpha(const TriangleMesh& mesh, int material) {
+        if (material < 0) return;  // the default material is OPAQUE
         const std::string& mode = m_.materials[size_t(material)].alphaMode;
         if (mode.empty() || mode == "OPAQUE") return;
-        if (std::all_of(mesh.color_alphas.begin(), mesh.color_alphas.end(),
-                        [](float a) { return a >= 1.0f; }))
-            return;
-        std::vector<std::string>& ignored = out_.materials[mesh.material].ignored;
-        if (std::find(ignored.begin(), ignored.end(), "vertex-colour alpha") != ignored.end()) return;
-        ignored.push_back("vertex-colour alpha");
-        log_warning(src_.file + ": " + element +
-                    ".attributes.COLOR_0: its alpha is not used yet (its colour is)");
+        if (std::any_of(mesh.color_alphas.begin(), mesh.color_alphas.end(), [](float a) { return a < 1.0f; }))
+            out_.materials[mesh.material].vertex_alpha = true;
     }
 
     /// For a skinned node: world_from_model x each joint's world matrix x its inverse

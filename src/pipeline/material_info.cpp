@@ -59,7 +59,7 @@ std::vector<std::pair<std::string, int>> textures_of(const MaterialDesc& m) {
 /// "opaque", "mask" (cut at alpha_cutoff) or "blend" (stochastic transparency).
 const char* alpha_mode(const MaterialDesc& m) {
     if (m.alpha_cutoff) return "mask";
-    return m.alpha < 1.0f || m.alpha_texture >= 0 ? "blend" : "opaque";
+    return m.alpha < 1.0f || m.alpha_texture >= 0 || m.vertex_alpha ? "blend" : "opaque";
 }
 
 bool attenuates(const MaterialDesc& m) {
@@ -80,7 +80,8 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     value["textures"] = textures;
     const bool pbr = m.type == MaterialType::pbr;
     value["vertex_colors"] = pbr && m.vertex_colors;
-    if (pbr && m.vertex_colors) parts.push_back("vertex colours");
+    value["vertex_alpha"] = m.vertex_alpha;
+    if (pbr && m.vertex_colors) parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
     value["emission"] = emits_light(m);
     if (emits_light(m) && m.type != MaterialType::emissive) parts.push_back("emission");
     const bool transmits = pbr && (m.transmission > 0.0f || m.transmission_texture >= 0);

@@ -46,7 +46,9 @@ float cutout_hash(const Ray& ray, uint32_t prim_id) {
     return float(h >> 40) * 0x1p-24f;
 }
 
-bool is_cutout_material(const MaterialDesc& m) { return m.alpha < 1.0f || m.alpha_texture >= 0; }
+bool is_cutout_material(const MaterialDesc& m) {
+    return m.alpha < 1.0f || m.alpha_texture >= 0 || m.vertex_alpha;
+}
 
 std::vector<uint8_t> one_sided_triangles(const Scene& scene) {
     std::vector<uint8_t> one_sided(scene.materials.size(), 0);
@@ -86,6 +88,7 @@ AlphaFilter::AlphaFilter(const Scene& scene) {
             Cutout c;
             c.alpha = md.alpha;
             c.cutoff = md.alpha_cutoff ? *md.alpha_cutoff : -1.0f;
+            c.vertex_alpha = md.vertex_alpha && !soup.color_alphas.empty();
             if (md.alpha_texture >= 0 && size_t(md.alpha_texture) < scene.textures.size() &&
                 scene.textures[size_t(md.alpha_texture)].image) {
                 c.texture = int(textures_.size());
@@ -98,8 +101,11 @@ AlphaFilter::AlphaFilter(const Scene& scene) {
         Triangle tri{};
         // Without UVs, interact() uses the barycentrics as uv: the same here.
         const Vec2 bary[3] = {{0, 0}, {1, 0}, {0, 1}};
-        for (int k = 0; k < 3; ++k)
-            tri.uv[k] = soup.uvs.empty() ? bary[k] : soup.uvs[soup.indices[3 * size_t(t) + size_t(k)]];
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t vertex = soup.indices[3 * size_t(t) + size_t(k)];
+            tri.uv[k] = soup.uvs.empty() ? bary[k] : soup.uvs[vertex];
+            tri.vertex_alpha[k] = soup.color_alphas.empty() ? 1.0f : soup.color_alphas[vertex];
+        }
         tri.cutout = cutout_of[m];
         entry_[t] = uint32_t(triangles_.size());
         triangles_.push_back(tri);
@@ -109,13 +115,15 @@ AlphaFilter::AlphaFilter(const Scene& scene) {
 float AlphaFilter::alpha(uint32_t entry, float u, float v) const {
     const Triangle& tri = triangles_[entry];
     const Cutout& c = cutouts_[tri.cutout];
-    if (c.texture < 0) return c.alpha;
     const float w = 1.0f - u - v;
+    float a = c.alpha;
+    if (c.vertex_alpha) a *= tri.vertex_alpha[0] * w + tri.vertex_alpha[1] * u + tri.vertex_alpha[2] * v;
+    if (c.texture < 0) return a;
     const Vec2 uv{tri.uv[0].x * w + tri.uv[1].x * u + tri.uv[2].x * v,
                   tri.uv[0].y * w + tri.uv[1].y * u + tri.uv[2].y * v};
-    float a = 1.0f;
-    sample_texture_rgb(textures_[size_t(c.texture)], uv, &a);
-    return c.alpha * a;
+    float texture_alpha = 1.0f;
+    sample_texture_rgb(textures_[size_t(c.texture)], uv, &texture_alpha);
+    return a * texture_alpha;
 }
 
 bool AlphaFilter::passes(uint32_t entry, const Ray& ray, uint32_t prim_id, float u, float v) const {

@@ -4,8 +4,10 @@
 /// missed that triangle: it neither shortens the ray nor counts as occlusion,
 /// so foliage and fences modelled as textured cards stay see-through.
 ///
-/// Materials with `alpha_cutoff` (glTF MASK) pass where alpha >= cutoff; the
-/// others with alpha < 1 or an alpha texture (glTF BLEND, OBJ d / map_d) are
+/// Alpha is the material's constant times its texture's alpha times, for glTF
+/// `vertex_alpha` materials, the interpolated COLOR_0 alpha. Materials with
+/// `alpha_cutoff` (glTF MASK) pass where alpha >= cutoff; the others with
+/// alpha < 1, an alpha texture or vertex alpha (glTF BLEND, OBJ d / map_d) are
 /// stochastic transparency (Enderton et al., "Stochastic Transparency", 2010):
 /// a hit passes when a hash of (ray origin, direction, primitive) in [0, 1) is
 /// below alpha. The hash makes every answer a pure function of the ray, so
@@ -59,11 +61,13 @@ class AlphaFilter {
     struct Cutout {
         float alpha = 1.0f;
         float cutoff = -1.0f;       ///< < 0: stochastic
-        int texture = -1;  ///< into textures_
+        int texture = -1;           ///< into textures_
+        bool vertex_alpha = false;  ///< also times the triangle's interpolated vertex alpha
     };
-    /// One cut-out triangle: its vertex UVs and its material.
+    /// One cut-out triangle: its vertex UVs, vertex alphas and its material.
     struct Triangle {
         Vec2 uv[3];
+        float vertex_alpha[3];  ///< 1 where the mesh has none
         uint32_t cutout;
     };
     std::vector<uint32_t> entry_;  ///< per scene triangle: index into triangles_, or kOpaque
@@ -72,7 +76,7 @@ class AlphaFilter {
     std::vector<TextureDesc> textures_;
 };
 
-/// Whether a material cuts holes: alpha below 1 or an alpha texture.
+/// Whether a material cuts holes: alpha below 1, an alpha texture or vertex alpha.
 bool is_cutout_material(const MaterialDesc& m);
 /// Per scene triangle: 1 where its material is one-sided (back faces invisible);
 /// empty when no triangle is.

@@ -182,12 +182,13 @@ void append_attribute(std::vector<T>& out, const std::vector<T>& values, size_t 
 /// The meshes' second UV set, vertex colours and tangents, merged in the order
 /// build_scene merges positions (tangents generated where a normal map needs them).
 void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
-    bool any_uv1 = false, any_colors = false, any_tangents = false;
+    bool any_uv1 = false, any_colors = false, any_alphas = false, any_tangents = false;
     std::vector<std::vector<std::array<float, 4>>> tangents(desc.meshes.size());
     for (size_t k = 0; k < desc.meshes.size(); ++k) {
         const TriangleMesh& m = desc.meshes[k];
         any_uv1 |= !m.uvs1.empty();
         any_colors |= !m.colors.empty();
+        any_alphas |= !m.color_alphas.empty();
         if (m.tangents.size() == m.positions.size() && !m.tangents.empty())
             tangents[k] = m.tangents;
         else if (uses_normal_map(desc, m))
@@ -200,6 +201,7 @@ void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
         total += n;
         if (any_uv1) append_attribute(soup.uvs1, desc.meshes[k].uvs1, n, total, Vec2{0, 0});
         if (any_colors) append_attribute(soup.colors, desc.meshes[k].colors, n, total, Rgb(1.0f));
+        if (any_alphas) append_attribute(soup.color_alphas, desc.meshes[k].color_alphas, n, total, 1.0f);
         if (any_tangents)
             append_attribute(soup.tangents, tangents[k], n, total, std::array<float, 4>{0, 0, 0, 1});
     }

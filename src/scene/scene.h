@@ -39,6 +39,7 @@ struct TriangleSoup {
     std::vector<Vec2> uvs;                       ///< empty or per position
     std::vector<Vec2> uvs1;                      ///< empty or per position (second UV set)
     std::vector<Rgb> colors;                     ///< empty or per position (vertex colours)
+    std::vector<float> color_alphas;             ///< empty or per position (vertex colours' alpha)
     std::vector<std::array<float, 4>> tangents;  ///< empty or per position (xyz, bitangent sign)
     std::vector<uint32_t> indices;
     std::vector<uint32_t> material;  ///< per triangle

@@ -64,22 +64,24 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
         CHECK_MESSAGE(m["textures"].contains(role), std::string(role));
     CHECK_FALSE(m["textures"].contains("alpha"));  // glTF's alpha comes with the base colour
     CHECK(m["vertex_colors"] == true);
+    CHECK(m["vertex_alpha"] == true);  // BLEND: COLOR_0's alpha 0.5 is used
     CHECK(m["emission"] == true);
     CHECK(m["transmission"].get<double>() == doctest::Approx(0.5));
     CHECK(m["alpha_mode"] == "blend");
     CHECK(m["double_sided"] == false);
     const json& ignored = j["Ignored inputs"]["[0] paint"];
-    for (const char* what : {"occlusion map", "KHR_materials_clearcoat", "vertex-colour alpha"})
+    for (const char* what : {"occlusion map", "KHR_materials_clearcoat"})
         CHECK_MESSAGE(contains(ignored, what), std::string(what));
     CHECK_FALSE(contains(ignored, "volume attenuation (not rendered yet)"));  // rendered now
     CHECK(m["volume_attenuation"] == true);
+    CHECK_FALSE(contains(ignored, "vertex-colour alpha"));  // used now
 
     // The text form says the same.
     TempDir run("info_pbr_text");
     const CliRun r = run_sahara("info " + file, run);
     CHECK(r.code == 0);
     for (const char* text : {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
-                             "vertex colours", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
+                             "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
                              "Ignored inputs", "occlusion map, KHR_materials_clearcoat"})
         CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
 }
@@ -92,6 +94,7 @@ TEST_CASE("info: an opaque glTF material has no alpha and ignores no vertex-colo
     CHECK(m["double_sided"] == true);
     CHECK(m["textures"].empty());
     CHECK(m["vertex_colors"] == true);
+    CHECK(m["vertex_alpha"] == false);
     CHECK_FALSE(j.contains("Ignored inputs"));  // OPAQUE: glTF itself ignores alpha
 }
 

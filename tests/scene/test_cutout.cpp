@@ -14,6 +14,7 @@
 #include "render/features.h"
 #include "scene/scene.h"
 #include "io/scene_parser.h"
+#include "io/gltf_test_doc.h"
 
 using namespace sahara;
 using namespace sahara::test;
@@ -373,4 +374,59 @@ TEST_CASE("cut-outs: BVH layouts agree with brute force with the filter on") {
             }
             CHECK(bad == 0);
         }
+}
+
+namespace {
+
+/// A scene holding a glTF unit quad in z = 0 whose COLOR_0 alphas are `alphas`
+/// (corners (0,0), (1,0), (1,1), (0,1)), with a double-sided material of `mode`.
+Scene vertex_alpha_quad(const fs::path& dir, const char* mode, const std::vector<float>& alphas) {
+    gltf::Doc d;
+    const int pos = d.positions({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0});
+    const int idx = d.accessor(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}, 5123, "SCALAR", 6);
+    std::vector<float> rgba;
+    for (float a : alphas) rgba.insert(rgba.end(), {0.8f, 0.8f, 0.8f, a});
+    const int colors = d.accessor(rgba, 5126, "VEC4", 4);
+    const int mesh = d.mesh(pos, idx, 4, {{"COLOR_0", colors}});
+    d.j["meshes"][size_t(mesh)]["primitives"][0]["material"] = 0;
+    d.j["materials"] = {{{"alphaMode", mode}, {"doubleSided", true}}};
+    d.node({{"mesh", mesh}});
+    d.write(dir / "quad.gltf");
+    std::ofstream(dir / "scene.json")
+        << R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0]},
+ "objects": [{"type": "mesh", "file": "quad.gltf"}]})";
+    return build_scene(parse_scene_file(dir / "scene.json"));
+}
+
+}  // namespace
+
+TEST_CASE("cut-outs: glTF COLOR_0 alpha scales MASK and BLEND alpha and OPAQUE ignores it") {
+    const fs::path dir = gltf::scratch("vertex_alpha");
+    // Alpha 0 along x = 0 and 1 along x = 1: a MASK at 0.5 is open on the left half.
+    const Scene mask = vertex_alpha_quad(dir, "MASK", {0, 1, 1, 0});
+    REQUIRE(mask.accelerator()->has_cutouts());
+    CHECK(mask.materials.at(mask.triangles.material[0]).vertex_alpha);
+    for (int i = 1; i < 20; ++i) {
+        const float x = float(i) / 20.0f;
+        if (std::abs(x - 0.5f) < 1e-3f) continue;
+        INFO("x = " << x);
+        CHECK(mask.occluded(ray_through({x, 0.5f, 1.0f}, {x, 0.5f})) == (x > 0.5f));
+    }
+
+    // Alpha 0.3 everywhere, blended: about 30% of varied rays are stopped.
+    const Scene blend = vertex_alpha_quad(dir, "BLEND", {0.3f, 0.3f, 0.3f, 0.3f});
+    const int n = 20000 / kSanitizerDivisor;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    int occluded = 0;
+    for (Vec2 q : uniform_points(n, 13))
+        occluded += blend.occluded(ray_through({0.5f + u(rng), 0.5f + u(rng), 1.0f}, q)) ? 1 : 0;
+    CHECK(std::abs(double(occluded) / n - 0.3) < four_sigma(0.3, n));
+
+    // OPAQUE: glTF ignores alpha, so the quad stops every ray.
+    const Scene opaque = vertex_alpha_quad(dir, "OPAQUE", {0, 0, 0, 0});
+    CHECK_FALSE(opaque.materials.at(opaque.triangles.material[0]).vertex_alpha);
+    CHECK_FALSE(opaque.accelerator()->has_cutouts());
+    for (Vec2 c : square_centres()) CHECK(opaque.occluded(ray_through({0.5f, 0.5f, 1.0f}, c)));
+    fs::remove_all(dir);
 }
