@@ -10,6 +10,7 @@
 #include "math/bounds.h"
 #include "math/ray.h"
 #include "desc/scene_desc.h"
+#include "io/mesh_utils.h"  // mesh_bounds
 
 namespace sahara::test {
 
@@ -191,12 +192,6 @@ inline size_t count_repeated_corner_triangles(const TriangleMesh& m) {
         n += a == b || b == c || a == c;
     }
     return n;
-}
-
-inline Bounds3 mesh_bounds(const TriangleMesh& m) {
-    Bounds3 b;
-    for (const Vec3& p : m.positions) b.extend(p);
-    return b;
 }
 
 /// Seeded random rays: origins uniformly in `b` grown by 50% on every side
