@@ -227,7 +227,7 @@ struct RenderSettings {
 /// places all of them with its transform. Every instance of a prototype shares one
 /// bottom-level tree (scene/instances.h).
 struct PrototypeDesc {
-    std::string name;             ///< for messages and `sahara info`
+    std::string name;              ///< for messages and `sahara info`
     std::vector<uint32_t> meshes;  ///< indices into SceneDesc::meshes (each in one prototype at most)
 };
 

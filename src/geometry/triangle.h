@@ -123,7 +123,8 @@ struct EdgesPerturbed {
         if (gy != 0.0f) return gy > 0.0f ? 1 : -1;
         return 0;
     }
-    static bool inside(float u, float v, float w, float ax, float ay, float bx, float by, float cx, float cy) {
+    static bool inside(float u, float v, float w, float ax, float ay, float bx, float by, float cx,
+                       float cy) {
         // The edge function p1 x p2 of a ray at (px, py) is (p1 - p) x (p2 - p): its
         // derivatives are (y1 - y2, x2 - x1). A float difference has an exact sign.
         const int su = perturbed_sign(u, cy - by, bx - cx);

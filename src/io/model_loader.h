@@ -21,7 +21,7 @@ struct LoadedModel {
     /// `meshes`, in the mesh's own space) placed by one instance per node.
     std::vector<PrototypeDesc> prototypes;
     std::vector<InstanceDesc> instances;
-    size_t dropped_degenerate = 0;    ///< zero-area triangles removed
+    size_t dropped_degenerate = 0;  ///< zero-area triangles removed
 };
 
 /// What a loader does with a glTF mesh that several nodes draw: copy it per node

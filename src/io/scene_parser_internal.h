@@ -38,7 +38,7 @@ struct ParseContext {
     Mat4 local_from_object(const std::optional<Mat4>& object) const {
         return Mat4::translate(-origin) * object.value_or(Mat4::identity());
     }
-    std::unordered_map<std::string, NamedObject> named;            ///< objects by their "name"
+    std::unordered_map<std::string, NamedObject> named;  ///< objects by their "name"
 
     /// Resolves a relative path from `where` and checks that the file exists.
     std::filesystem::path resolve_existing(const JsonValue& where) const;

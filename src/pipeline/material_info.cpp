@@ -81,7 +81,8 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     const bool pbr = m.type == MaterialType::pbr;
     value["vertex_colors"] = pbr && m.vertex_colors;
     value["vertex_alpha"] = m.vertex_alpha;
-    if (pbr && m.vertex_colors) parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
+    if (pbr && m.vertex_colors)
+        parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
     value["emission"] = emits_light(m);
     if (emits_light(m) && m.type != MaterialType::emissive) parts.push_back("emission");
     const bool transmits = pbr && (m.transmission > 0.0f || m.transmission_texture >= 0);

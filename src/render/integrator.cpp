@@ -149,13 +149,14 @@ struct Medium {
     /// The medium after a refraction through `m` (from its front when `entering`).
     static Medium after_refraction(const MaterialDesc& m, bool entering) {
         Medium out;
-        if (!entering || m.type != MaterialType::pbr || m.thin_walled || !std::isfinite(m.attenuation_distance) ||
-            !(m.attenuation_distance > 0.0f))
+        if (!entering || m.type != MaterialType::pbr || m.thin_walled ||
+            !std::isfinite(m.attenuation_distance) || !(m.attenuation_distance > 0.0f))
             return out;
         for (int c = 0; c < 3; ++c) {
             const float color = std::clamp(m.attenuation_color[c], 0.0f, 1.0f);
             // Colour 0 absorbs everything: -log(0) = inf, kept finite so that distance 0 gives 1.
-            out.sigma[c] = std::min(-std::log(color) / m.attenuation_distance, std::numeric_limits<float>::max());
+            out.sigma[c] =
+                std::min(-std::log(color) / m.attenuation_distance, std::numeric_limits<float>::max());
         }
         out.absorbs = max_component(out.sigma) > 0.0f;
         return out;

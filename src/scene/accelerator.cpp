@@ -367,7 +367,8 @@ bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, floa
                                          {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                          {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
                 h = tri.intersect(tr, ray.tmin, tmax);
-                if (h && !one_sided_.empty() && culls(id, ray.dir, tri.vertex(0), tri.vertex(1), tri.vertex(2)))
+                if (h && !one_sided_.empty() &&
+                    culls(id, ray.dir, tri.vertex(0), tri.vertex(1), tri.vertex(2)))
                     h.reset();
                 if (h && !alpha_.empty() && !keep_triangle_hit(ray, id, h->u, h->v)) h.reset();
             } else {

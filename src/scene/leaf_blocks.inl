@@ -39,7 +39,8 @@ inline Vec3 block_vertex(const TriangleBlock4& b, int v, int l) {
     return Vec3(b.p[v][0][l], b.p[v][1][l], b.p[v][2][l]);
 }
 
-__attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ray& ray, const TriangleBlock4* b0,
+__attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ray& ray,
+                                                                        const TriangleBlock4* b0,
                                                                         const TriangleBlock4* b1,
                                                                         int mask) const {
     for (int m = mask; m; m &= m - 1) {
@@ -120,7 +121,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             else
                 mask = intersect_triangle_block4(tr, blocks_[b], ray.tmin, tmax, t, u, v);
         }
-        if (mask && !one_sided_.empty()) mask = cull_block_lanes(ray, &blocks_[b], &blocks_[b + (pair ? 1 : 0)], mask);
+        if (mask && !one_sided_.empty())
+            mask = cull_block_lanes(ray, &blocks_[b], &blocks_[b + (pair ? 1 : 0)], mask);
         if constexpr (kCutouts)
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
@@ -159,7 +161,8 @@ __attribute__((always_inline)) inline bool Accelerator::test_slots(const Ray& ra
         if (prim_kind(id) == PrimKind::triangle) {
             h = slots_[s].tri.intersect(tr, ray.tmin, tmax);
             const TriangleVerts& v = slots_[s].tri;
-            if (h && !one_sided_.empty() && culls(id, ray.dir, v.vertex(0), v.vertex(1), v.vertex(2))) continue;
+            if (h && !one_sided_.empty() && culls(id, ray.dir, v.vertex(0), v.vertex(1), v.vertex(2)))
+                continue;
             if constexpr (kCutouts)
                 if (h && !keep_triangle_hit(ray, id, h->u, h->v)) continue;
         } else {

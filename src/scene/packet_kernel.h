@@ -37,11 +37,11 @@ struct PacketContext {
     const TriangleBlock4* blocks;
     const Accelerator* accel;
     const uint8_t* one_sided;  ///< per triangle: 1 when one-sided (Accelerator::culls); null: none is
-    int kx, ky, kz;   ///< watertight-test axis permutation, common to all active rays
-    int neg[3];       ///< direction sign per axis, common to all active rays
-    int near_off[3];  ///< offset of each axis's near planes in a node, in units of N floats
-    int far_off[3];   ///< offset of each axis's far planes, in units of N floats
-    int first;        ///< first active lane
+    int kx, ky, kz;            ///< watertight-test axis permutation, common to all active rays
+    int neg[3];                ///< direction sign per axis, common to all active rays
+    int near_off[3];           ///< offset of each axis's near planes in a node, in units of N floats
+    int far_off[3];            ///< offset of each axis's far planes, in units of N floats
+    int first;                 ///< first active lane
 };
 
 namespace packet_kernel {
@@ -183,13 +183,13 @@ template <int kIsa>
 /// The rays of `mask` that meet the front of triangle lane `l` of `b` (the float
 /// operations of Accelerator::culls, so single rays and packets agree).
 template <int kIsa>
-[[gnu::always_inline]] inline uint32_t front_facing_rays(const PacketContext& c, const TriangleBlock4& b, int l,
-                                                         uint32_t mask) {
+[[gnu::always_inline]] inline uint32_t front_facing_rays(const PacketContext& c, const TriangleBlock4& b,
+                                                         int l, uint32_t mask) {
     const Vec3 a(b.p[0][0][l], b.p[0][1][l], b.p[0][2][l]);
     const Vec3 n = cross(Vec3(b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]) - a,
                          Vec3(b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]) - a);
-    const F d = splat<kIsa>(n.x) * load<kIsa>(c.rays->dir[0]) + splat<kIsa>(n.y) * load<kIsa>(c.rays->dir[1]) +
-                splat<kIsa>(n.z) * load<kIsa>(c.rays->dir[2]);
+    const F d = splat<kIsa>(n.x) * load<kIsa>(c.rays->dir[0]) +
+                splat<kIsa>(n.y) * load<kIsa>(c.rays->dir[1]) + splat<kIsa>(n.z) * load<kIsa>(c.rays->dir[2]);
     return mask & ~mask_of<kIsa>(d >= F{});  // NaN counts as the front, as in culls
 }
 

@@ -111,8 +111,8 @@ float textured_pbr_radiance(const Scene& s, uint32_t i, const MaterialDesc& m) {
     float sum = 0;
     for (const Vec2& b : bary) {
         const Vec3 p = p0 * (1.0f - b.x - b.y) + p1 * b.x + p2 * b.y;
-        const SurfaceInteraction si =
-            s.interact(Ray{p + n, -n, 0.0f, 2.0f, 0.0f}, Hit{1.0f, make_prim_id(PrimKind::triangle, i), b.x, b.y});
+        const SurfaceInteraction si = s.interact(Ray{p + n, -n, 0.0f, 2.0f, 0.0f},
+                                                 Hit{1.0f, make_prim_id(PrimKind::triangle, i), b.x, b.y});
         sum += average(eval_color(m.radiance, s.textures, si.p, tex.texcoord == 1 ? si.uv1 : si.uv));
     }
     return sum / 7.0f;

@@ -81,8 +81,8 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     const CliRun r = run_sahara("info " + file, run);
     CHECK(r.code == 0);
     for (const char* text : {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
-                             "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
-                             "Ignored inputs", "occlusion map, KHR_materials_clearcoat"})
+                             "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend",
+                             "one-sided", "Ignored inputs", "occlusion map, KHR_materials_clearcoat"})
         CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
 }
 

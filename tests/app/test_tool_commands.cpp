@@ -232,8 +232,9 @@ TEST_CASE("bench --embree-quality: accepted names and bad values") {
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-quality", "HIGH"}).first == 2);
     CHECK(run_captured(run_bench_command, {"bench", mesh, "--embree-quality"}).first == 2);
     // Without Embree the option is still accepted (and reported), the comparison skipped.
-    const auto noembree = run_captured(run_bench_command, {"bench", mesh, "--size", "8", "--repeat", "1",
-                                                           "--embree-quality", "low", "--no-embree", "--json"});
+    const auto noembree = run_captured(
+        run_bench_command,
+        {"bench", mesh, "--size", "8", "--repeat", "1", "--embree-quality", "low", "--no-embree", "--json"});
     REQUIRE(noembree.first == 0);
     CHECK(noembree.second.find("\"embree_quality\":\"low\"") != std::string::npos);
 }
@@ -242,9 +243,9 @@ TEST_CASE("bench against Embree at each build quality: same hits [needs Embree]"
           doctest::skip(!EmbreeReference::available())) {
     for (const char* quality : {"low", "medium", "high"}) {
         CAPTURE(quality);
-        const auto bench = run_captured(run_bench_command, {"bench", kToolMesh, "--size", "32", "--repeat", "1",
-                                                            "--threads", "2", "--embree-quality", quality,
-                                                            "--json"});
+        const auto bench =
+            run_captured(run_bench_command, {"bench", kToolMesh, "--size", "32", "--repeat", "1", "--threads",
+                                             "2", "--embree-quality", quality, "--json"});
         REQUIRE(bench.first == 0);
         CHECK(bench.second.find(std::string("\"embree_quality\":\"") + quality + "\"") != std::string::npos);
         CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);

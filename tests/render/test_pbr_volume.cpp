@@ -46,7 +46,8 @@ Stat through_slab(float thickness, const MaterialDesc& glass) {
     d.materials.push_back(glass);
     d.meshes.push_back(slab(thickness));
     const Scene scene = build_scene(d);
-    return radiance_stats(scene, Ray{{0.1f, 0.2f, 3.0f}, {0, 0, -1}, 0.0f, kInfinity, 0.0f}, scaled(4000), 16);
+    return radiance_stats(scene, Ray{{0.1f, 0.2f, 3.0f}, {0, 0, -1}, 0.0f, kInfinity, 0.0f}, scaled(4000),
+                          16);
 }
 
 /// At normal incidence with reflectance r = 0.04 per face and transmittance T per

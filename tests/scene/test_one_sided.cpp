@@ -53,8 +53,11 @@ SceneDesc one_sided_scene(bool double_sided) {
 RayPacket packet_along(float z0, float dz) {
     RayPacket p;
     for (int i = 0; i < kPacketSize; ++i)
-        p.set(i, Ray{{0.1f + 0.2f * float(i % 4), 0.1f + 0.2f * float(i / 4), z0}, {0.0f, 0.0f, dz}, 0.0f,
-                     kInfinity, 0.0f});
+        p.set(i, Ray{{0.1f + 0.2f * float(i % 4), 0.1f + 0.2f * float(i / 4), z0},
+                     {0.0f, 0.0f, dz},
+                     0.0f,
+                     kInfinity,
+                     0.0f});
     return p;
 }
 
@@ -163,7 +166,8 @@ TEST_CASE("one-sided: a glTF quad with doubleSided false renders from the front 
             INFO(view, packets);
             const std::string out = std::string(view) + ".pfm";
             const CliRun run = run_sahara(
-                std::string("render ") + view + ".json --spp 2 --size 16x12 --seed 1 -o " + out + packets, dir);
+                std::string("render ") + view + ".json --spp 2 --size 16x12 --seed 1 -o " + out + packets,
+                dir);
             REQUIRE(run.code == 0);
             const auto img = read_image(dir.path / out, false);
             REQUIRE(img);
