@@ -15,16 +15,9 @@ import time
 
 import numpy as np
 
+from ray_sets import random_rays
+
 import sahara
-
-
-def random_rays(vertices, count, rng):
-    lo, hi = vertices.min(0), vertices.max(0)
-    center, radius = (lo + hi) / 2, np.linalg.norm(hi - lo)
-    d = rng.normal(size=(count, 3))
-    origins = center + radius * d / np.linalg.norm(d, axis=1, keepdims=True)
-    targets = rng.uniform(lo, hi, size=(count, 3))
-    return np.hstack([origins, targets - origins]).astype(np.float32)
 
 
 def median_seconds(fn, repeats):

@@ -33,6 +33,8 @@ import time
 
 import numpy as np
 
+from ray_sets import random_rays
+
 import sahara
 
 # The interposer. RTCRay keeps `mask` at byte 36 in Embree 3 (RTCRayHit starts with an RTCRay).
@@ -85,15 +87,6 @@ def import_open3d_unmasked():
         raise SystemExit(f"Open3D still misses a ray straight at a triangle (t_hit {t[0]}): the interposer "
                          "did not take effect")
     return o3d
-
-
-def random_rays(vertices, count, rng):
-    lo, hi = vertices.min(0), vertices.max(0)
-    center, radius = (lo + hi) / 2, np.linalg.norm(hi - lo)
-    d = rng.normal(size=(count, 3))
-    origins = center + radius * d / np.linalg.norm(d, axis=1, keepdims=True)
-    targets = rng.uniform(lo, hi, size=(count, 3))
-    return np.hstack([origins, targets - origins]).astype(np.float32)
 
 
 def camera_rays(vertices, count):

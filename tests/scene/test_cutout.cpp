@@ -48,26 +48,6 @@ TextureDesc checker_texture() {
     return t;
 }
 
-/// The unit square [0,1]^2 at height z as an n x n grid of quads (2n^2 triangles, several
-/// BVH leaves), uv = (x, y).
-TriangleMesh unit_grid(int n, float z, uint32_t material) {
-    TriangleMesh m;
-    m.name = "grid";
-    m.material = material;
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) {
-            const float x = float(i) / float(n), y = float(j) / float(n);
-            m.positions.push_back({x, y, z});
-            m.uvs.push_back({x, y});
-        }
-    const auto at = [n](int i, int j) { return uint32_t(j * (n + 1) + i); };
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-            m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
-                                               at(i + 1, j + 1), at(i, j + 1)});
-    return m;
-}
-
 /// Material 1: the checker cut-out (MASK at 0.5 when `mask`, else stochastic).
 SceneDesc checker_scene(bool mask) {
     SceneDesc d;

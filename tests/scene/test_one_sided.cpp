@@ -11,6 +11,7 @@
 #include "accel/packet.h"
 #include "accel/simd_path.h"
 #include "cli_test_util.h"
+#include "mesh_fixtures.h"
 #include "io/image_io.h"
 #include "render/features.h"
 #include "scene/accelerator.h"
@@ -21,21 +22,6 @@ using namespace sahara::test;
 
 namespace {
 
-/// An n x n grid of quads over [0, 1]^2 at height z, counter-clockwise seen from +z.
-TriangleMesh grid(int n, float z, uint32_t material) {
-    TriangleMesh m;
-    m.name = "grid";
-    m.material = material;
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) m.positions.push_back({float(i) / float(n), float(j) / float(n), z});
-    const auto at = [n](int i, int j) { return uint32_t(j * (n + 1) + i); };
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-            m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j),
-                                               at(i + 1, j + 1), at(i, j + 1)});
-    return m;
-}
-
 /// Material 1 one-sided (pbr) at z = 0 facing +z; material 0 (double-sided) at z = 1 behind it.
 SceneDesc one_sided_scene(bool double_sided) {
     SceneDesc d;
@@ -44,8 +30,8 @@ SceneDesc one_sided_scene(bool double_sided) {
     m.type = MaterialType::pbr;
     m.double_sided = double_sided;
     d.materials.push_back(m);
-    d.meshes.push_back(grid(8, 0.0f, 1));
-    d.meshes.push_back(grid(8, 1.0f, 0));
+    d.meshes.push_back(unit_grid(8, 0.0f, 1));
+    d.meshes.push_back(unit_grid(8, 1.0f, 0));
     return d;
 }
 
