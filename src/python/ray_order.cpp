@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -13,63 +14,83 @@ namespace {
 
 constexpr int kBitsPerCoordinate = 5;
 constexpr int kCells = 1 << kBitsPerCoordinate;
-constexpr int kRadixBits = 10;  ///< three passes over the 30-bit code
+constexpr int kKeyBits = 6 * kBitsPerCoordinate;
+constexpr int kRadixBits = 10;
 constexpr size_t kBuckets = size_t(1) << kRadixBits;
+/// The sort orders only the key's top bits: two passes resolve 2^20 cells, more than a
+/// batch of a million rays fills, and a third pass would only order rays within a cell.
+constexpr int kSortedBits = 2 * kRadixBits;
 
-/// The cell of x in [lo, lo + kCells / scale); NaN and everything below go to cell 0.
+/// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
+/// cell 0 or the last (maxss and minss pass NaN through their first operand).
 uint32_t cell(float x, float lo, float scale) {
     const float f = (x - lo) * scale;
-    return f >= 0.0f ? (f < float(kCells - 1) ? uint32_t(f) : uint32_t(kCells - 1)) : 0u;
+    return uint32_t(int(std::min(float(kCells - 1), std::max(f, 0.0f))));  // int: one cvttss2si
 }
 
-/// Bit b of coordinate k goes to bit 6 b + k: nearby codes are nearby in all six.
-uint32_t morton6(const uint32_t (&q)[6]) {
-    uint32_t code = 0;
-    for (int b = 0; b < kBitsPerCoordinate; ++b)
-        for (int k = 0; k < 6; ++k) code |= ((q[k] >> b) & 1u) << (6 * b + k);
-    return code;
+/// Bit b of a cell index moved to bit 6 b, for all kCells indices: coordinate k's
+/// spread bits shifted by k interleave the six coordinates (a Morton code), so nearby
+/// codes are nearby in all six.
+constexpr std::array<uint32_t, kCells> spread_table() {
+    std::array<uint32_t, kCells> t{};
+    for (uint32_t v = 0; v < uint32_t(kCells); ++v)
+        for (int b = 0; b < kBitsPerCoordinate; ++b) t[v] |= ((v >> b) & 1u) << (6 * b);
+    return t;
 }
+constexpr std::array<uint32_t, kCells> kSpread = spread_table();
 
-struct OriginBounds {
-    float lo[3], scale[3];
-};
+/// Rays per block of the key computation: structure-of-arrays blocks let the compiler
+/// vectorise the slab test and the cells, the bulk of the work.
+constexpr int kKeyBlock = 16;
 
-OriginBounds origin_bounds(const RayBatch& rays, int threads) {
-    const auto n = int64_t(rays.size());
-    float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
-                   std::numeric_limits<float>::max()};
-    float hi[3] = {-lo[0], -lo[1], -lo[2]};
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(min : lo[:3]) reduction(max : hi[:3])
-    for (int64_t i = 0; i < n; ++i) {
-        const Vec3 o = rays.ray(size_t(i)).origin;
-        for (int k = 0; k < 3; ++k)
-            if (std::isfinite(o[k])) lo[k] = std::min(lo[k], o[k]), hi[k] = std::max(hi[k], o[k]);
+/// The keys of rays [first, first + count) (count <= kKeyBlock): where each ray's
+/// segment [tmin, tmax] enters and leaves `box` (the mesh's bounds), as cells of the
+/// box. Rays with nearby entry and exit points are nearly the same line where the mesh
+/// is, so they visit the same nodes; keys of origin and direction leave random rays'
+/// neighbours far apart inside the box. Rays that miss the box share key 0 (any key is
+/// correct: it only orders the work).
+void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& box, const float (&scale)[3],
+                  uint64_t* keys) {
+    float org[3][kKeyBlock] = {}, dir[3][kKeyBlock] = {}, enter[kKeyBlock] = {}, leave[kKeyBlock] = {};
+    for (int i = 0; i < count; ++i) {
+        const Ray r = rays.ray(first + size_t(i));
+        for (int k = 0; k < 3; ++k) org[k][i] = r.origin[k], dir[k][i] = r.dir[k];
+        enter[i] = r.tmin, leave[i] = r.tmax;
     }
-    OriginBounds b{};
-    for (int k = 0; k < 3; ++k) {
-        const float extent = hi[k] - lo[k];
-        b.lo[k] = lo[k];
-        b.scale[k] = extent > 0.0f && std::isfinite(extent) ? float(kCells) / extent : 0.0f;
-    }
-    return b;
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < kKeyBlock; ++i) {
+            const float inv = 1.0f / dir[k][i];
+            const float t0 = (box.lo[k] - org[k][i]) * inv, t1 = (box.hi[k] - org[k][i]) * inv;
+            // Operand order makes NaN (an origin on a slab plane of a zero component) skipped.
+            enter[i] = std::max(enter[i], std::min(t0, t1));
+            leave[i] = std::min(leave[i], std::max(t0, t1));
+        }
+    uint32_t code[kKeyBlock] = {};
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < kKeyBlock; ++i) {
+            const uint32_t in = cell(org[k][i] + enter[i] * dir[k][i], box.lo[k], scale[k]);
+            const uint32_t out = cell(org[k][i] + leave[i] * dir[k][i], box.lo[k], scale[k]);
+            code[i] |= kSpread[in] << k | kSpread[out] << (3 + k);
+        }
+    for (int i = 0; i < count; ++i)
+        keys[i] = uint64_t(enter[i] <= leave[i] ? code[i] : 0u) << 32 | uint64_t(first + size_t(i));
 }
 
 /// Morton code (high 32 bits) and batch index (low 32 bits) of every ray.
-std::vector<uint64_t> keyed_indices(const RayBatch& rays, int threads) {
-    const OriginBounds b = origin_bounds(rays, threads);
+std::vector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, int threads) {
+    float scale[3];
+    for (int k = 0; k < 3; ++k) {
+        const float extent = box.hi[k] - box.lo[k];
+        scale[k] = extent > 0.0f && std::isfinite(extent) ? float(kCells) / extent : 0.0f;
+    }
     const auto n = int64_t(rays.size());
     std::vector<uint64_t> keys(static_cast<size_t>(n));
+    const int64_t blocks = (n + kKeyBlock - 1) / kKeyBlock;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t i = 0; i < n; ++i) {
-        const Ray r = rays.ray(size_t(i));
-        const float len = std::sqrt(dot(r.dir, r.dir));
-        const float inv = len > 0.0f && std::isfinite(len) ? 1.0f / len : 0.0f;
-        uint32_t q[6];
-        for (int k = 0; k < 3; ++k) {
-            q[k] = cell(r.dir[k] * inv, -1.0f, 0.5f * float(kCells));
-            q[3 + k] = cell(r.origin[k], b.lo[k], b.scale[k]);
-        }
-        keys[size_t(i)] = uint64_t(morton6(q)) << 32 | uint64_t(i);
+    for (int64_t b = 0; b < blocks; ++b) {
+        const auto first = size_t(b * kKeyBlock);
+        segment_keys(rays, first, int(std::min<int64_t>(kKeyBlock, n - int64_t(first))), box, scale,
+                     &keys[first]);
     }
     return keys;
 }
@@ -102,13 +123,13 @@ void radix_pass(const std::vector<uint64_t>& in, std::vector<uint64_t>& out, int
 
 }  // namespace
 
-std::vector<uint32_t> ray_order(const RayBatch& rays, int threads) {
+std::vector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads) {
     const size_t n = rays.size();
     if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return {};
     if (threads <= 0) threads = omp_get_max_threads();
-    std::vector<uint64_t> keys = keyed_indices(rays, threads);
+    std::vector<uint64_t> keys = keyed_indices(rays, box, threads);
     std::vector<uint64_t> scratch(n);
-    for (int shift = 32; shift < 32 + 6 * kBitsPerCoordinate; shift += kRadixBits) {
+    for (int shift = 32 + kKeyBits - kSortedBits; shift < 32 + kKeyBits; shift += kRadixBits) {
         radix_pass(keys, scratch, shift, threads);
         keys.swap(scratch);
     }
@@ -116,14 +137,6 @@ std::vector<uint32_t> ray_order(const RayBatch& rays, int threads) {
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t i = 0; i < int64_t(n); ++i) order[size_t(i)] = uint32_t(keys[size_t(i)]);
     return order;
-}
-
-std::vector<Ray> gather_rays(const RayBatch& rays, const std::vector<uint32_t>& order, int threads) {
-    std::vector<Ray> out(order.size());
-    const auto n = int64_t(order.size());
-#pragma omp parallel for schedule(static) num_threads(threads > 0 ? threads : omp_get_max_threads())
-    for (int64_t k = 0; k < n; ++k) out[size_t(k)] = rays.ray(order[size_t(k)]);
-    return out;
 }
 
 bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset) {

@@ -9,6 +9,7 @@
 
 #include "accel/packet.h"
 #include "geometry/hit.h"
+#include "math/bounds.h"
 #include "python/raycast_arrays.h"
 
 namespace sahara::python {
@@ -17,31 +18,33 @@ namespace sahara::python {
 /// sparse for neighbours to share much, and the sort would cost more than it saves.
 inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 
-/// The batch's rays by a 30-bit Morton code of the unit direction and the origin
-/// (5 bits per coordinate, the origin relative to the batch's origin bounds),
-/// ties in batch order. Empty (meaning the identity) below kMinSortedRays or at
-/// 2^32 rays and more. OpenMP on `threads` (0: all).
-std::vector<uint32_t> ray_order(const RayBatch& rays, int threads);
-
-/// The rays of the batch in `order`, as one contiguous array (reading them through
-/// the permutation while tracing would cost a cache miss per ray).
-std::vector<Ray> gather_rays(const RayBatch& rays, const std::vector<uint32_t>& order, int threads);
+/// The batch's rays by a Morton code of the points where each ray enters and leaves
+/// `box` (the mesh's bounds; 5 bits per coordinate), ordered by the code's top 20
+/// bits, ties in batch order. Empty (meaning the identity) below kMinSortedRays or
+/// at 2^32 rays and more. OpenMP on `threads` (0: all).
+std::vector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
 
 /// The rays a query traces, in the order it traces them: the batch itself, or the
-/// sorted copy whose position k holds the batch's ray order[k].
+/// batch read through a permutation whose position k holds the batch's ray order[k].
+/// Tracers prefetch() a packet ahead, so the rays are read in place without a cache
+/// miss each and without a sorted copy.
 struct TraceOrder {
     const RayBatch& batch;
     std::vector<uint32_t> order;  ///< empty: the batch's own order
-    std::vector<Ray> sorted;
     /// Nearest hits in the sorted order (with `order` only): they reach the result
     /// arrays in one pass in batch order, which reads one scattered hit per ray instead
     /// of writing four scattered results.
     std::vector<Hit> hits;
 
     size_t size() const { return batch.size(); }
-    Ray ray(size_t k) const { return order.empty() ? batch.ray(k) : sorted[k]; }
+    Ray ray(size_t k) const { return batch.ray(index(k)); }
     /// The batch index of position k (where its result goes).
     size_t index(size_t k) const { return order.empty() ? k : size_t(order[k]); }
+    /// Starts loading the ray at position k (in batch order the hardware prefetcher
+    /// follows the rows by itself).
+    void prefetch(size_t k) const {
+        if (k < order.size()) batch.prefetch(order[k]);
+    }
 };
 
 /// Whether the active rays of a packet are close enough for the packet traversal to

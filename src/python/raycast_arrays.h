@@ -43,6 +43,10 @@ class RayBatch {
         return r;
     }
 
+    /// Starts loading ray i's origin and direction into the cache (per-ray limits are
+    /// rarer and left to the hardware).
+    void prefetch(size_t i) const { __builtin_prefetch(data_ + py::ssize_t(i) * row_stride_); }
+
    private:
     /// A per-ray float argument: a constant or a contiguous float32 array.
     struct Limit {

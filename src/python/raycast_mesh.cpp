@@ -103,15 +103,12 @@ float CastMesh::packet_max_offset() const {
 }
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
-    TraceOrder out{rays, {}, {}, {}};
+    TraceOrder out{rays, {}, {}};
     if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
-    out.order = ray_order(rays, threads);
-    if (!out.order.empty()) {
-        out.sorted = gather_rays(rays, out.order, threads);
-        out.hits.resize(out.order.size());
-    }
+    out.order = ray_order(rays, accel_->bounds(), threads);
+    if (!out.order.empty()) out.hits.resize(out.order.size());
     return out;
 }
 
@@ -152,6 +149,7 @@ void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out)
         HitPacket hits;
         const int64_t start = first + p * kPacketSize;
         const int lanes = int(std::min<int64_t>(kPacketSize, last - start));
+        for (int l = 0; l < lanes; ++l) rays.prefetch(size_t(start + kPacketSize + l));
         for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(start + l)));
         if (lanes > 1 && packet_is_coherent(packet, kPacketMaxChord, max_offset)) {
             accel_->intersect_packet(packet, hits);
@@ -172,8 +170,10 @@ void CastMesh::occluded(const TraceOrder& rays, RaySlice slice, bool* out) const
     const int threads = team_size(slice);
     const int64_t item = work_item(slice, threads, 1);
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
-    for (int64_t k = first; k < last; ++k)
+    for (int64_t k = first; k < last; ++k) {
+        rays.prefetch(size_t(k + kPacketSize));
         out[rays.index(size_t(k))] = accel_ && accel_->occluded(rays.ray(size_t(k)));
+    }
 }
 
 void CastMesh::count_crossings(const RayBatch& rays, int32_t* out) const {
