@@ -15,11 +15,10 @@ namespace {
 constexpr int kBitsPerCoordinate = 5;
 constexpr int kCells = 1 << kBitsPerCoordinate;
 constexpr int kKeyBits = 6 * kBitsPerCoordinate;
+/// Three passes order all 30 bits: a million rays fill 2^20 cells, but the order within
+/// those cells still shortens traversal by more than the third pass costs.
 constexpr int kRadixBits = 10;
 constexpr size_t kBuckets = size_t(1) << kRadixBits;
-/// The sort orders only the key's top bits: two passes resolve 2^20 cells, more than a
-/// batch of a million rays fills, and a third pass would only order rays within a cell.
-constexpr int kSortedBits = 2 * kRadixBits;
 
 /// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
 /// cell 0 or the last (maxss and minss pass NaN through their first operand).
@@ -53,9 +52,14 @@ void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& 
                   uint64_t* keys) {
     float org[3][kKeyBlock] = {}, dir[3][kKeyBlock] = {}, enter[kKeyBlock] = {}, leave[kKeyBlock] = {};
     for (int i = 0; i < count; ++i) {
-        const Ray r = rays.ray(first + size_t(i));
-        for (int k = 0; k < 3; ++k) org[k][i] = r.origin[k], dir[k][i] = r.dir[k];
-        enter[i] = r.tmin, leave[i] = r.tmax;
+        const size_t j = first + size_t(i);
+        if (const float* row = rays.f32_row(j)) {
+            for (int k = 0; k < 3; ++k) org[k][i] = row[k], dir[k][i] = row[3 + k];
+        } else {
+            const Ray r = rays.ray(j);
+            for (int k = 0; k < 3; ++k) org[k][i] = r.origin[k], dir[k][i] = r.dir[k];
+        }
+        enter[i] = rays.tmin(j), leave[i] = rays.tmax(j);
     }
     for (int k = 0; k < 3; ++k)
         for (int i = 0; i < kKeyBlock; ++i) {
@@ -65,26 +69,30 @@ void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& 
             enter[i] = std::max(enter[i], std::min(t0, t1));
             leave[i] = std::min(leave[i], std::max(t0, t1));
         }
-    uint32_t code[kKeyBlock] = {};
+    // The cells in a loop of their own, which vectorises: entry and exit points lie on the
+    // box, where clamping to the first or last cell is a coin toss a branch would miss.
+    uint32_t cells[6][kKeyBlock];
     for (int k = 0; k < 3; ++k)
         for (int i = 0; i < kKeyBlock; ++i) {
-            const uint32_t in = cell(org[k][i] + enter[i] * dir[k][i], box.lo[k], scale[k]);
-            const uint32_t out = cell(org[k][i] + leave[i] * dir[k][i], box.lo[k], scale[k]);
-            code[i] |= kSpread[in] << k | kSpread[out] << (3 + k);
+            cells[k][i] = cell(org[k][i] + enter[i] * dir[k][i], box.lo[k], scale[k]);
+            cells[3 + k][i] = cell(org[k][i] + leave[i] * dir[k][i], box.lo[k], scale[k]);
         }
-    for (int i = 0; i < count; ++i)
-        keys[i] = uint64_t(enter[i] <= leave[i] ? code[i] : 0u) << 32 | uint64_t(first + size_t(i));
+    for (int i = 0; i < count; ++i) {
+        uint32_t code = 0;
+        for (int k = 0; k < 6; ++k) code |= kSpread[cells[k][i]] << k;
+        keys[i] = uint64_t(enter[i] <= leave[i] ? code : 0u) << 32 | uint64_t(first + size_t(i));
+    }
 }
 
 /// Morton code (high 32 bits) and batch index (low 32 bits) of every ray.
-std::vector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, int threads) {
+UninitializedVector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, int threads) {
     float scale[3];
     for (int k = 0; k < 3; ++k) {
         const float extent = box.hi[k] - box.lo[k];
         scale[k] = extent > 0.0f && std::isfinite(extent) ? float(kCells) / extent : 0.0f;
     }
     const auto n = int64_t(rays.size());
-    std::vector<uint64_t> keys(static_cast<size_t>(n));
+    UninitializedVector<uint64_t> keys(static_cast<size_t>(n));
     const int64_t blocks = (n + kKeyBlock - 1) / kKeyBlock;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t b = 0; b < blocks; ++b) {
@@ -97,7 +105,7 @@ std::vector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, in
 
 /// One stable counting pass of an LSD radix sort on the bits from `shift`: each thread
 /// counts and then places one contiguous block of `in`.
-void radix_pass(const std::vector<uint64_t>& in, std::vector<uint64_t>& out, int shift, int threads) {
+void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uint64_t>& out, int shift, int threads) {
     const size_t n = in.size();
     std::vector<size_t> counts(size_t(threads) * kBuckets);
 #pragma omp parallel num_threads(threads)
@@ -123,17 +131,17 @@ void radix_pass(const std::vector<uint64_t>& in, std::vector<uint64_t>& out, int
 
 }  // namespace
 
-std::vector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads) {
+UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads) {
     const size_t n = rays.size();
     if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return {};
     if (threads <= 0) threads = omp_get_max_threads();
-    std::vector<uint64_t> keys = keyed_indices(rays, box, threads);
-    std::vector<uint64_t> scratch(n);
-    for (int shift = 32 + kKeyBits - kSortedBits; shift < 32 + kKeyBits; shift += kRadixBits) {
+    UninitializedVector<uint64_t> keys = keyed_indices(rays, box, threads);
+    UninitializedVector<uint64_t> scratch(n);
+    for (int shift = 32; shift < 32 + kKeyBits; shift += kRadixBits) {
         radix_pass(keys, scratch, shift, threads);
         keys.swap(scratch);
     }
-    std::vector<uint32_t> order(n);
+    UninitializedVector<uint32_t> order(n);
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int64_t i = 0; i < int64_t(n); ++i) order[size_t(i)] = uint32_t(keys[size_t(i)]);
     return order;

@@ -5,6 +5,9 @@
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "accel/packet.h"
@@ -18,11 +21,33 @@ namespace sahara::python {
 /// sparse for neighbours to share much, and the sort would cost more than it saves.
 inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 
+/// An allocator whose value-initialisation leaves the memory as it is: the sort's
+/// buffers (tens of MB for a million rays) are written in full by parallel loops,
+/// which then also take their first-touch page faults in parallel instead of one
+/// thread zeroing them first.
+template <class T>
+struct UninitializedAllocator {
+    using value_type = T;
+    UninitializedAllocator() = default;
+    template <class U>
+    UninitializedAllocator(const UninitializedAllocator<U>&) {}
+    T* allocate(size_t n) { return std::allocator<T>().allocate(n); }
+    void deallocate(T* p, size_t n) { std::allocator<T>().deallocate(p, n); }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        if constexpr (sizeof...(Args) > 0) ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+    friend bool operator==(const UninitializedAllocator&, const UninitializedAllocator&) { return true; }
+};
+
+/// A vector whose resize() leaves new elements unwritten (T must be an implicit-lifetime type).
+template <class T>
+using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
+
 /// The batch's rays by a Morton code of the points where each ray enters and leaves
-/// `box` (the mesh's bounds; 5 bits per coordinate), ordered by the code's top 20
-/// bits, ties in batch order. Empty (meaning the identity) below kMinSortedRays or
+/// `box` (the mesh's bounds; 5 bits per coordinate, 30 in all), ties in batch order. Empty (meaning the identity) below kMinSortedRays or
 /// at 2^32 rays and more. OpenMP on `threads` (0: all).
-std::vector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
+UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
 
 /// The rays a query traces, in the order it traces them: the batch itself, or the
 /// batch read through a permutation whose position k holds the batch's ray order[k].
@@ -30,11 +55,11 @@ std::vector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int th
 /// miss each and without a sorted copy.
 struct TraceOrder {
     const RayBatch& batch;
-    std::vector<uint32_t> order;  ///< empty: the batch's own order
+    UninitializedVector<uint32_t> order;  ///< empty: the batch's own order
     /// Nearest hits in the sorted order (with `order` only): they reach the result
     /// arrays in one pass in batch order, which reads one scattered hit per ray instead
     /// of writing four scattered results.
-    std::vector<Hit> hits;
+    UninitializedVector<Hit> hits;
 
     size_t size() const { return batch.size(); }
     Ray ray(size_t k) const { return batch.ray(index(k)); }

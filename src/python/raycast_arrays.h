@@ -43,6 +43,15 @@ class RayBatch {
         return r;
     }
 
+    /// Ray i's six floats (origin, direction) when the rays are float32 with contiguous
+    /// rows, else nullptr (then ray() converts): bulk readers skip the per-value checks.
+    const float* f32_row(size_t i) const {
+        return f64_ || col_stride_ != py::ssize_t(sizeof(float))
+                   ? nullptr
+                   : reinterpret_cast<const float*>(data_ + py::ssize_t(i) * row_stride_);
+    }
+    float tmin(size_t i) const { return tmin_.at(i); }
+    float tmax(size_t i) const { return tmax_.at(i); }
     /// Starts loading ray i's origin and direction into the cache (per-ray limits are
     /// rarer and left to the hardware).
     void prefetch(size_t i) const { __builtin_prefetch(data_ + py::ssize_t(i) * row_stride_); }

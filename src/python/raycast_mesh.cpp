@@ -78,19 +78,14 @@ Vec3 CastMesh::unit_normal(uint32_t triangle) const {
 }
 
 void CastMesh::store(size_t k, const Hit& hit, const NearestHits& out) const {
-    if (!hit.hit()) {
-        out.t[k] = kInfinity;
-        out.prim[k] = -1;
-        out.uv[2 * k] = out.uv[2 * k + 1] = 0.0f;
-        out.normal[3 * k] = out.normal[3 * k + 1] = out.normal[3 * k + 2] = 0.0f;
-        return;
-    }
-    const uint32_t tri = prim_index(hit.prim);
-    out.t[k] = hit.t;
-    out.prim[k] = int64_t(tri);
-    out.uv[2 * k] = hit.u;
-    out.uv[2 * k + 1] = hit.v;
-    const Vec3 nrm = normals_[tri];
+    // Selects, not a branch: after a sort, hits and misses alternate at random.
+    const bool found = hit.hit();
+    const uint32_t tri = found ? prim_index(hit.prim) : 0;
+    const Vec3 nrm = found ? normals_[tri] : Vec3(0.0f);
+    out.t[k] = found ? hit.t : kInfinity;
+    out.prim[k] = found ? int64_t(tri) : int64_t(-1);
+    out.uv[2 * k] = found ? hit.u : 0.0f;
+    out.uv[2 * k + 1] = found ? hit.v : 0.0f;
     out.normal[3 * k] = nrm.x;
     out.normal[3 * k + 1] = nrm.y;
     out.normal[3 * k + 2] = nrm.z;
@@ -115,14 +110,24 @@ TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
 void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const {
     if (rays.order.empty()) return;
     const auto n = int64_t(rays.order.size());
-    std::vector<uint32_t> position(static_cast<size_t>(n));  // the inverse permutation
+    UninitializedVector<uint32_t> position(static_cast<size_t>(n));  // the inverse permutation
     const int team = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel num_threads(team)
     {
 #pragma omp for schedule(static)
         for (int64_t k = 0; k < n; ++k) position[rays.order[size_t(k)]] = uint32_t(k);
+        // The hits are read in random order: prefetched kHitsAhead rays ahead, and the
+        // normal of a hit read half as far ahead (its triangle is known by then).
+        constexpr int64_t kHitsAhead = 32;
 #pragma omp for schedule(static)
-        for (int64_t i = 0; i < n; ++i) store(size_t(i), rays.hits[position[size_t(i)]], out);
+        for (int64_t i = 0; i < n; ++i) {
+            if (i + kHitsAhead < n) __builtin_prefetch(&rays.hits[position[size_t(i + kHitsAhead)]]);
+            if (i + kHitsAhead / 2 < n) {
+                const Hit& ahead = rays.hits[position[size_t(i + kHitsAhead / 2)]];
+                if (ahead.hit()) __builtin_prefetch(&normals_[prim_index(ahead.prim)]);
+            }
+            store(size_t(i), rays.hits[position[size_t(i)]], out);
+        }
     }
 }
 
@@ -149,14 +154,15 @@ void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out)
         HitPacket hits;
         const int64_t start = first + p * kPacketSize;
         const int lanes = int(std::min<int64_t>(kPacketSize, last - start));
-        for (int l = 0; l < lanes; ++l) rays.prefetch(size_t(start + kPacketSize + l));
         for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(start + l)));
         if (lanes > 1 && packet_is_coherent(packet, kPacketMaxChord, max_offset)) {
+            for (int l = 0; l < lanes; ++l) rays.prefetch(size_t(start + kPacketSize + l));
             accel_->intersect_packet(packet, hits);
             for (int l = 0; l < lanes; ++l) put(start + l, hits.hit(l));
             continue;
         }
         for (int l = 0; l < lanes; ++l) {
+            rays.prefetch(size_t(start + kPacketSize + l));  // one per ray: spread over the packet
             Ray r = packet.ray(l);
             Hit h;
             accel_->intersect(r, h);
