@@ -105,7 +105,8 @@ UninitializedVector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3&
 
 /// One stable counting pass of an LSD radix sort on the bits from `shift`: each thread
 /// counts and then places one contiguous block of `in`.
-void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uint64_t>& out, int shift, int threads) {
+void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uint64_t>& out, int shift,
+                int threads) {
     const size_t n = in.size();
     std::vector<size_t> counts(size_t(threads) * kBuckets);
 #pragma omp parallel num_threads(threads)

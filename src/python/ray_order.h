@@ -45,8 +45,8 @@ template <class T>
 using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
 
 /// The batch's rays by a Morton code of the points where each ray enters and leaves
-/// `box` (the mesh's bounds; 5 bits per coordinate, 30 in all), ties in batch order. Empty (meaning the identity) below kMinSortedRays or
-/// at 2^32 rays and more. OpenMP on `threads` (0: all).
+/// `box` (the mesh's bounds; 5 bits per coordinate, 30 in all), ties in batch order. Empty (meaning the
+/// identity) below kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
 UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
 
 /// The rays a query traces, in the order it traces them: the batch itself, or the
