@@ -106,6 +106,13 @@ struct BinMap {
         scale = _mm_setr_ps(scale_s[0], scale_s[1], scale_s[2], 0.0f);
     }
     uint32_t clamp(int b) const { return uint32_t(std::clamp(b, 0, last)); }
+    /// The bins of centroid c on the three axes (lanes 0-2), clamped as clamp() does, in SSE2.
+    __m128i bins(__m128 c, __m128i last_bin) const {
+        __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+        k = _mm_and_si128(k, _mm_cmpgt_epi32(k, _mm_setzero_si128()));
+        const __m128i over = _mm_cmpgt_epi32(k, last_bin);
+        return _mm_or_si128(_mm_andnot_si128(over, k), _mm_and_si128(over, last_bin));
+    }
     /// Bin on one axis (the same arithmetic as the three-axis version).
     uint32_t bin(const PrimRef& p, int axis) const {
         return clamp(_mm_cvtt_ss2si(_mm_set_ss((p.c[axis] - lo_s[axis]) * scale_s[axis])));
@@ -212,8 +219,12 @@ class BinnedBuild {
         Split best;
         if (n <= kParallelScanThreshold) {
             thread_local Bins all;  // not used across a task scheduling point
-            all.clear(bins);
-            fill_bins(r.refs, r.begin, r.end, map, all);
+            if (n < bins) {
+                fill_few_bins(r.refs, r.begin, r.end, map, all);
+            } else {
+                all.clear(bins);
+                fill_bins(r.refs, r.begin, r.end, map, all);
+            }
             best = find_split(all, map);
             if (best.axis < 0) return !may_be_leaf && median_split(r, left, right);
             if (may_be_leaf && is_leaf_cheaper(r, n, best)) return false;
@@ -243,18 +254,50 @@ class BinnedBuild {
     }
 
     static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
+        const __m128i last = _mm_set1_epi32(map.last);
         for (uint32_t i = begin; i < end; ++i) {
             const PrimRef& p = refs[i];
-            alignas(16) int32_t k[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k),
-                            _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(p.c), map.lo), map.scale)));
+            alignas(16) uint32_t k[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k), map.bins(_mm_load_ps(p.c), last));
             const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
             for (int a = 0; a < 3; ++a) {
-                const uint32_t b = map.clamp(k[a]);
-                out.box[a][b].extend(lo, hi);
-                ++out.count[a][b];
+                out.box[a][k[a]].extend(lo, hi);
+                ++out.count[a][k[a]];
             }
         }
+    }
+
+    /// fill_bins for fewer primitives than bins: clears all counts but only the boxes of
+    /// the bins they fall in (find_split reads no other box); near the leaves the full
+    /// clear cost more than the binning.
+    static void fill_few_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map,
+                              Bins& out) {
+        for (int a = 0; a < 3; ++a) std::fill_n(out.count[a], map.last + 1, 0u);
+        const __m128i last = _mm_set1_epi32(map.last);
+        alignas(16) uint32_t k[kMaxBins][4];
+        for (uint32_t i = begin; i < end; ++i) {
+            _mm_store_si128(reinterpret_cast<__m128i*>(k[i - begin]), map.bins(_mm_load_ps(refs[i].c), last));
+            for (int a = 0; a < 3; ++a) out.box[a][k[i - begin][a]] = Box4{};
+        }
+        for (uint32_t i = begin; i < end; ++i) {
+            const __m128 lo = load_lo(refs[i]), hi = _mm_load_ps(refs[i].hi);
+            for (int a = 0; a < 3; ++a) {
+                out.box[a][k[i - begin][a]].extend(lo, hi);
+                ++out.count[a][k[i - begin][a]];
+            }
+        }
+    }
+
+    /// Bit b set where count[b] != 0, for b < nb (count has kMaxBins entries).
+    static uint64_t nonzero_mask(const uint32_t* count, uint32_t nb) {
+        uint64_t bits = 0;
+        for (uint32_t b = 0; b < nb; b += 4) {
+            const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(count + b));
+            const auto zero =
+                uint64_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128()))));
+            bits |= (~zero & 15u) << b;
+        }
+        return nb == 64 ? bits : bits & ((uint64_t(1) << nb) - 1);
     }
 
     /// The cheapest bin boundary over the axes with a non-zero centroid extent. Only the
@@ -275,7 +318,8 @@ class BinnedBuild {
             const Box4* box = bins.box[axis];
             const uint32_t* count = bins.count[axis];
             uint32_t m = 0;
-            for (uint32_t b = 0; b < nb; ++b) used[m] = b, m += count[b] != 0;
+            for (uint64_t bits = nonzero_mask(count, nb); bits; bits &= bits - 1)
+                used[m++] = uint32_t(__builtin_ctzll(bits));
             if (m < 2) continue;
             // right_*[j]: bins used[j..m) together.
             Box4 acc;
