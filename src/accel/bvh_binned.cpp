@@ -222,6 +222,7 @@ class BinnedBuild {
         const uint32_t n = r.end - r.begin;
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
+        if (may_be_leaf && params_.intersection_cost > 0.0f && leaf_is_certain(r)) return false;
         const uint32_t bins = params_.bin_count;
         const BinMap map(r.centroids, bins);
         Split best;
@@ -254,6 +255,27 @@ class BinnedBuild {
         left.box = best.left;
         right.box = best.right;
         return true;
+    }
+
+    /// Whether is_leaf_cheaper holds for every split of `r`, so binning can be skipped. Each
+    /// side of a split holds a primitive, so its area is at least that primitive's (the areas
+    /// round monotonically), and blocked() of a side is at least blocked(1): every split costs
+    /// at least intersection_cost * (a_max + a_min) * blocked(1), computed here in the same
+    /// order, from the largest and smallest primitive box areas.
+    bool leaf_is_certain(const Range& r) const {
+        float a_max = 0.0f, a_min = kInfinity;
+        for (uint32_t i = r.begin; i < r.end; ++i) {
+            Box4 b;
+            b.extend(load_lo(r.refs[i]), _mm_load_ps(r.refs[i].hi));
+            const float a = b.area();
+            a_max = std::max(a_max, a);
+            a_min = std::min(a_min, a);
+        }
+        const float one = blocked(1);
+        const float lowest_split_cost = params_.intersection_cost * (a_max * one + a_min * one);
+        Split bound;
+        bound.cost = lowest_split_cost;
+        return is_leaf_cheaper(r, r.end - r.begin, bound);
     }
 
     bool is_leaf_cheaper(const Range& r, uint32_t n, const Split& s) const {
