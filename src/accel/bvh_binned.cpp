@@ -268,6 +268,7 @@ class BinnedBuild {
             Box4 b;
             b.extend(load_lo(r.refs[i]), _mm_load_ps(r.refs[i].hi));
             const float a = b.area();
+            if (!(a >= 0.0f)) return false;  // a NaN box: no bound, bin as usual
             a_max = std::max(a_max, a);
             a_min = std::min(a_min, a);
         }
