@@ -81,8 +81,16 @@ struct Bins {
     uint32_t count[3][kMaxBins];
 
     void clear(uint32_t bins) {
+        clear_counts(bins);
         for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins; ++k) box[a][k] = Box4{}, count[a][k] = 0;
+            for (uint32_t k = 0; k < bins; ++k) box[a][k] = Box4{};
+    }
+    /// Zeroes the counts of bins [0, bins) in whole groups of four (a few stores, where
+    /// std::fill_n calls memset for every small node).
+    void clear_counts(uint32_t bins) {
+        for (int a = 0; a < 3; ++a)
+            for (uint32_t k = 0; k < bins; k += 4)
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(&count[a][k]), _mm_setzero_si128());
     }
     void add(const Bins& o, uint32_t bins) {
         for (int a = 0; a < 3; ++a)
@@ -106,6 +114,13 @@ struct BinMap {
         scale = _mm_setr_ps(scale_s[0], scale_s[1], scale_s[2], 0.0f);
     }
     uint32_t clamp(int b) const { return uint32_t(std::clamp(b, 0, last)); }
+    /// The bins of centroid c on the three axes (lanes 0-2), clamped as clamp() does, in SSE2.
+    __m128i bins(__m128 c, __m128i last_bin) const {
+        __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
+        k = _mm_and_si128(k, _mm_cmpgt_epi32(k, _mm_setzero_si128()));
+        const __m128i over = _mm_cmpgt_epi32(k, last_bin);
+        return _mm_or_si128(_mm_andnot_si128(over, k), _mm_and_si128(over, last_bin));
+    }
     /// Bin on one axis (the same arithmetic as the three-axis version).
     uint32_t bin(const PrimRef& p, int axis) const {
         return clamp(_mm_cvtt_ss2si(_mm_set_ss((p.c[axis] - lo_s[axis]) * scale_s[axis])));
@@ -207,13 +222,18 @@ class BinnedBuild {
         const uint32_t n = r.end - r.begin;
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
+        if (may_be_leaf && params_.intersection_cost > 0.0f && leaf_is_certain(r)) return false;
         const uint32_t bins = params_.bin_count;
         const BinMap map(r.centroids, bins);
         Split best;
         if (n <= kParallelScanThreshold) {
             thread_local Bins all;  // not used across a task scheduling point
-            all.clear(bins);
-            fill_bins(r.refs, r.begin, r.end, map, all);
+            if (n < bins) {
+                fill_few_bins(r.refs, r.begin, r.end, map, all);
+            } else {
+                all.clear(bins);
+                fill_bins(r.refs, r.begin, r.end, map, all);
+            }
             best = find_split(all, map);
             if (best.axis < 0) return !may_be_leaf && median_split(r, left, right);
             if (may_be_leaf && is_leaf_cheaper(r, n, best)) return false;
@@ -237,24 +257,78 @@ class BinnedBuild {
         return true;
     }
 
+    /// Whether is_leaf_cheaper holds for every split of `r`, so binning can be skipped. Each
+    /// side of a split holds a primitive, so its area is at least that primitive's (the areas
+    /// round monotonically), and blocked() of a side is at least blocked(1): every split costs
+    /// at least intersection_cost * (a_max + a_min) * blocked(1), computed here in the same
+    /// order, from the largest and smallest primitive box areas.
+    bool leaf_is_certain(const Range& r) const {
+        float a_max = 0.0f, a_min = kInfinity;
+        for (uint32_t i = r.begin; i < r.end; ++i) {
+            Box4 b;
+            b.extend(load_lo(r.refs[i]), _mm_load_ps(r.refs[i].hi));
+            const float a = b.area();
+            if (!(a >= 0.0f)) return false;  // a NaN box: no bound, bin as usual
+            a_max = std::max(a_max, a);
+            a_min = std::min(a_min, a);
+        }
+        const float one = blocked(1);
+        const float lowest_split_cost = params_.intersection_cost * (a_max * one + a_min * one);
+        Split bound;
+        bound.cost = lowest_split_cost;
+        return is_leaf_cheaper(r, r.end - r.begin, bound);
+    }
+
     bool is_leaf_cheaper(const Range& r, uint32_t n, const Split& s) const {
         const float area = r.box.surface_area();
         return params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + s.cost;
     }
 
     static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
+        const __m128i last = _mm_set1_epi32(map.last);
         for (uint32_t i = begin; i < end; ++i) {
             const PrimRef& p = refs[i];
-            alignas(16) int32_t k[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k),
-                            _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(p.c), map.lo), map.scale)));
+            alignas(16) uint32_t k[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(k), map.bins(_mm_load_ps(p.c), last));
             const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
             for (int a = 0; a < 3; ++a) {
-                const uint32_t b = map.clamp(k[a]);
-                out.box[a][b].extend(lo, hi);
-                ++out.count[a][b];
+                out.box[a][k[a]].extend(lo, hi);
+                ++out.count[a][k[a]];
             }
         }
+    }
+
+    /// fill_bins for fewer primitives than bins: clears all counts but only the boxes of
+    /// the bins they fall in (find_split reads no other box); near the leaves the full
+    /// clear cost more than the binning.
+    static void fill_few_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map,
+                              Bins& out) {
+        out.clear_counts(uint32_t(map.last) + 1);
+        const __m128i last = _mm_set1_epi32(map.last);
+        alignas(16) uint32_t k[kMaxBins][4];
+        for (uint32_t i = begin; i < end; ++i) {
+            _mm_store_si128(reinterpret_cast<__m128i*>(k[i - begin]), map.bins(_mm_load_ps(refs[i].c), last));
+            for (int a = 0; a < 3; ++a) out.box[a][k[i - begin][a]] = Box4{};
+        }
+        for (uint32_t i = begin; i < end; ++i) {
+            const __m128 lo = load_lo(refs[i]), hi = _mm_load_ps(refs[i].hi);
+            for (int a = 0; a < 3; ++a) {
+                out.box[a][k[i - begin][a]].extend(lo, hi);
+                ++out.count[a][k[i - begin][a]];
+            }
+        }
+    }
+
+    /// Bit b set where count[b] != 0, for b < nb (count has kMaxBins entries).
+    static uint64_t nonzero_mask(const uint32_t* count, uint32_t nb) {
+        uint64_t bits = 0;
+        for (uint32_t b = 0; b < nb; b += 4) {
+            const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(count + b));
+            const auto zero =
+                uint64_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128()))));
+            bits |= (~zero & 15u) << b;
+        }
+        return nb == 64 ? bits : bits & ((uint64_t(1) << nb) - 1);
     }
 
     /// The cheapest bin boundary over the axes with a non-zero centroid extent. Only the
@@ -275,7 +349,8 @@ class BinnedBuild {
             const Box4* box = bins.box[axis];
             const uint32_t* count = bins.count[axis];
             uint32_t m = 0;
-            for (uint32_t b = 0; b < nb; ++b) used[m] = b, m += count[b] != 0;
+            for (uint64_t bits = nonzero_mask(count, nb); bits; bits &= bits - 1)
+                used[m++] = uint32_t(__builtin_ctzll(bits));
             if (m < 2) continue;
             // right_*[j]: bins used[j..m) together.
             Box4 acc;

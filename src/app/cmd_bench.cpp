@@ -68,9 +68,10 @@ constexpr const char* kBenchUsage =
     "MRays/s is per second of elapsed time; (CPU) per second of CPU time summed over the tracing\n"
     "threads, which is steadier when other processes share the cores.\n"
     "Build: sahara's whole acceleration structure (primitive boxes, binned SAH BVH, wide tree,\n"
-    "leaf blocks), Mprims/s per elapsed and per CPU second; Embree's is rtcCommitScene alone on a\n"
-    "device with --threads build threads, Mtris/s per elapsed second (JSON: embree_build_ms,\n"
-    "embree_mtris_s; embree_setup_ms adds the device start and the buffer copies).\n"
+    "leaf blocks), Mprims/s per elapsed second (also per thread) and per CPU second; Embree's is\n"
+    "rtcCommitScene alone (its primitive boxes, BVH and leaf triangles) on a device with --threads\n"
+    "build threads, timed the same ways (JSON: embree_build_ms, embree_build_cpu_ms, embree_mtris_s,\n"
+    "build_ratio, build_ratio_cpu; embree_setup_ms adds the device start and the buffer copies).\n"
     "confirmed: the answers differ and a double-precision brute-force test sides with sahara\n"
     "(Embree's default triangle test is not watertight: rays slip through shared edges); these\n"
     "are not counted as disagreements.\n";
@@ -217,11 +218,19 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"build_threads", opt.threads},
         {"mprims_s", double(accel.primitive_count()) / std::max(accel.build_ms() * 1e3, 1e-9)},
         {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
+    j["mprims_s_per_thread"] = j["mprims_s"].get<double>() / opt.threads;
     if (embree) {
         // rtcCommitScene alone: Embree's build from the triangle buffers (its device, started
         // before, and the buffer copies are in embree_setup_ms).
         j["embree_build_ms"] = embree->build_ms();
         j["embree_mtris_s"] = double(mesh.triangle_count()) / std::max(embree->build_ms() * 1e3, 1e-9);
+        j["embree_build_cpu_ms"] = embree->build_cpu_ms();
+        j["embree_mtris_cpu_s"] =
+            double(mesh.triangle_count()) / std::max(embree->build_cpu_ms() * 1e3, 1e-9);
+        j["embree_mtris_s_per_thread"] = j["embree_mtris_s"].get<double>() / opt.threads;
+        // Build speed against Embree's: primitives per elapsed second, and per CPU second.
+        j["build_ratio"] = j["mprims_s"].get<double>() / j["embree_mtris_s"].get<double>();
+        j["build_ratio_cpu"] = j["mprims_cpu_s"].get<double>() / j["embree_mtris_cpu_s"].get<double>();
         j["embree_setup_ms"] = embree->setup_ms();
         j["embree_bvh_bytes_per_primitive"] =
             double(embree->bvh_bytes()) / double(std::max<size_t>(accel.primitive_count(), 1));
@@ -246,18 +255,24 @@ void print_text(const nlohmann::ordered_json& j) {
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
     std::printf("threads     %d\n", j["threads"].get<int>());
-    std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s%s)",
-                j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),
-                j["mprims_cpu_s"].get<double>(), j["builder"].get<std::string>().c_str(),
-                j["layout"].get<std::string>().c_str(), j["simd"].get<std::string>().c_str(),
-                j["node_pairing"].get<bool>() ? ", node pairing" : "");
+    std::printf(
+        "build       %.1f ms (%.2f Mprims/s, %.2f per thread), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s "
+        "layout, %s%s)",
+        j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["mprims_s_per_thread"].get<double>(),
+        j["build_cpu_ms"].get<double>(), j["mprims_cpu_s"].get<double>(),
+        j["builder"].get<std::string>().c_str(), j["layout"].get<std::string>().c_str(),
+        j["simd"].get<std::string>().c_str(), j["node_pairing"].get<bool>() ? ", node pairing" : "");
     if (j.contains("embree_build_ms"))
         std::printf(
-            "\nEmbree      build %.1f ms (%.2f Mtris/s, rtcCommitScene, %d threads), %s quality, %s mode, "
-            "%s%s",
-            j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(), j["threads"].get<int>(),
+            "\nEmbree      build %.1f ms (%.2f Mtris/s, %.2f per thread), CPU %.1f ms (%.2f Mtris/s) "
+            "(rtcCommitScene, %d threads), %s quality, %s mode, %s%s\nbuild ratio %.2f, CPU %.2f (sahara / "
+            "Embree)",
+            j["embree_build_ms"].get<double>(), j["embree_mtris_s"].get<double>(),
+            j["embree_mtris_s_per_thread"].get<double>(), j["embree_build_cpu_ms"].get<double>(),
+            j["embree_mtris_cpu_s"].get<double>(), j["threads"].get<int>(),
             j["embree_quality"].get<std::string>().c_str(), j["embree_mode"].get<std::string>().c_str(),
-            j["embree_isa"] == "best" ? "" : "ISA up to ", j["embree_isa"].get<std::string>().c_str());
+            j["embree_isa"] == "best" ? "" : "ISA up to ", j["embree_isa"].get<std::string>().c_str(),
+            j["build_ratio"].get<double>(), j["build_ratio_cpu"].get<double>());
     std::printf("\nbytes/prim  %.1f (tree + leaf-ordered primitive data)",
                 j["tree_bytes_per_primitive"].get<double>());
     if (j.contains("embree_bvh_bytes_per_primitive"))

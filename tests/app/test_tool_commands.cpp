@@ -205,6 +205,10 @@ TEST_CASE("bench command compares with Embree: default, robust and ISA-capped mo
     CHECK(bench.second.find("\"embree_mrays_s\"") != std::string::npos);
     CHECK(bench.second.find("\"embree_build_ms\"") != std::string::npos);
     CHECK(bench.second.find("\"embree_mtris_s\"") != std::string::npos);
+    // Build speed per thread and against Embree, per elapsed and per CPU second.
+    for (const char* key : {"\"mprims_s_per_thread\"", "\"embree_build_cpu_ms\"",
+                            "\"embree_mtris_s_per_thread\"", "\"build_ratio\"", "\"build_ratio_cpu\""})
+        CHECK_MESSAGE(bench.second.find(key) != std::string::npos, key);
     CHECK(bench.second.find("\"disagreements\":0") != std::string::npos);
     CHECK(bench.second.find("\"embree_mode\":\"default\"") != std::string::npos);
     // Embree's robust mode (robust traversal, accurate triangle test) answers the same rays alike.

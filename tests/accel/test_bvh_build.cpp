@@ -1,0 +1,157 @@
+// The binned builder's set-up shortcuts (bins cleared only where a small range falls,
+// non-empty bins found by mask) and the memory bound of the default acceleration structure.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "mesh_fixtures.h"
+#include "scene/accelerator.h"
+#include "scene/mesh_scene.h"
+#include "scene/scene.h"
+
+namespace sahara {
+
+using namespace test;
+
+namespace {
+
+std::vector<Bounds3> boxes_of(const TriangleMesh& m) {
+    std::vector<Bounds3> boxes;
+    for (size_t i = 0; i < m.triangle_count(); ++i) {
+        Bounds3 b;
+        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
+        boxes.push_back(b);
+    }
+    return boxes;
+}
+
+double blocked_leaf(uint32_t n, const BvhBuildParams& p) {
+    return double((n + p.leaf_block_size - 1) / p.leaf_block_size * p.leaf_block_size);
+}
+
+bool same_box(const Bounds3& a, const Bounds3& b) {
+    for (int k = 0; k < 3; ++k)
+        if (a.lo[k] != b.lo[k] || a.hi[k] != b.hi[k]) return false;
+    return true;
+}
+
+/// The union of everything below `node`; counts the nodes whose box is not exactly that union.
+Bounds3 union_below(const Bvh& bvh, std::span<const Bounds3> prims, uint32_t node, int& loose) {
+    const BvhNode& n = bvh.nodes[node];
+    Bounds3 u;
+    if (n.is_leaf()) {
+        for (uint32_t s = n.index; s < n.index + n.count; ++s) u.extend(prims[bvh.prim_indices[s]]);
+    } else {
+        u.extend(union_below(bvh, prims, n.index, loose));
+        u.extend(union_below(bvh, prims, n.index + 1, loose));
+    }
+    if (!same_box(u, n.box())) ++loose;
+    return u;
+}
+
+/// Reference for a leaf of `count` primitives from slot `first`: the cheapest split over
+/// `bins` centroid bins per axis (the builder's rule, recomputed here in plain code), as
+/// traversal + intersection * sum(child area * blocked child count); +inf if none.
+double cheapest_binned_split(const Bvh& bvh, std::span<const Bounds3> prims, uint32_t first, uint32_t count,
+                             const BvhBuildParams& p) {
+    Bounds3 box, centroids;
+    for (uint32_t s = first; s < first + count; ++s) {
+        box.extend(prims[bvh.prim_indices[s]]);
+        centroids.extend(prims[bvh.prim_indices[s]].center());
+    }
+    auto blocked = [&](uint32_t n) {
+        return double((n + p.leaf_block_size - 1) / p.leaf_block_size * p.leaf_block_size);
+    };
+    double best = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+        const float extent = centroids.hi[axis] - centroids.lo[axis];
+        if (!(extent > 0.0f)) continue;
+        for (uint32_t pos = 1; pos < p.bin_count; ++pos) {
+            Bounds3 left, right;
+            uint32_t nl = 0, nr = 0;
+            for (uint32_t s = first; s < first + count; ++s) {
+                const Bounds3& b = prims[bvh.prim_indices[s]];
+                const int bin =
+                    std::clamp(int((b.center()[axis] - centroids.lo[axis]) * (float(p.bin_count) / extent)),
+                               0, int(p.bin_count) - 1);
+                if (uint32_t(bin) < pos)
+                    left.extend(b), ++nl;
+                else
+                    right.extend(b), ++nr;
+            }
+            if (nl == 0 || nr == 0) continue;
+            best = std::min(best,
+                            double(p.traversal_cost) * double(box.surface_area()) +
+                                double(p.intersection_cost) * (double(left.surface_area()) * blocked(nl) +
+                                                               double(right.surface_area()) * blocked(nr)));
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
+TEST_CASE("binned build: a leaf is never more expensive than its cheapest binned split") {
+    // The builder decides many small leaves without binning them, from a lower bound on
+    // every split's cost; a wrong bound would leave leaves that splitting makes cheaper.
+    for (const TriangleMesh& m : {make_icosphere(4), make_slivers(3000), make_scan_mesh(40, 60, 3, 5)}) {
+        BvhBuildParams p;
+        p.leaf_block_size = 4;
+        p.intersection_cost = 0.5f;  // the wide layout's weights (AcceleratorOptions::build_params)
+        const std::vector<Bounds3> boxes = boxes_of(m);
+        std::vector<Vec3> centers;
+        for (const Bounds3& b : boxes) centers.push_back(b.center());
+        const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::binned, p);
+        int leaves = 0, too_expensive = 0;
+        for (const BvhNode& n : bvh.nodes) {
+            if (!n.is_leaf() || n.count < 2 || &n == &bvh.nodes[1]) continue;
+            ++leaves;
+            const double leaf =
+                double(p.intersection_cost) * blocked_leaf(n.count, p) * double(n.box().surface_area());
+            if (leaf > cheapest_binned_split(bvh, boxes, n.index, n.count, p) * (1 + 1e-5)) ++too_expensive;
+        }
+        INFO(m.name, " ", too_expensive, " of ", leaves, " leaves");
+        REQUIRE(leaves > 100);
+        CHECK(too_expensive == 0);
+    }
+}
+
+TEST_CASE("binned build: every node's box is exactly the union of what it holds") {
+    // Bins that a small range does not touch keep the boxes of earlier nodes; a box read
+    // from such a bin would make a node larger than its contents, which validate_bvh allows.
+    const std::vector<TriangleMesh> meshes = {make_icosphere(4), make_slivers(3000), make_tiny_grid(40),
+                                              make_degenerate_mesh()};
+    for (const TriangleMesh& m : meshes) {
+        for (uint32_t bins : {4u, 16u, 64u}) {
+            BvhBuildParams p;
+            p.bin_count = bins;
+            p.leaf_block_size = 4;
+            const std::vector<Bounds3> boxes = boxes_of(m);
+            std::vector<Vec3> centers;
+            for (const Bounds3& b : boxes) centers.push_back(b.center());
+            const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::binned, p);
+            INFO(m.name, " bins ", bins);
+            REQUIRE(bvh.nodes.size() > 1);
+            int loose = 0;
+            union_below(bvh, boxes, 0, loose);
+            CHECK(loose == 0);
+        }
+    }
+}
+
+TEST_CASE("the default acceleration structure keeps at most 64 bytes per triangle") {
+    // Tree plus leaf triangle blocks (what Accelerator::bytes counts for the wide layout).
+    for (const TriangleMesh& m : {make_icosphere(5), make_slivers(20000), make_scan_mesh(60, 90, 4, 3)}) {
+        const Scene scene = scene_from_mesh(m);
+        const Accelerator acc(scene);
+        INFO(m.name, " ", acc.bytes(), " bytes for ", acc.primitive_count(), " triangles");
+        REQUIRE(acc.primitive_count() == m.triangle_count());
+        CHECK(double(acc.bytes()) / double(acc.primitive_count()) <= 64.0);
+    }
+}
+
+}  // namespace sahara
