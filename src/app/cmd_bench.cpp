@@ -13,6 +13,7 @@
 #include "scene/accelerator.h"
 #include "pipeline/bench_rays.h"
 #include "app/commands.h"
+#include "pipeline/bvh_report.h"
 #include "pipeline/mesh_input.h"
 #include "app/ray_batch.h"
 #include "app/cli_args.h"
@@ -217,6 +218,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"build_threads", opt.threads},
         {"mprims_s", double(accel.primitive_count()) / std::max(accel.build_ms() * 1e3, 1e-9)},
         {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
+    if (scene.instances()) j["instances"] = instance_level_json(scene);
     if (embree) {
         // rtcCommitScene alone: Embree's build from the triangle buffers (its device, started
         // before, and the buffer copies are in embree_setup_ms).
@@ -245,6 +247,14 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["primitive_kinds"].get<std::string>().c_str());
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
+    if (j.contains("instances")) {
+        const auto& in = j["instances"];
+        std::printf("instances   %zu of %zu prototypes, top-level tree %zu nodes; %zu triangles stored, %zu drawn\n"
+                    "            (not traced here: the rays below see the scene's own tree only)\n",
+                    in["instances"].get<size_t>(), in["prototypes"].get<size_t>(),
+                    in["top_level_nodes"].get<size_t>(), in["triangles_stored"].get<size_t>(),
+                    in["triangles_drawn"].get<size_t>());
+    }
     std::printf("threads     %d\n", j["threads"].get<int>());
     std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s%s)",
                 j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["build_cpu_ms"].get<double>(),
