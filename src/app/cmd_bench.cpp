@@ -249,11 +249,12 @@ void print_text(const nlohmann::ordered_json& j) {
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
     if (j.contains("instances")) {
         const auto& in = j["instances"];
-        std::printf("instances   %zu of %zu prototypes, top-level tree %zu nodes; %zu triangles stored, %zu drawn\n"
-                    "            (not traced here: the rays below see the scene's own tree only)\n",
-                    in["instances"].get<size_t>(), in["prototypes"].get<size_t>(),
-                    in["top_level_nodes"].get<size_t>(), in["triangles_stored"].get<size_t>(),
-                    in["triangles_drawn"].get<size_t>());
+        std::printf(
+            "instances   %zu of %zu prototypes, top-level tree %zu nodes; %zu triangles stored, %zu drawn\n"
+            "            (not traced here: the rays below see the scene's own tree only)\n",
+            in["instances"].get<size_t>(), in["prototypes"].get<size_t>(),
+            in["top_level_nodes"].get<size_t>(), in["triangles_stored"].get<size_t>(),
+            in["triangles_drawn"].get<size_t>());
     }
     std::printf("threads     %d\n", j["threads"].get<int>());
     std::printf("build       %.1f ms (%.2f Mprims/s), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s layout, %s%s)",

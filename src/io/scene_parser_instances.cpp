@@ -44,7 +44,8 @@ NamedObject parse_instance(JsonObject& o, ParseContext& ctx) {
     // An instance's transform applies after the named object's own; nested
     // instances compose here, so every InstanceDesc places a prototype directly.
     for (const InstanceDesc& part : it->second.parts) {
-        const InstanceDesc in{part.prototype, m * part.world_from_object, m.apply_vector(part.velocity) + velocity};
+        const InstanceDesc in{part.prototype, m * part.world_from_object,
+                              m.apply_vector(part.velocity) + velocity};
         ctx.scene->instances.push_back(in);
         placed.parts.push_back(in);
     }

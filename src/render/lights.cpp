@@ -128,8 +128,8 @@ bool sample_area_point(const Scene& scene, const Emitter& e, const Vec3& p, floa
         case Emitter::Kind::triangle: {
             const TriangleSoup& soup = scene.triangles;
             const uint32_t* v = &soup.indices[3 * size_t(e.index)];
-            *pl = sample_triangle(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]], u, nl, &area,
-                                  bary);
+            *pl = sample_triangle(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]], u, nl,
+                                  &area, bary);
             break;
         }
         case Emitter::Kind::instanced_triangle: {

@@ -49,8 +49,8 @@ InstanceSet::InstanceSet(const SceneDesc& desc) {
     std::vector<Vec3> centers;
     const float t0 = desc.camera.shutter_open, t1 = desc.camera.shutter_close;
     for (const InstanceDesc& in : desc.instances) {
-        instances_.push_back(
-            {Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.velocity, in.world_from_object});
+        instances_.push_back({Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.velocity,
+                              in.world_from_object});
         moving_ |= in.velocity != Vec3(0.0f);
         Bounds3 b = transformed_bounds(prototypes_[in.prototype].bounds(), in.world_from_object);
         if (in.velocity != Vec3(0.0f) && b.lo.x <= b.hi.x) {

@@ -73,8 +73,8 @@ class InstanceSet {
         Mat4 world_from_object;  ///< moves shading data back (double: once per hit)
         /// The ray in the prototype's space at the ray's time.
         Ray local_ray(const Ray& ray, float tmax) const {
-            return {object_from_world.point(ray.origin - velocity * ray.time), object_from_world.vector(ray.dir),
-                    ray.tmin, tmax, ray.time};
+            return {object_from_world.point(ray.origin - velocity * ray.time),
+                    object_from_world.vector(ray.dir), ray.tmin, tmax, ray.time};
         }
     };
     template <bool kAnyHit>

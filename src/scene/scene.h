@@ -66,8 +66,15 @@ struct SceneFeatures {
 
 /// Something that light sampling can pick: a light, an emissive primitive, or the envmap.
 struct Emitter {
-    enum class Kind : uint8_t { point, directional, sphere, triangle, box, envmap, instanced_triangle } kind =
-        Kind::point;
+    enum class Kind : uint8_t {
+        point,
+        directional,
+        sphere,
+        triangle,
+        box,
+        envmap,
+        instanced_triangle
+    } kind = Kind::point;
     uint32_t index = 0;  ///< into lights, spheres, triangles, boxes or instanced_emitters
 };
 
