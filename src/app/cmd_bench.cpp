@@ -13,6 +13,7 @@
 #include "scene/accelerator.h"
 #include "pipeline/bench_rays.h"
 #include "app/commands.h"
+#include "pipeline/bvh_report.h"
 #include "pipeline/mesh_input.h"
 #include "app/ray_batch.h"
 #include "app/cli_args.h"
@@ -219,6 +220,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"mprims_s", double(accel.primitive_count()) / std::max(accel.build_ms() * 1e3, 1e-9)},
         {"mprims_cpu_s", double(accel.primitive_count()) / std::max(accel.build_cpu_ms() * 1e3, 1e-9)}};
     j["mprims_s_per_thread"] = j["mprims_s"].get<double>() / opt.threads;
+    if (scene.instances()) j["instances"] = instance_level_json(scene);
     if (embree) {
         // rtcCommitScene alone: Embree's build from the triangle buffers (its device, started
         // before, and the buffer copies are in embree_setup_ms).
@@ -254,6 +256,15 @@ void print_text(const nlohmann::ordered_json& j) {
                 j["primitive_kinds"].get<std::string>().c_str());
     if (const auto planes = j["planes_outside_tree"].get<size_t>())
         std::printf("planes      %zu, unbounded: not in the tree, not traced here\n", planes);
+    if (j.contains("instances")) {
+        const auto& in = j["instances"];
+        std::printf(
+            "instances   %zu of %zu prototypes, top-level tree %zu nodes; %zu triangles stored, %zu drawn\n"
+            "            (not traced here: the rays below see the scene's own tree only)\n",
+            in["instances"].get<size_t>(), in["prototypes"].get<size_t>(),
+            in["top_level_nodes"].get<size_t>(), in["triangles_stored"].get<size_t>(),
+            in["triangles_drawn"].get<size_t>());
+    }
     std::printf("threads     %d\n", j["threads"].get<int>());
     std::printf(
         "build       %.1f ms (%.2f Mprims/s, %.2f per thread), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s "

@@ -100,6 +100,19 @@ void print_text(const nlohmann::ordered_json& j) {
     std::printf(
         "memory            %zu bytes (%.1f per primitive; tree %zu, leaf-ordered primitives the rest)\n",
         j["bytes"].get<size_t>(), j["bytes_per_primitive"].get<double>(), j["tree_bytes"].get<size_t>());
+    if (j.contains("instances")) {
+        const auto& in = j["instances"];
+        std::printf(
+            "instances         %zu of %zu prototypes; top-level tree %zu nodes (%zu leaves, depth %d)\n",
+            in["instances"].get<size_t>(), in["prototypes"].get<size_t>(),
+            in["top_level_nodes"].get<size_t>(), in["top_level_leaves"].get<size_t>(),
+            in["top_level_max_depth"].get<int>());
+        std::printf(
+            "                  %zu triangles stored, %zu drawn; %zu bytes (the counts above and below\n"
+            "                  are the scene's own tree, without the instances)\n",
+            in["triangles_stored"].get<size_t>(), in["triangles_drawn"].get<size_t>(),
+            in["bytes"].get<size_t>());
+    }
     for (const char* set : {"primary", "diffuse", "shadow"}) {
         const auto& r = j["rays"][set];
         std::printf("%-7s rays      %zu: %.1f nodes visited, %.2f primitives tested per ray\n", set,

@@ -236,6 +236,8 @@ struct PrototypeDesc {
 struct InstanceDesc {
     uint32_t prototype = 0;
     Mat4 world_from_object;  ///< invertible (the parser checks)
+    /// Motion blur: at time t the instance sits at translate(velocity * t) * world_from_object.
+    Vec3 velocity{0, 0, 0};
 };
 
 struct SceneDesc {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -96,7 +97,7 @@ void validate_attributes(const std::string& file, const tinyobj::attrib_t& attri
     for (const auto& [values, name] : lists) {
         const size_t stride = std::string(name) == "vt" ? 2 : 3;
         for (size_t i = 0; i < values->size(); ++i)
-            if (!std::isfinite((*values)[i]))
+            if (!std::isfinite(float((*values)[i])))  // read in double, stored in float
                 throw input_error(file, std::string(name) + " #" + std::to_string(i / stride + 1),
                                   "coordinate is not a finite number");
     }
@@ -247,7 +248,6 @@ class ObjShapeBuilder {
 /// One mesh per group; per-triangle material ids collapse to `material` when uniform.
 void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
                       const std::vector<tinyobj::shape_t>& shapes, bool fan_split, LoadedModel& model) {
-    validate_attributes(file, attrib);
     int default_material = -1;
     size_t face_number = 0;
     ObjShapeBuilder builder(file, attrib, model, default_material, fan_split);
@@ -261,6 +261,21 @@ void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
         }
         model.meshes.push_back(std::move(mesh));
     }
+}
+
+/// Where a model far from the origin is recentred before its positions round to
+/// float: the centre of its vertices' box, or zero for a model within 1024 of the
+/// origin (float keeps ~1e-4 there, and files near the origin load unchanged).
+Vec3d far_model_centre(const std::vector<tinyobj::real_t>& v) {
+    Vec3d lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    double reach = 0;
+    for (size_t i = 0; i + 2 < v.size(); i += 3) {
+        const Vec3d p(double(v[i]), double(v[i + 1]), double(v[i + 2]));
+        lo = min(lo, p);
+        hi = max(hi, p);
+        reach = std::max({reach, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    }
+    return reach > 1024.0 ? (lo + hi) * 0.5 : Vec3d(0.0);
 }
 
 /// tinyobjloader's warnings, one line each; a missing .mtl is reported by MtlFileReader, and
@@ -305,12 +320,22 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     obj::ObjTextures textures(model, mtl_reader.texture_dir());
     for (const tinyobj::material_t& m : materials)
         model.materials.push_back(obj::convert_material(m, keys[m.name], textures));
+    validate_attributes(file.string(), attrib);
+    // The file's digits were read in double (tinyobjloader's double build): subtract
+    // the centre before they become float, and let the transform (double) add it back.
+    const Vec3d centre = far_model_centre(attrib.vertices);
+    Mat4 placed = world_from_model;
+    if (centre != Vec3d(0.0)) {
+        for (size_t i = 0; i + 2 < attrib.vertices.size(); i += 3)
+            for (size_t k = 0; k < 3; ++k) attrib.vertices[i + k] -= centre[int(k)];
+        placed = world_from_model * Mat4::translate(centre);
+    }
     build_obj_meshes(file.string(), attrib, shapes, options.fan_split, model);
     if (model.meshes.empty()) throw input_error(file.string(), "", "no faces (is this an OBJ file?)");
     if (model.materials.empty()) model.materials.push_back(default_material());
 
     for (TriangleMesh& mesh : model.meshes) {
-        transform_mesh(mesh, world_from_model);
+        transform_mesh(mesh, placed);
         if (!options.keep_degenerate) model.dropped_degenerate += remove_degenerate(mesh);
     }
     std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.indices.empty(); });

@@ -298,7 +298,7 @@ void set_pbr(MaterialDesc& out, const tinyobj::material_t& m, const std::set<std
     if (keys.count("pr"))
         out.roughness = std::clamp(float(m.roughness), 0.0f, 1.0f);
     else if (specular)  // Beckmann/Phong equivalence alpha = sqrt(2 / (Ns + 2)), roughness = sqrt(alpha)
-        out.roughness = float(std::pow(2.0 / (std::max(0.0, double(m.shininess)) + 2.0), 0.25));
+        out.roughness = float(std::pow(2.0 / (std::max(0.0, double(float(m.shininess))) + 2.0), 0.25));
     if (!extension && specular && !(max_component(out.albedo.color) > 0.0f) &&
         out.albedo.kind == ColorSource::Kind::constant) {
         out.metallic = 1.0f;  // black Kd and a specular colour: the classic way of writing a metal
@@ -309,7 +309,7 @@ void set_pbr(MaterialDesc& out, const tinyobj::material_t& m, const std::set<std
         if (!m.roughness_texname.empty()) out.roughness = 1.0f;
         if (!m.metallic_texname.empty()) out.metallic = 1.0f;
     }
-    if (keys.count("ni") && m.ior > 1.0f) out.ior = float(m.ior);
+    if (keys.count("ni") && float(m.ior) > 1.0f) out.ior = float(m.ior);
     if (!m.normal_texname.empty()) {
         out.normal_texture =
             textures.get(m.normal_texname, m.normal_texopt, ObjTextures::Use::data, "norm of " + m.name);

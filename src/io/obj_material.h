@@ -2,6 +2,7 @@
 /// Internals of the OBJ loader: MTL materials -> MaterialDesc, and the checks
 /// of the text that tinyobjloader does not make (encoding, malformed numbers).
 #include <tiny_obj_loader.h>
+#include <type_traits>
 
 #include <filesystem>
 #include <map>
@@ -11,6 +12,9 @@
 #include "io/model_loader.h"
 
 namespace sahara::obj {
+
+// CMake compiles the files that include this with the double build's define.
+static_assert(std::is_same_v<tinyobj::real_t, double>, "OBJ files are read in double");
 
 /// Refuses UTF-16 and UTF-32 text, recognised by its byte-order mark, naming the encoding.
 void check_encoding(const std::string& file, const std::string& text);

@@ -32,6 +32,9 @@ NamedObject parse_instance(JsonObject& o, ParseContext& ctx) {
         if (!(std::isfinite(det) && det != 0.0))
             v->fail("is singular (an instance's transform must be invertible)");
     }
+    // Motion blur as a sphere's: velocity in the frame the transform maps into.
+    Vec3 velocity(0.0f);
+    if (auto v = o.get("velocity")) velocity = v->vec3();
     // The named object's geometry is stored relative to the local origin, so
     // the world-space transform is conjugated into that frame.
     m = Mat4::translate(-ctx.origin) * m * Mat4::translate(ctx.origin);
@@ -41,7 +44,8 @@ NamedObject parse_instance(JsonObject& o, ParseContext& ctx) {
     // An instance's transform applies after the named object's own; nested
     // instances compose here, so every InstanceDesc places a prototype directly.
     for (const InstanceDesc& part : it->second.parts) {
-        const InstanceDesc in{part.prototype, m * part.world_from_object};
+        const InstanceDesc in{part.prototype, m * part.world_from_object,
+                              m.apply_vector(part.velocity) + velocity};
         ctx.scene->instances.push_back(in);
         placed.parts.push_back(in);
     }

@@ -8,6 +8,7 @@
 #include "pipeline/bench_rays.h"
 #include "pipeline/mesh_input.h"
 #include "scene/accelerator.h"
+#include "scene/instances.h"
 
 namespace sahara {
 
@@ -114,7 +115,22 @@ nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file, c
     j["rays"]["primary"] = work_json(count_work(accel, rays.primary), rays.primary.size());
     j["rays"]["diffuse"] = work_json(count_work(accel, rays.diffuse), rays.diffuse.size());
     j["rays"]["shadow"] = work_json(count_work(accel, rays.shadow, true), rays.shadow.size());
+    if (scene.instances()) j["instances"] = instance_level_json(scene);
     return j;
+}
+
+nlohmann::ordered_json instance_level_json(const Scene& scene) {
+    const InstanceSet* in = scene.instances();
+    if (!in) return nullptr;
+    const BvhStats top = compute_bvh_stats(in->top_level());
+    return {{"instances", in->instance_count()},
+            {"prototypes", in->prototype_count()},
+            {"top_level_nodes", top.nodes},
+            {"top_level_leaves", top.leaves},
+            {"top_level_max_depth", top.max_depth},
+            {"triangles_stored", in->unique_triangle_count()},
+            {"triangles_drawn", in->instanced_triangle_count()},
+            {"bytes", in->bytes()}};
 }
 
 }  // namespace sahara

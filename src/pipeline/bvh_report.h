@@ -25,4 +25,9 @@ struct BvhReportOptions {
 nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file,
                                   const BvhReportOptions& options);
 
+/// The instance level of a scene with instances (null JSON without): the top-level
+/// tree's shape, prototypes, instances, triangles stored and drawn, and bytes. The
+/// rest of a bvh or bench report is about the scene's own (flat) tree.
+nlohmann::ordered_json instance_level_json(const Scene& scene);
+
 }  // namespace sahara

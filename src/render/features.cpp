@@ -62,6 +62,7 @@ std::string describe_features(const Scene& scene) {
                 ++spheres;
                 break;
             case Emitter::Kind::triangle:
+            case Emitter::Kind::instanced_triangle:  // counted as drawn: once per instance
                 ++triangles;
                 break;
             case Emitter::Kind::box:

@@ -51,11 +51,9 @@ bool sample_sphere_cone(const Sphere& s, const Vec3& p, float time, Vec2 u, Vec3
     return true;
 }
 
-/// A uniform point on triangle i (barycentrics by the square-root warp).
-Vec3 sample_triangle(const TriangleSoup& soup, uint32_t i, Vec2 u, Vec3* n, float* area, Vec2* bary) {
-    const Vec3& p0 = soup.positions[soup.indices[3 * i]];
-    const Vec3& p1 = soup.positions[soup.indices[3 * i + 1]];
-    const Vec3& p2 = soup.positions[soup.indices[3 * i + 2]];
+/// A uniform point on the triangle (p0, p1, p2) (barycentrics by the square-root warp).
+Vec3 sample_triangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, Vec2 u, Vec3* n, float* area,
+                     Vec2* bary) {
     const float su = std::sqrt(u.x);
     const float b1 = u.y * su, b2 = 1.0f - su;
     const Vec3 c = cross(p1 - p0, p2 - p0);
@@ -101,15 +99,23 @@ uint32_t material_of(const Scene& scene, const Emitter& e) {
             return scene.triangles.material[e.index];
         case Emitter::Kind::box:
             return scene.boxes[e.index].material;
+        case Emitter::Kind::instanced_triangle:
+            return scene.instanced_emitters[e.index].material;
         default:
             return 0;
     }
 }
 
-PrimKind prim_kind_of(Emitter::Kind k) {
-    return k == Emitter::Kind::sphere     ? PrimKind::sphere
-           : k == Emitter::Kind::triangle ? PrimKind::triangle
-                                          : PrimKind::box;
+/// The hit that would have found the sampled point of emitter e (barycentrics bary).
+Hit hit_of(const Scene& scene, const Emitter& e, Vec2 bary) {
+    if (e.kind == Emitter::Kind::instanced_triangle) {
+        const InstancedEmitter& t = scene.instanced_emitters[e.index];
+        return Hit{1.0f, make_prim_id(PrimKind::triangle, t.triangle), bary.x, bary.y, t.instance};
+    }
+    const PrimKind kind = e.kind == Emitter::Kind::sphere     ? PrimKind::sphere
+                          : e.kind == Emitter::Kind::triangle ? PrimKind::triangle
+                                                              : PrimKind::box;
+    return Hit{1.0f, make_prim_id(kind, e.index), bary.x, bary.y};
 }
 
 /// A point on an area emitter with its outward normal and its density per unit solid angle at p.
@@ -119,9 +125,19 @@ bool sample_area_point(const Scene& scene, const Emitter& e, const Vec3& p, floa
     switch (e.kind) {
         case Emitter::Kind::sphere:
             return sample_sphere_cone(scene.spheres[e.index], p, time, u, pl, nl, pdf_solid);
-        case Emitter::Kind::triangle:
-            *pl = sample_triangle(scene.triangles, e.index, u, nl, &area, bary);
+        case Emitter::Kind::triangle: {
+            const TriangleSoup& soup = scene.triangles;
+            const uint32_t* v = &soup.indices[3 * size_t(e.index)];
+            *pl = sample_triangle(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]], u, nl,
+                                  &area, bary);
             break;
+        }
+        case Emitter::Kind::instanced_triangle: {
+            const InstancedEmitter& t = scene.instanced_emitters[e.index];
+            const Vec3 shift = t.velocity * time;
+            *pl = sample_triangle(t.p0 + shift, t.p1 + shift, t.p2 + shift, u, nl, &area, bary);
+            break;
+        }
         case Emitter::Kind::box: {
             const Bounds3& b = scene.boxes[e.index].box;
             *pl = sample_box(b, u, nl);
@@ -156,8 +172,7 @@ bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, floa
     } else {
         // Textured emission: let the scene compute uv exactly as for a hit.
         const Ray r{p, d, 0.0f, 2.0f, time};
-        const SurfaceInteraction si =
-            scene.interact(r, Hit{1.0f, make_prim_id(prim_kind_of(e.kind), e.index), bary.x, bary.y});
+        const SurfaceInteraction si = scene.interact(r, hit_of(scene, e, bary));
         ls.li = m.type == MaterialType::pbr ? pbr_emission(m, si, scene.textures)
                                             : eval_color(m.radiance, scene.textures, si.p, si.uv);
     }
@@ -213,8 +228,7 @@ bool sample_light(const Scene& scene, const Vec3& p, float time, float u_select,
 }
 
 uint32_t emitter_of_hit(const Scene& scene, const Hit& hit) {
-    // Instanced emitters are not light-sampled: found by BSDF sampling alone (MIS weight 1).
-    if (hit.instance != kNoInstance) return kNoEmitter;
+    if (hit.instance != kNoInstance) return scene.instanced_emitter(hit.instance, prim_index(hit.prim));
     const uint32_t i = prim_index(hit.prim);
     switch (prim_kind(hit.prim)) {
         case PrimKind::sphere:
@@ -246,6 +260,9 @@ float area_light_pdf(const Scene& scene, uint32_t emitter, const Vec3& p, const 
         const Vec3& p0 = t.positions[t.indices[3 * e.index]];
         area = 0.5f * length(cross(t.positions[t.indices[3 * e.index + 1]] - p0,
                                    t.positions[t.indices[3 * e.index + 2]] - p0));
+    } else if (e.kind == Emitter::Kind::instanced_triangle) {
+        const InstancedEmitter& t = scene.instanced_emitters[e.index];
+        area = 0.5f * length(cross(t.p1 - t.p0, t.p2 - t.p0));
     } else if (e.kind == Emitter::Kind::box) {
         area = scene.boxes[e.index].box.surface_area();
     }

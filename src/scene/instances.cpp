@@ -47,10 +47,18 @@ InstanceSet::InstanceSet(const SceneDesc& desc) {
     instances_.reserve(desc.instances.size());
     std::vector<Bounds3> boxes;
     std::vector<Vec3> centers;
+    const float t0 = desc.camera.shutter_open, t1 = desc.camera.shutter_close;
     for (const InstanceDesc& in : desc.instances) {
-        instances_.push_back(
-            {Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.world_from_object});
-        const Bounds3 b = transformed_bounds(prototypes_[in.prototype].bounds(), in.world_from_object);
+        instances_.push_back({Affine3f(affine_inverse(in.world_from_object)), in.prototype, in.velocity,
+                              in.world_from_object});
+        moving_ |= in.velocity != Vec3(0.0f);
+        Bounds3 b = transformed_bounds(prototypes_[in.prototype].bounds(), in.world_from_object);
+        if (in.velocity != Vec3(0.0f) && b.lo.x <= b.hi.x) {
+            // A translation sweeps the box between its two ends (both, for any shutter order).
+            const Bounds3 start{b.lo + in.velocity * t0, b.hi + in.velocity * t0};
+            b = Bounds3{b.lo + in.velocity * t1, b.hi + in.velocity * t1};
+            b.extend(start);
+        }
         boxes.push_back(b);
         centers.push_back(b.lo.x <= b.hi.x ? b.center() : Vec3(0.0f));
         bounds_.extend(b);
@@ -74,8 +82,7 @@ bool InstanceSet::trace(Ray& ray, Hit& hit) const {
             const Instance& in = instances_[id];
             const Accelerator* accel = prototypes_[in.prototype].accelerator();
             // Not renormalised: t means the same distance along the ray in both spaces.
-            Ray local{in.object_from_world.point(ray.origin), in.object_from_world.vector(ray.dir), ray.tmin,
-                      tmax, ray.time};
+            Ray local = in.local_ray(ray, tmax);
             if constexpr (kAnyHit) {
                 if (accel->occluded(local)) return true;
             } else {
@@ -105,15 +112,14 @@ bool InstanceSet::occluded(const Ray& ray) const {
 
 SurfaceInteraction InstanceSet::interact(const Ray& ray, const Hit& hit) const {
     const Instance& in = instances_[hit.instance];
-    const Ray local{in.object_from_world.point(ray.origin), in.object_from_world.vector(ray.dir), ray.tmin,
-                    ray.tmax, ray.time};
+    const Ray local = in.local_ray(ray, ray.tmax);
     Hit h = hit;
     h.instance = kNoInstance;
     // Oriented against the local ray: the inverse transpose keeps the sign of
     // dot(n, dir), so the orientation holds in world space too.
     SurfaceInteraction si = prototypes_[in.prototype].interact(local, h);
     const Mat4& m = in.world_from_object;
-    si.p = m.apply_point(si.p);
+    si.p = m.apply_point(si.p) + in.velocity * ray.time;
     si.ng = m.apply_normal(si.ng);
     si.ns = m.apply_normal(si.ns);
     if (si.tangent != Vec3(0.0f)) {

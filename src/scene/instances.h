@@ -45,8 +45,18 @@ class InstanceSet {
     /// Shading data of a hit with hit.instance set, in world space.
     SurfaceInteraction interact(const Ray& ray, const Hit& hit) const;
 
+    /// World bounds over the shutter (moving instances: both ends of their path).
     Bounds3 bounds() const { return bounds_; }
+    /// Whether an instance moves (has a velocity); motion blur needs the ray times then.
+    bool has_motion() const { return moving_; }
     size_t instance_count() const { return instances_.size(); }
+    /// The bottom-level scene an instance places, and where: for light sampling.
+    const Scene& prototype_of(uint32_t instance) const { return prototypes_[instances_[instance].prototype]; }
+    uint32_t prototype_index(uint32_t instance) const { return instances_[instance].prototype; }
+    const Mat4& world_from_object(uint32_t instance) const { return instances_[instance].world_from_object; }
+    Vec3 velocity(uint32_t instance) const { return instances_[instance].velocity; }
+    /// The top-level tree (its leaves hold instance indices), for reports.
+    const Bvh& top_level() const { return top_; }
     size_t prototype_count() const { return prototypes_.size(); }
     /// Triangles stored once per prototype (what memory holds)...
     size_t unique_triangle_count() const;
@@ -59,7 +69,13 @@ class InstanceSet {
     struct Instance {
         Affine3f object_from_world;  ///< moves rays into the prototype's space
         uint32_t prototype;
+        Vec3 velocity;           ///< world-space motion: the ray origin moves back by velocity * time
         Mat4 world_from_object;  ///< moves shading data back (double: once per hit)
+        /// The ray in the prototype's space at the ray's time.
+        Ray local_ray(const Ray& ray, float tmax) const {
+            return {object_from_world.point(ray.origin - velocity * ray.time),
+                    object_from_world.vector(ray.dir), ray.tmin, tmax, ray.time};
+        }
     };
     template <bool kAnyHit>
     bool trace(Ray& ray, Hit& hit) const;
@@ -68,6 +84,7 @@ class InstanceSet {
     std::vector<Instance> instances_;
     Bvh top_;  ///< leaves hold instance indices
     Bounds3 bounds_;
+    bool moving_ = false;
 };
 
 }  // namespace sahara

@@ -66,8 +66,24 @@ struct SceneFeatures {
 
 /// Something that light sampling can pick: a light, an emissive primitive, or the envmap.
 struct Emitter {
-    enum class Kind : uint8_t { point, directional, sphere, triangle, box, envmap } kind = Kind::point;
-    uint32_t index = 0;  ///< into lights, spheres, triangles or boxes
+    enum class Kind : uint8_t {
+        point,
+        directional,
+        sphere,
+        triangle,
+        box,
+        envmap,
+        instanced_triangle
+    } kind = Kind::point;
+    uint32_t index = 0;  ///< into lights, spheres, triangles, boxes or instanced_emitters
+};
+
+/// An emissive triangle of a prototype as one instance places it: light sampling
+/// picks it like a triangle of the flat tree.
+struct InstancedEmitter {
+    Vec3 p0, p1, p2;  ///< world space at time 0
+    Vec3 velocity;    ///< the instance's: the triangle at time t is moved by velocity * t
+    uint32_t instance = 0, triangle = 0, material = 0;  ///< triangle: in the prototype
 };
 inline constexpr uint32_t kNoEmitter = 0xFFFFFFFFu;
 
@@ -134,6 +150,7 @@ class Scene {
     std::vector<uint32_t> sphere_emitter;    ///< emitter id per sphere (kNoEmitter: none); empty if none emit
     std::vector<uint32_t> triangle_emitter;  ///< same per triangle
     std::vector<uint32_t> box_emitter;       ///< same per box
+    std::vector<InstancedEmitter> instanced_emitters;  ///< Emitter::Kind::instanced_triangle's entries
     uint32_t envmap_emitter = kNoEmitter;
     Distribution2D envmap_distribution;  ///< over the envmap's (u, v), luminance * sin(theta)
     float scene_radius = 1;              ///< bounding-sphere radius of the bounded geometry
@@ -148,8 +165,14 @@ class Scene {
     const InstanceSet* instances() const { return instances_.get(); }
     /// Adds the instance level; call before build_accelerator() (bounds include it).
     void set_instances(std::unique_ptr<InstanceSet> instances);
+    /// Emitter id of triangle `triangle` of the prototype that `instance` places
+    /// (kNoEmitter: it does not emit); set by prepare_lighting().
+    uint32_t instanced_emitter(uint32_t instance, uint32_t triangle) const;
 
    private:
+    void collect_instanced_emitters(std::vector<float>& power);
+    std::vector<uint32_t> instance_emitter_base_;                ///< per instance; empty if none emits
+    std::vector<std::vector<uint32_t>> prototype_emitter_slot_;  ///< per prototype, per triangle
     std::unique_ptr<Accelerator> accel_;
     std::unique_ptr<InstanceSet> instances_;
     Bounds3 bounds_;

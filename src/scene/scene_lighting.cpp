@@ -141,6 +141,7 @@ void collect_features(const Scene& s, SceneFeatures& f) {
     f.lambertian_only = !f.has_metal && !f.has_dielectric && !f.has_pbr;
     const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
     for (const Sphere& sp : s.spheres) f.has_motion |= shutter && sp.velocity != Vec3(0.0f);
+    if (s.instances()) f.has_motion |= shutter && s.instances()->has_motion();
     f.has_lens = s.camera.aperture > 0;
 }
 
@@ -154,6 +155,67 @@ void force_all(SceneFeatures& f) {
 }
 
 }  // namespace
+
+void Scene::collect_instanced_emitters(std::vector<float>& power) {
+    instanced_emitters.clear();
+    instance_emitter_base_.clear();
+    prototype_emitter_slot_.clear();
+    if (!instances_) return;
+    // Per prototype: which triangles emit (their slot) and their radiance estimate.
+    std::vector<std::vector<float>> radiance(instances_->prototype_count());
+    prototype_emitter_slot_.resize(instances_->prototype_count());
+    bool any = false;
+    for (uint32_t in = 0; in < instances_->instance_count(); ++in) {
+        const uint32_t p = instances_->prototype_index(in);
+        const Scene& proto = instances_->prototype_of(in);
+        std::vector<uint32_t>& slot = prototype_emitter_slot_[p];
+        if (slot.empty() && proto.triangles.size() > 0) {
+            slot.assign(proto.triangles.size(), kNoEmitter);
+            for (uint32_t i = 0; i < proto.triangles.size(); ++i) {
+                const MaterialDesc& m = proto.materials[proto.triangles.material[i]];
+                const float r = is_sampled_emitter(m) ? triangle_radiance(proto, i, m) : 0.0f;
+                if (!(r > 0)) continue;
+                slot[i] = uint32_t(radiance[p].size());
+                radiance[p].push_back(r);
+            }
+        }
+        any |= !radiance[p].empty();
+    }
+    if (!any) return;
+    instance_emitter_base_.assign(instances_->instance_count(), kNoEmitter);
+    for (uint32_t in = 0; in < instances_->instance_count(); ++in) {
+        const uint32_t p = instances_->prototype_index(in);
+        if (radiance[p].empty()) continue;
+        instance_emitter_base_[in] = uint32_t(emitters.size());
+        const TriangleSoup& soup = instances_->prototype_of(in).triangles;
+        const Mat4& m = instances_->world_from_object(in);
+        for (uint32_t i = 0; i < soup.size(); ++i) {
+            const uint32_t k = prototype_emitter_slot_[p][i];
+            if (k == kNoEmitter) continue;
+            InstancedEmitter e;
+            e.p0 = m.apply_point(soup.positions[soup.indices[3 * size_t(i)]]);
+            e.p1 = m.apply_point(soup.positions[soup.indices[3 * size_t(i) + 1]]);
+            e.p2 = m.apply_point(soup.positions[soup.indices[3 * size_t(i) + 2]]);
+            e.velocity = instances_->velocity(in);
+            e.instance = in;
+            e.triangle = i;
+            e.material = soup.material[i];
+            // Every slot gets its entry (ids are base + slot); a degenerate one gets no power.
+            const float area = 0.5f * length(cross(e.p1 - e.p0, e.p2 - e.p0));
+            emitters.push_back({Emitter::Kind::instanced_triangle, uint32_t(instanced_emitters.size())});
+            power.push_back(area > 0 ? kPiF * area * radiance[p][k] : 0.0f);
+            instanced_emitters.push_back(e);
+        }
+    }
+}
+
+uint32_t Scene::instanced_emitter(uint32_t instance, uint32_t triangle) const {
+    if (instance_emitter_base_.empty()) return kNoEmitter;
+    const uint32_t base = instance_emitter_base_[instance];
+    if (base == kNoEmitter) return kNoEmitter;
+    const uint32_t k = prototype_emitter_slot_[instances_->prototype_index(instance)][triangle];
+    return k == kNoEmitter ? kNoEmitter : base + k;
+}
 
 void Scene::prepare_lighting(bool force_all_features) {
     emitters.clear();
@@ -180,6 +242,7 @@ void Scene::prepare_lighting(bool force_all_features) {
     for (uint32_t i = 0; i < boxes.size(); ++i)
         add_area_emitter(box_emitter, boxes.size(), Emitter::Kind::box, i, boxes[i].box.surface_area(),
                          materials[boxes[i].material], emitters, power);
+    collect_instanced_emitters(power);
     const size_t area_count = emitters.size() - delta_count;
 
     envmap_distribution = Distribution2D();

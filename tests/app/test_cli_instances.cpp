@@ -56,3 +56,29 @@ TEST_CASE("instances: an instance of an unknown name exits 2 naming it") {
     CHECK(r.err.find("objects[1].of") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(dir.path / "out.png"));
 }
+
+TEST_CASE("instances: sahara bvh and bench report the instance level beside the scene's own tree") {
+    TempDir dir("cli_instances_bvh");
+    gltf::write_text(dir.path / "square.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    gltf::write_text(dir.path / "scene.json",
+                     R"({"camera": {"position": [0, -5, 1], "look_at": [0, 0, 0]},
+                   "objects": [{"type": "mesh", "file": "square.obj", "name": "a"},
+                               {"type": "instance", "of": "a", "name": "b", "transform": {"translate": [2, 0, 0]}},
+                               {"type": "instance", "of": "b", "transform": {"translate": [0, 2, 0]}},
+                               {"type": "sphere", "center": [0, 0, 3], "radius": 1}]})");
+    const CliRun bvh = run_sahara("bvh scene.json --size 16 --json", dir);
+    REQUIRE(bvh.code == 0);
+    const json j = json::parse(bvh.out);
+    CHECK(j["primitives"] == 1);  // the sphere: the scene's own tree
+    REQUIRE(j.contains("instances"));
+    CHECK(j["instances"]["instances"] == 3);
+    CHECK(j["instances"]["prototypes"] == 1);
+    CHECK(j["instances"]["triangles_stored"] == 2);
+    CHECK(j["instances"]["triangles_drawn"] == 6);
+    CHECK(j["instances"]["top_level_leaves"].get<int>() >= 2);  // leaves hold one or two instances
+    const CliRun text = run_sahara("bvh scene.json --size 16", dir);
+    CHECK(text.out.find("3 of 1 prototypes") != std::string::npos);
+    const CliRun bench = run_sahara("bench scene.json --size 16 --json --no-embree", dir);
+    REQUIRE(bench.code == 0);
+    CHECK(json::parse(bench.out)["instances"]["instances"] == 3);
+}

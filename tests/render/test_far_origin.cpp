@@ -172,3 +172,46 @@ TEST_CASE("far origin: a scene moved by 1e6 or 1e7 renders like the scene at the
         CHECK(fraction <= c.max_fraction);
     }
 }
+
+namespace {
+
+/// The pyramid with its vertices written at `o` + the small coordinates, digits
+/// enough for double: what a surveyed or georeferenced OBJ looks like.
+void write_far_pyramid_obj(const std::filesystem::path& file, const Vec3d& o) {
+    const double v[5][3] = {{-0.7, -0.7, 0}, {0.7, -0.7, 0}, {0.7, 0.7, 0}, {-0.7, 0.7, 0}, {0.05, 0.1, 1.3}};
+    std::ofstream out(file);
+    out.precision(17);
+    for (const auto& p : v) out << "v " << o.x + p[0] << " " << o.y + p[1] << " " << o.z + p[2] << "\n";
+    out << "f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 1 4 3 2\n";
+}
+
+std::string far_obj_scene(const Vec3d& o) {
+    json scene = {
+        {"render", {{"width", 48}, {"height", 36}, {"spp", 4}, {"max_depth", 3}, {"seed", 2}}},
+        {"camera", {{"position", at(o, 0.9, -3.1, 1.9)}, {"look_at", at(o, 0, 0, 0.5)}, {"vfov", 45}}},
+        {"background", {{"type", "constant"}, {"color", {0.2, 0.25, 0.3}}}},
+        {"lights", {{{"type", "point"}, {"position", at(o, -2, -3, 4)}, {"intensity", {20, 20, 20}}}}},
+        {"objects",
+         {{{"type", "plane"}, {"point", at(o, 0, 0, 0)}, {"normal", {0, 0, 1}}},
+          {{"type", "mesh"}, {"file", "far_pyramid.obj"}}}}};
+    return scene.dump();
+}
+
+}  // namespace
+
+TEST_CASE("far origin: an OBJ whose vertices sit 1e6 or 1e7 away renders like the OBJ at the origin") {
+    // tinyobjloader's double build reads the digits; the loader recentres the model
+    // before they round to float. Read in float, the vertices would snap to a grid of
+    // 1/16 (1e6) or 1 (1e7) and the pyramid would change shape.
+    const auto dir = test::gltf::scratch("far_origin_obj");
+    write_far_pyramid_obj(dir / "far_pyramid.obj", {0, 0, 0});
+    const std::vector<float> ref = render_pixels(far_obj_scene({0, 0, 0}), dir);
+    for (const Vec3d& o : {Vec3d(1e6 + 0.3, -1e6, 2e6), Vec3d(-1e7, 1e7 + 0.7, 1e6)}) {
+        INFO("offset " << o.x << ", " << o.y << ", " << o.z);
+        write_far_pyramid_obj(dir / "far_pyramid.obj", o);
+        const std::vector<float> img = render_pixels(far_obj_scene(o), dir);
+        const double fraction = differing_fraction(ref, img, 1e-3f);
+        INFO("differing pixels " << fraction);
+        CHECK(fraction <= 0.005);
+    }
+}
