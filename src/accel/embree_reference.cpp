@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/process_usage.h"
+
 #if SAHARA_HAVE_EMBREE
 #include <embree3/rtcore.h>
 #endif
@@ -79,7 +81,9 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
     rtcReleaseGeometry(geom);
     const int64_t before_commit = impl_->allocated.load();
     const auto commit = Clock::now();
+    const double cpu_before_commit = process_cpu_ms();
     rtcCommitScene(impl_->scene);
+    build_cpu_ms_ = process_cpu_ms() - cpu_before_commit;
     const auto end = Clock::now();
     // What the build added and keeps: the BVH and its leaf triangles (the vertex and
     // index buffers were allocated before).

@@ -53,6 +53,9 @@ class EmbreeReference {
     /// (device, buffer copies, build).
     double build_ms() const { return build_ms_; }
     double setup_ms() const { return setup_ms_; }
+    /// CPU time of rtcCommitScene summed over the process's threads (steadier than
+    /// build_ms when other processes share the cores).
+    double build_cpu_ms() const { return build_cpu_ms_; }
     /// Bytes Embree's scene build allocated and kept (BVH nodes and leaf triangles,
     /// without the vertex and index buffers), from its device memory monitor.
     size_t bvh_bytes() const { return bvh_bytes_; }
@@ -61,6 +64,7 @@ class EmbreeReference {
     struct Impl;
     std::unique_ptr<Impl> impl_;
     double build_ms_ = 0;
+    double build_cpu_ms_ = 0;
     size_t bvh_bytes_ = 0;
     double setup_ms_ = 0;
 };
