@@ -6,10 +6,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <ctime>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+
+#include "base/process_usage.h"
 
 #if SAHARA_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -35,14 +36,6 @@ struct EmbreeReference::Impl {
 };
 
 bool EmbreeReference::available() { return true; }
-
-namespace {
-double process_cpu_ms() {
-    timespec ts{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
-}
-}  // namespace
 
 EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<const uint32_t> indices,
                                  bool robust, int build_threads, std::string_view max_isa,
@@ -88,9 +81,9 @@ EmbreeReference::EmbreeReference(std::span<const Vec3> positions, std::span<cons
     rtcReleaseGeometry(geom);
     const int64_t before_commit = impl_->allocated.load();
     const auto commit = Clock::now();
-    const double cpu_commit = process_cpu_ms();
+    const double cpu_before_commit = process_cpu_ms();
     rtcCommitScene(impl_->scene);
-    build_cpu_ms_ = process_cpu_ms() - cpu_commit;
+    build_cpu_ms_ = process_cpu_ms() - cpu_before_commit;
     const auto end = Clock::now();
     // What the build added and keeps: the BVH and its leaf triangles (the vertex and
     // index buffers were allocated before).

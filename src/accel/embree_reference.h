@@ -53,8 +53,8 @@ class EmbreeReference {
     /// (device, buffer copies, build).
     double build_ms() const { return build_ms_; }
     double setup_ms() const { return setup_ms_; }
-    /// Process CPU time of rtcCommitScene (all of Embree's build threads; on a shared
-    /// machine steadier than the wall time).
+    /// CPU time of rtcCommitScene summed over the process's threads (steadier than
+    /// build_ms when other processes share the cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
     /// Bytes Embree's scene build allocated and kept (BVH nodes and leaf triangles,
     /// without the vertex and index buffers), from its device memory monitor.

@@ -15,10 +15,12 @@
 #include "app/commands.h"
 #include "pipeline/bvh_report.h"
 #include "pipeline/mesh_input.h"
+#include "io/generated_mesh.h"
 #include "app/ray_batch.h"
 #include "app/cli_args.h"
 #include "accel/packet.h"
 #include "base/error.h"
+#include "base/process_usage.h"
 
 namespace sahara {
 
@@ -30,11 +32,15 @@ constexpr const char* kBenchUsage =
     "                         [--builder binned|sweep|reinsert] [--layout L] [--size WxH|N] [--repeat K]\n"
     "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
     "                         [--embree-quality low|medium|high]\n"
+    "       sahara bench --generated-mesh N [options above]\n"
     "       sahara bench --small-scenes   (flat loop vs tree for scenes of 1..32 primitives)\n"
     "  FILE        a mesh (.obj, .gltf, .glb) or a scene file (.json); for a scene the tree holds\n"
     "              its triangles, spheres, boxes and quadrics (planes are unbounded: not in the\n"
     "              tree, not traced), primary rays come from the scene's camera (lens centre), and\n"
     "              the Embree comparison runs only if every bounded primitive is a triangle\n"
+    "  --generated-mesh N\n"
+    "              instead of FILE, a displaced sphere of exactly N triangles made in memory\n"
+    "              (N even, at least 6); the report adds the process's resident memory\n"
     "  --threads   threads for building and tracing (default: all cores)\n"
     "  --ray-set S ray set to trace (default all): primary = W x H camera rays framing the mesh\n"
     "              (a scene: its camera), primary_packet = the primary rays as 16-ray packets of\n"
@@ -79,6 +85,7 @@ constexpr const char* kBenchUsage =
 
 struct BenchOptions {
     std::string mesh;
+    size_t generated_triangles = 0;  ///< > 0: --generated-mesh instead of a file
     int threads = 1;
     std::vector<std::string> sets;
     BvhBuilder builder = BvhBuilder::binned;
@@ -180,25 +187,54 @@ std::string embree_plan(const BenchOptions& opt, const Scene& scene) {
     return "compared";
 }
 
+/// The process's resident memory (MiB) by stage: a stage's peak is the high-water
+/// mark while it ran (reset_peak_rss before it), its rss what it left resident.
+struct MemoryStages {
+    double input_rss = 0, input_peak = 0;    ///< the input read (or generated)
+    double sahara_rss = 0, sahara_peak = 0;  ///< sahara's build
+    double embree_rss = 0, embree_peak = 0;  ///< Embree's build (if it ran)
+};
+
+nlohmann::ordered_json memory_json(const MemoryStages& m, bool embree) {
+    nlohmann::ordered_json j = {{"input_rss_mib", m.input_rss},
+                                {"input_peak_rss_mib", m.input_peak},
+                                {"sahara_build_rss_mib", m.sahara_rss},
+                                {"sahara_build_peak_rss_mib", m.sahara_peak}};
+    if (embree) {
+        j["embree_build_rss_mib"] = m.embree_rss;
+        j["embree_build_peak_rss_mib"] = m.embree_peak;
+    }
+    return j;
+}
+
 nlohmann::ordered_json run_bench(const BenchOptions& opt) {
     omp_set_num_threads(opt.threads);
-    const ToolInput input = read_tool_input(opt.mesh);
+    const ToolInput input =
+        opt.generated_triangles ? generated_tool_input(opt.generated_triangles) : read_tool_input(opt.mesh);
     const Scene& scene = input.scene;
     const TriangleMesh& mesh = input.triangles;
+    MemoryStages memory{current_rss_mib(), peak_rss_mib()};
+    reset_peak_rss();
     AcceleratorOptions aopt;
     aopt.builder = opt.builder;
     aopt.layout = opt.layout;
     const Accelerator accel(scene, aopt);
+    memory.sahara_rss = current_rss_mib();
+    memory.sahara_peak = peak_rss_mib();
     std::unique_ptr<EmbreeReference> embree;
     const std::string embree_status = embree_plan(opt, scene);
-    if (embree_status == "compared")
+    if (embree_status == "compared") {
+        reset_peak_rss();
         embree = std::make_unique<EmbreeReference>(mesh.positions, mesh.indices, opt.embree_robust,
                                                    opt.threads, opt.embree_isa, opt.embree_quality);
+        memory.embree_rss = current_rss_mib();
+        memory.embree_peak = peak_rss_mib();
+    }
     const BenchRaySets rays =
         make_bench_rays(scene, accel, opt.width, opt.height,
                         input.from_scene_file ? BenchAim::scene_camera : BenchAim::frame_bounds);
     nlohmann::ordered_json j = {
-        {"mesh", opt.mesh},
+        {"mesh", opt.generated_triangles ? mesh.name : opt.mesh},
         {"input", input.from_scene_file ? "scene" : "mesh"},
         {"primitives", accel.primitive_count()},
         {"primitive_kinds", primitive_kinds_text(scene)},
@@ -237,6 +273,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         j["embree_bvh_bytes_per_primitive"] =
             double(embree->bvh_bytes()) / double(std::max<size_t>(accel.primitive_count(), 1));
     }
+    if (opt.generated_triangles) j["memory"] = memory_json(memory, embree != nullptr);
     for (const std::string& set : opt.sets) {
         if (set == "primary_packet") {
             j["rays"][set] = bench_packet_set(mesh, accel, embree.get(), rays.primary, opt);
@@ -248,6 +285,17 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         j["rays"][set] = bench_set(mesh, accel, embree.get(), r, set == "shadow", opt);
     }
     return j;
+}
+
+/// The process's resident memory by stage: what it left, and its peak while it ran.
+void print_memory(const nlohmann::ordered_json& m) {
+    std::printf("memory      resident MiB after (peak during): input %.0f (%.0f), sahara's build %.0f (%.0f)",
+                m["input_rss_mib"].get<double>(), m["input_peak_rss_mib"].get<double>(),
+                m["sahara_build_rss_mib"].get<double>(), m["sahara_build_peak_rss_mib"].get<double>());
+    if (m.contains("embree_build_rss_mib"))
+        std::printf(", Embree's build %.0f (%.0f)", m["embree_build_rss_mib"].get<double>(),
+                    m["embree_build_peak_rss_mib"].get<double>());
+    std::printf("\n");
 }
 
 void print_text(const nlohmann::ordered_json& j) {
@@ -290,6 +338,7 @@ void print_text(const nlohmann::ordered_json& j) {
         std::printf(", Embree %.1f (what its build allocated)",
                     j["embree_bvh_bytes_per_primitive"].get<double>());
     std::printf("\n");
+    if (j.contains("memory")) print_memory(j["memory"]);
     const bool embree = j.contains("embree_build_ms");
     if (!embree) std::printf("Embree      %s\n", j["embree"].get<std::string>().c_str());
     std::printf("%-14s %9s %8s %8s %8s", "rays", "count", "hit rate", "MRays/s", "(CPU)");
@@ -403,6 +452,14 @@ void add_bench_options(CLI::App& app, BenchOptions& opt, bool& small_scenes) {
     app.add_flag_callback("--no-embree", [&opt] { opt.embree = false; });
     app.add_flag("--embree-robust", opt.embree_robust);
     app.add_flag("--small-scenes", small_scenes);
+    app.add_option_function<std::string>("--generated-mesh", [&opt](const std::string& v) {
+        opt.generated_triangles = size_t(parse_int_value("--generated-mesh", v, 6, 1ll << 32));
+        try {
+            sphere_grid_for(opt.generated_triangles);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(std::string("--generated-mesh: ") + e.what());
+        }
+    });
 }
 
 }  // namespace
@@ -418,7 +475,9 @@ int run_bench_command(int argc, char** argv) {
         add_bench_options(app, opt, small_scenes);
         const std::vector<std::string> files =
             parse_command_line(app, std::vector<std::string>(argv + 1, argv + argc));
-        if (!help && !small_scenes && files.size() != 1) throw UsageError("expected one mesh or scene file");
+        const size_t inputs = files.size() + (opt.generated_triangles ? 1 : 0);
+        if (!help && !small_scenes && inputs != 1)
+            throw UsageError("expected one mesh or scene file, or --generated-mesh N");
         if (files.size() == 1) opt.mesh = files[0];
     } catch (const UsageError& e) {
         return usage_error("bench", e.what());

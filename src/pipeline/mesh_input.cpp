@@ -3,6 +3,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "io/files.h"
+#include "io/generated_mesh.h"
 #include "io/scene_parser.h"
 
 namespace sahara {
@@ -32,6 +33,13 @@ ToolInput read_tool_input(const std::filesystem::path& file) {
     in.triangles.name = file.string();
     in.triangles.positions = in.scene.triangles.positions;
     in.triangles.indices = in.scene.triangles.indices;
+    return in;
+}
+
+ToolInput generated_tool_input(size_t triangles) {
+    ToolInput in;
+    in.triangles = make_displaced_sphere(sphere_grid_for(triangles));
+    in.scene = scene_from_mesh(in.triangles);
     return in;
 }
 

@@ -31,6 +31,11 @@ struct ToolInput {
 /// the scene (scene_parser.h, build_scene); throws InputError naming the file.
 ToolInput read_tool_input(const std::filesystem::path& file);
 
+/// A displaced sphere of exactly `triangles` triangles made in memory
+/// (io/generated_mesh.h), as a mesh input; throws std::invalid_argument for a count
+/// sphere_grid_for refuses.
+ToolInput generated_tool_input(size_t triangles);
+
 /// Counts of the scene's bounded primitives by kind, e.g. "120 triangles, 2 spheres"
 /// (kinds with none left out, planes never listed; "none" if nothing is left).
 std::string primitive_kinds_text(const Scene& scene, bool with_triangles = true);

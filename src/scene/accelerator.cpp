@@ -1,12 +1,14 @@
 #include "scene/accelerator.h"
 
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <string>
 
+#include "base/error.h"
+#include "base/process_usage.h"
 #include "scene/leaf_blocks.inl"
 #include "scene/scene.h"
 
@@ -64,12 +66,6 @@ size_t l2_cache_bytes() {
     return bytes > 0 ? size_t(bytes) : size_t(1) << 20;
 }
 
-double process_cpu_ms() {
-    timespec ts{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
-}
-
 /// The flat loop: one root leaf over every primitive.
 Bvh single_leaf_bvh(const PrimitiveList& prims) {
     Bvh bvh;
@@ -124,6 +120,20 @@ bool parse_bvh_layout(std::string_view text, BvhLayout& out) {
     return true;
 }
 
+void check_accelerator_capacity(size_t total, size_t largest_kind, BvhLayout layout) {
+    const size_t per_kind = size_t(kPrimIndexMask) + 1;
+    if (largest_kind > per_kind)
+        throw InputError("scene too large: " + std::to_string(largest_kind) +
+                         " primitives of one kind, more than the " + std::to_string(per_kind) +
+                         " that primitive ids index");
+    // make_bvh_wide checks again after the build: the slots, not the primitives, count there.
+    const size_t wide_slots = size_t(kMaxWideLeafFirst) + 1;
+    if (layout != BvhLayout::pairs && total > wide_slots)
+        throw InputError("scene too large: " + std::to_string(total) + " primitives, more than the " +
+                         std::to_string(wide_slots) +
+                         " that a wide BVH's leaf references reach (the pairs layout has none)");
+}
+
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     : spheres_(scene.spheres),
       boxes_(scene.boxes),
@@ -131,6 +141,10 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
       alpha_(scene),
       one_sided_(one_sided_triangles(scene)) {
     one_sided_count_ = size_t(std::count(one_sided_.begin(), one_sided_.end(), uint8_t(1)));
+    check_accelerator_capacity(
+        scene.triangles.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size(),
+        std::max({scene.triangles.size(), scene.spheres.size(), scene.boxes.size(), scene.quadrics.size()}),
+        options.layout);
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
     const PrimitiveList prims = collect_primitives(scene);

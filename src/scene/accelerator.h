@@ -98,6 +98,12 @@ struct AcceleratorOptions {
     }
 };
 
+/// Throws InputError when a scene of `total` bounded primitives, `largest_kind` of
+/// them of one kind, is beyond what the structures index: 29-bit primitive indices
+/// per kind (geometry/hit.h) and, but for `pairs`, the wide tree's leaf references
+/// (2^26 slots). The Accelerator checks before it builds anything.
+void check_accelerator_capacity(size_t total, size_t largest_kind, BvhLayout layout);
+
 class Accelerator {
    public:
     explicit Accelerator(const Scene& scene, const AcceleratorOptions& options = {});
