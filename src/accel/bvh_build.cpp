@@ -203,9 +203,14 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     return reinsert_optimize_bvh(bvh, input.boxes, p);
 }
 
+/// Below this many primitives the automatic choice stays binned: a few large
+/// primitives make largest_share high, but a tree that small traces no faster rebuilt.
+constexpr size_t kAutoMinPrimitives = 1000;
+
 BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
     const bool long_render = w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives);
-    return long_render && w.largest_share >= kAutoMinLargestShare ? BvhBuilder::reinsert : BvhBuilder::binned;
+    const bool uneven = w.primitives >= kAutoMinPrimitives && w.largest_share >= kAutoMinLargestShare;
+    return long_render && uneven ? BvhBuilder::reinsert : BvhBuilder::binned;
 }
 
 double largest_box_area_share(std::span<const Bounds3> boxes) {

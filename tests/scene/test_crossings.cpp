@@ -210,9 +210,17 @@ TEST_CASE("crossings: random rays through icosphere edge midpoints count the rig
 
 namespace {
 
-/// A closed box of big wall triangles around an icosphere: spatial splits cut the walls.
+/// A closed box of big wall triangles around an icosphere, and big triangles across the
+/// box: spatial splits cut them.
 TriangleMesh make_walled_sphere() {
     TriangleMesh m = make_icosphere(3, 0.3f, Vec3(0.4f, 0.2f, 0.1f));
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(-1.9f, 1.9f);
+    for (int i = 0; i < 30; ++i) {
+        const auto base = uint32_t(m.positions.size());
+        for (int k = 0; k < 3; ++k) m.positions.push_back(Vec3(u(rng), u(rng), u(rng)));
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
     const Vec3 c[8] = {{-2, -2, -2}, {2, -2, -2}, {2, 2, -2}, {-2, 2, -2},
                        {-2, -2, 2},  {2, -2, 2},  {2, 2, 2},  {-2, 2, 2}};
     const uint32_t faces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
