@@ -138,9 +138,11 @@ struct BvhWorkload {
     double largest_share = 0;
 };
 
-/// What BvhBuilder::automatic builds: reinsert when largest_share >= kAutoMinLargestShare
-/// and expected_rays >= kAutoMinRaysPerPrimitive * primitives (its slower build repaid
-/// by faster rays), binned otherwise (also when the ray count is unknown). The
+/// What BvhBuilder::automatic builds: reinsert when largest_share >= kAutoMinLargestShare,
+/// expected_rays >= kAutoMinRaysPerPrimitive * primitives (its slower build repaid by
+/// faster rays) and there are at least 1,000 primitives; binned otherwise (also when
+/// the ray count is unknown). Spatial splits (sbvh) are never chosen: on interiors
+/// reinsertion gives the better tree at half their build time. The
 /// measurements behind it: docs/performance.md, "Choosing the builder".
 BvhBuilder choose_bvh_builder(const BvhWorkload& workload);
 inline constexpr double kAutoMinLargestShare = 0.5;

@@ -45,6 +45,10 @@ struct SpatialSplit {
     uint32_t n_left = 0, n_right = 0;
 };
 
+/// Bin of a scaled coordinate f: clamped to [0, bins - 1], NaN (0 times an infinite
+/// scale over a denormal extent) to bin 0, never an out-of-range float-to-int conversion.
+int clamp_bin(float f, int bins) { return f > 0.0f ? int(std::min(f, float(bins - 1))) : 0; }
+
 Bounds3 intersect_boxes(const Bounds3& a, const Bounds3& b) {
     Bounds3 r{max(a.lo, b.lo), min(a.hi, b.hi)};
     return r.empty() ? Bounds3{} : r;
@@ -106,7 +110,8 @@ class SbvhBuild {
             root.extend(in_.boxes[i]);
         }
         root_area_ = root.surface_area();
-        budget_ = std::max<size_t>(n, size_t(double(n) * double(std::max(params_.sbvh_reference_budget, 1.0f))));
+        budget_ =
+            std::max<size_t>(n, size_t(double(n) * double(std::max(params_.sbvh_reference_budget, 1.0f))));
         ref_count_ = n;
         out_.prim_indices.resize(budget_);
         out_.nodes.resize(2 * budget_);
@@ -156,7 +161,7 @@ class SbvhBuild {
             Bounds3 box[kObjectBins];
             uint32_t count[kObjectBins] = {};
             for (const Ref& r : refs) {
-                const int b = std::min(kObjectBins - 1, int((centroid(r)[axis] - lo) * scale));
+                const int b = clamp_bin((centroid(r)[axis] - lo) * scale, kObjectBins);
                 box[b].extend(r.box);
                 ++count[b];
             }
@@ -191,8 +196,7 @@ class SbvhBuild {
 
     static int bin_of(const Bounds3& box, int axis, float x) {
         const float ext = box.hi[axis] - box.lo[axis];
-        const int b = int((x - box.lo[axis]) * (float(kSpatialBins) / ext));
-        return std::clamp(b, 0, kSpatialBins - 1);
+        return clamp_bin((x - box.lo[axis]) * (float(kSpatialBins) / ext), kSpatialBins);
     }
 
     SpatialSplit find_spatial_split(const std::vector<Ref>& refs, const Bounds3& node) const {
@@ -238,7 +242,8 @@ class SbvhBuild {
             n += enter[b - 1];
             if (n == 0 || n_right[b] == 0) continue;
             const float cost = sah(acc, n, right[b], n_right[b]);
-            if (cost < best.cost) best = SpatialSplit{axis, bin_plane(node, axis, b), cost, acc, right[b], n, n_right[b]};
+            if (cost < best.cost)
+                best = SpatialSplit{axis, bin_plane(node, axis, b), cost, acc, right[b], n, n_right[b]};
         }
     }
 
@@ -281,8 +286,8 @@ class SbvhBuild {
     }
 
     /// Chooses leaf (false) or a split of `refs` into `left` and `right` (true).
-    bool split(std::vector<Ref>& refs, const Bounds3& box, const Bounds3& cents, int depth, std::vector<Ref>& left,
-               std::vector<Ref>& right) {
+    bool split(std::vector<Ref>& refs, const Bounds3& box, const Bounds3& cents, int depth,
+               std::vector<Ref>& left, std::vector<Ref>& right) {
         const auto n = uint32_t(refs.size());
         if (n <= 1) return false;
         const bool may_be_leaf = n <= params_.max_leaf_size;
@@ -295,7 +300,8 @@ class SbvhBuild {
         const float best = std::min(object.cost, spatial.cost);
         if (best == kInfinity) return !may_be_leaf && median_split(refs, cents, left, right);
         const float area = box.surface_area();
-        if (may_be_leaf && params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + best)
+        if (may_be_leaf &&
+            params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + best)
             return false;
         if (spatial.cost < object.cost && spatial_partition(refs, spatial, left, right)) return true;
         if (object.axis >= 0) {
@@ -310,7 +316,7 @@ class SbvhBuild {
         const float lo = cents.lo[s.axis];
         const float scale = float(kObjectBins) / (cents.hi[s.axis] - lo);
         for (const Ref& r : refs) {
-            const int b = std::min(kObjectBins - 1, int((centroid(r)[s.axis] - lo) * scale));
+            const int b = clamp_bin((centroid(r)[s.axis] - lo) * scale, kObjectBins);
             (b < s.bin ? left : right).push_back(r);
         }
     }

@@ -34,9 +34,9 @@ TriangleMesh make_room(uint32_t seed, int planks = 100) {
     TriangleMesh m;
     m.name = "room";
     const Vec3 size(10.0f, 4.0f, 8.0f);
-    add_quad(m, Vec3(0.0f), Vec3(size.x, 0, 0), Vec3(0, 0, size.z));           // floor
-    add_quad(m, Vec3(0, size.y, 0), Vec3(0, 0, size.z), Vec3(size.x, 0, 0));   // ceiling
-    add_quad(m, Vec3(0.0f), Vec3(0, size.y, 0), Vec3(size.x, 0, 0));           // walls
+    add_quad(m, Vec3(0.0f), Vec3(size.x, 0, 0), Vec3(0, 0, size.z));          // floor
+    add_quad(m, Vec3(0, size.y, 0), Vec3(0, 0, size.z), Vec3(size.x, 0, 0));  // ceiling
+    add_quad(m, Vec3(0.0f), Vec3(0, size.y, 0), Vec3(size.x, 0, 0));          // walls
     add_quad(m, Vec3(0, 0, size.z), Vec3(size.x, 0, 0), Vec3(0, size.y, 0));
     add_quad(m, Vec3(0.0f), Vec3(0, 0, size.z), Vec3(0, size.y, 0));
     add_quad(m, Vec3(size.x, 0, 0), Vec3(0, size.y, 0), Vec3(0, 0, size.z));
@@ -92,7 +92,8 @@ std::string check_split_tree(const Bvh& bvh, const TriangleMesh& m, float budget
         std::vector<uint32_t> prims(bvh.prim_indices.begin() + node.index,
                                     bvh.prim_indices.begin() + node.index + node.count);
         std::sort(prims.begin(), prims.end());
-        if (std::adjacent_find(prims.begin(), prims.end()) != prims.end()) return "a triangle twice in one leaf";
+        if (std::adjacent_find(prims.begin(), prims.end()) != prims.end())
+            return "a triangle twice in one leaf";
         for (const uint32_t p : prims) leaf_boxes[p].push_back(node.box());
     }
     std::mt19937 rng(3);
@@ -162,7 +163,8 @@ TEST_CASE("sbvh references every triangle within the budget and covers it with l
             BvhBuildParams params;
             params.sbvh_reference_budget = budget;
             params.leaf_block_size = 4;
-            const Bvh bvh = build_bvh({in.boxes, in.centers, m.positions, m.indices}, BvhBuilder::sbvh, params);
+            const Bvh bvh =
+                build_bvh({in.boxes, in.centers, m.positions, m.indices}, BvhBuilder::sbvh, params);
             CHECK(check_split_tree(bvh, m, budget) == "");
             if (budget == 1.0f) CHECK(bvh.prim_indices.size() == m.triangle_count());
         }
@@ -200,8 +202,8 @@ TEST_CASE("the automatic builder picks reinsert only for long renders of scenes 
         return choose_bvh_builder(BvhWorkload{m.triangle_count(), rays, share});
     };
     CHECK(pick(room, room_share, 1e9) == BvhBuilder::reinsert);
-    CHECK(pick(room, room_share, 0.0) == BvhBuilder::binned);   // unknown ray count
-    CHECK(pick(room, room_share, 1e3) == BvhBuilder::binned);   // a short render
+    CHECK(pick(room, room_share, 0.0) == BvhBuilder::binned);  // unknown ray count
+    CHECK(pick(room, room_share, 1e3) == BvhBuilder::binned);  // a short render
     CHECK(pick(sphere, sphere_share, 1e9) == BvhBuilder::binned);
     CHECK(choose_bvh_builder(BvhWorkload{12, 1e9, 1.0}) == BvhBuilder::binned);  // too small to matter
     // The accelerator resolves "auto" and reports what it built.
