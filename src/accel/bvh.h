@@ -105,17 +105,50 @@ struct BvhBuildParams {
     uint32_t reinsert_max_rounds = 100;
     /// ... and it stops after two rounds in a row that lower the SAH cost by less than this fraction.
     float reinsert_min_gain = 0.001f;
+    /// Spatial splits (sbvh): at most this many references per primitive in all leaves.
+    float sbvh_reference_budget = 1.3f;
+    /// Spatial splits are tried only where the best object split's children overlap by
+    /// more than this fraction of the root's surface area (Stich et al.'s alpha).
+    float sbvh_overlap_alpha = 1e-5f;
 };
 
 /// Inputs of a build: one box and one centre per primitive (same length).
 struct BvhBuildInput {
     std::span<const Bounds3> boxes;
     std::span<const Vec3> centers;
+    /// Only the spatial-split builder reads these: primitive i < triangle_indices.size() / 3
+    /// is the triangle positions[triangle_indices[3i .. 3i + 2]], which it clips to split
+    /// planes; every other primitive is clipped as its box.
+    std::span<const Vec3> positions = {};
+    std::span<const uint32_t> triangle_indices = {};
 };
 
-/// Builds a BVH with the chosen builder. Primitives with empty boxes are kept
-/// (they land in some leaf but can never be reached by a ray).
+/// Builds a BVH with the chosen builder (automatic: binned, as for an unknown workload). Primitives with empty boxes are kept
+/// (they land in some leaf but can never be reached by a ray). Only sbvh may reference
+/// a primitive from several leaves (never twice in one leaf).
 Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params = {});
+
+/// What the automatic builder choice reads about a scene.
+struct BvhWorkload {
+    size_t primitives = 0;
+    double expected_rays = 0;  ///< rays the render will trace; 0 when unknown
+    /// Share of the primitives' summed box surface area held by the largest 1% of
+    /// them: 0.03-0.16 for scanned and modelled objects, near 1 for interiors, whose
+    /// walls, floors and long planks overlap most other boxes and spoil top-down splits.
+    double largest_share = 0;
+};
+
+/// What BvhBuilder::automatic builds: reinsert when largest_share >= kAutoMinLargestShare,
+/// expected_rays >= kAutoMinRaysPerPrimitive * primitives (its slower build repaid by
+/// faster rays) and there are at least 1,000 primitives; binned otherwise (also when
+/// the ray count is unknown). Spatial splits (sbvh) are never chosen: on interiors
+/// reinsertion gives the better tree at half their build time. The
+/// measurements behind it: docs/performance.md, "Choosing the builder".
+BvhBuilder choose_bvh_builder(const BvhWorkload& workload);
+inline constexpr double kAutoMinLargestShare = 0.5;
+inline constexpr double kAutoMinRaysPerPrimitive = 100.0;
+/// The largest_share of these boxes (BvhWorkload).
+double largest_box_area_share(std::span<const Bounds3> boxes);
 
 /// Insertion-based reinsertion (Bittner, Hapala, Havran 2013) on `bvh`, built
 /// over `prim_boxes`, then an SAH-optimal collapse of subtrees into leaves of at
@@ -131,7 +164,7 @@ inline constexpr int kBvhMedianSplitDepth = 32;
 
 /// Parses a bvh_builder_name(); returns false for anything else.
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out);
-/// "binned", "sweep" or "reinsert".
+/// "binned", "sweep", "reinsert", "sbvh" or "auto".
 const char* bvh_builder_name(BvhBuilder builder);
 
 /// Whether a layout keeps its leaf triangles in TriangleBlock4s (wide8).

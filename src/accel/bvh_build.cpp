@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <string_view>
 #include <vector>
 
 #include "accel/bvh.h"
 #include "accel/bvh_binned.h"
+#include "accel/bvh_sbvh.h"
 #include "accel/build_chunks.h"
 
 namespace sahara {
@@ -185,6 +187,11 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
         build_binned_bvh(input, p, bvh);
         return bvh;
     }
+    if (builder == BvhBuilder::automatic) builder = choose_bvh_builder({});
+    if (builder == BvhBuilder::sbvh) {
+        build_sbvh(input, p, bvh);
+        return bvh;
+    }
     if (builder == BvhBuilder::sweep) {
         BvhBuildJob(input, p, bvh).run();
         return bvh;
@@ -196,6 +203,28 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     return reinsert_optimize_bvh(bvh, input.boxes, p);
 }
 
+/// Below this many primitives the automatic choice stays binned: a few large
+/// primitives make largest_share high, but a tree that small traces no faster rebuilt.
+constexpr size_t kAutoMinPrimitives = 1000;
+
+BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
+    const bool long_render = w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives);
+    const bool uneven = w.primitives >= kAutoMinPrimitives && w.largest_share >= kAutoMinLargestShare;
+    return long_render && uneven ? BvhBuilder::reinsert : BvhBuilder::binned;
+}
+
+double largest_box_area_share(std::span<const Bounds3> boxes) {
+    std::vector<double> areas(boxes.size());
+    double total = 0;
+    for (size_t i = 0; i < boxes.size(); ++i) total += areas[i] = double(boxes[i].surface_area());
+    if (!(total > 0)) return 0.0;
+    const size_t k = std::max<size_t>(1, boxes.size() / 100);
+    std::nth_element(areas.begin(), areas.begin() + std::ptrdiff_t(k - 1), areas.end(), std::greater<>());
+    double top = 0;
+    for (size_t i = 0; i < k; ++i) top += areas[i];
+    return top / total;
+}
+
 bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
     if (text == "binned")
         out = BvhBuilder::binned;
@@ -203,6 +232,10 @@ bool parse_bvh_builder(std::string_view text, BvhBuilder& out) {
         out = BvhBuilder::sweep;
     else if (text == "reinsert")
         out = BvhBuilder::reinsert;
+    else if (text == "sbvh")
+        out = BvhBuilder::sbvh;
+    else if (text == "auto")
+        out = BvhBuilder::automatic;
     else
         return false;
     return true;
@@ -216,6 +249,10 @@ const char* bvh_builder_name(BvhBuilder builder) {
             return "sweep";
         case BvhBuilder::reinsert:
             return "reinsert";
+        case BvhBuilder::sbvh:
+            return "sbvh";
+        case BvhBuilder::automatic:
+            return "auto";
     }
     return "binned";
 }

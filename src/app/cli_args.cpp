@@ -155,7 +155,7 @@ SamplerType parse_sampler_name(const std::string& flag, const std::string& v) {
 BvhBuilder parse_builder_name(const std::string& flag, const std::string& v) {
     BvhBuilder b{};
     if (!parse_bvh_builder(v, b))
-        throw UsageError(flag + ": expected binned|sweep|reinsert, got '" + v + "'");
+        throw UsageError(flag + ": expected binned|sweep|reinsert|sbvh|auto, got '" + v + "'");
     return b;
 }
 

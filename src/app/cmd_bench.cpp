@@ -29,7 +29,7 @@ namespace {
 constexpr const char* kBenchUsage =
     "usage: sahara bench FILE [--threads N] [--ray-set primary|primary_packet|diffuse|shadow|all]\n"
     "                         [--json]\n"
-    "                         [--builder binned|sweep|reinsert] [--layout L] [--size WxH|N] [--repeat K]\n"
+    "                         [--builder binned|sweep|reinsert|sbvh|auto] [--layout L] [--size WxH|N] [--repeat K]\n"
     "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
     "                         [--embree-quality low|medium|high]\n"
     "       sahara bench --generated-mesh N [options above]\n"
@@ -244,7 +244,8 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"embree_isa", opt.embree_isa},
         {"embree_quality", kEmbreeQualityNames[size_t(opt.embree_quality)]},
         {"threads", opt.threads},
-        {"builder", bvh_builder_name(opt.builder)},
+        {"builder", bvh_builder_name(accel.builder())},
+        {"references", accel.reference_count()},
         {"layout", bvh_layout_name(opt.layout)},
         {"simd", simd_path_name(active_simd_path())},
         {"node_pairing", accel.pairs_nodes() && active_simd_path() != SimdPath::sse2},

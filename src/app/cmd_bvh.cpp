@@ -22,7 +22,7 @@ namespace sahara {
 namespace {
 
 constexpr const char* kBvhUsage =
-    "usage: sahara bvh FILE [--builder binned|sweep|reinsert] [--layout L] [--threads N]\n"
+    "usage: sahara bvh FILE [--builder binned|sweep|reinsert|sbvh|auto] [--layout L] [--threads N]\n"
     "                       [--size WxH|N] [--json]\n"
     "  FILE        a mesh (.obj, .gltf, .glb; OBJ polygons are fan-split, degenerate triangles kept)\n"
     "              or a scene file (.json): the tree holds its triangles, spheres, boxes and quadrics;\n"

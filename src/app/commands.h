@@ -22,7 +22,7 @@ int run_view_command(const std::vector<std::string>& args);
 // BVH tools: argv[0] is the subcommand name; exit code 0 ok, 2 bad usage or
 // bad input; each prints its usage on --help.
 
-/// `sahara bvh FILE [--builder binned|sweep|reinsert] [--size WxH|N] [--json]`: tree statistics.
+/// `sahara bvh FILE [--builder binned|sweep|reinsert|sbvh|auto] [--size WxH|N] [--json]`: tree statistics.
 int run_bvh_command(int argc, char** argv);
 /// `sahara bench MESH [--threads N] [--ray-set primary|diffuse|shadow|all] [--json]`: throughput vs Embree.
 int run_bench_command(int argc, char** argv);

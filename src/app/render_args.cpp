@@ -25,7 +25,7 @@ const char* const kRenderUsage =
     "  --exposure STOPS     exposure for 8-bit outputs (EXR stays linear)\n"
     "  --tonemap CURVE      clamp | reinhard | aces | filmic (8-bit outputs only)\n"
     "  --sampler NAME       sobol (default: Owen-scrambled Sobol) | independent\n"
-    "  --builder NAME       BVH builder: binned (default) | sweep | reinsert (render.bvh_builder)\n"
+    "  --builder NAME       BVH builder: auto (default) | binned | sweep | reinsert | sbvh (render.bvh_builder)\n"
     "  --layout L           traversal structure: wide8 (default) | pairs\n"
     "                       (see sahara bench --help; pairs: a plain binary BVH, one ray at a time)\n"
     "  --threads N          worker threads (default: all)\n"

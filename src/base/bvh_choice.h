@@ -11,13 +11,15 @@ enum class BvhBuilder : uint8_t {
     binned,    ///< binned SAH, parallel over subtrees (fast default)
     sweep,     ///< exact sweep SAH over all centroid-sorted splits (quality reference)
     reinsert,  ///< binned SAH, then insertion-based reinsertion (accel/bvh_optimize.cpp)
+    sbvh,      ///< object and spatial splits (accel/bvh_sbvh.cpp): triangles may be in several leaves
+    automatic,  ///< "auto": binned or reinsert per scene (choose_bvh_builder in accel/bvh.h)
 };
 
 /// The builder used unless a scene ("render": {"bvh_builder"}) or --builder says otherwise.
-/// Binned: on a typical render (some 60M rays) the better trees of sweep and reinsert
-/// save no more tracing time than their slower builds cost, and on shorter renders the
-/// build dominates. Reinsert pays off on long renders of meshes with uneven triangle sizes.
-inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::binned;
+/// Automatic: reinsertion where the render is long enough for its better tree to repay
+/// the slower build and a few huge triangles (walls, floors) spoil top-down splits,
+/// binned otherwise (the rule and its measurements: docs/performance.md).
+inline constexpr BvhBuilder kDefaultBvhBuilder = BvhBuilder::automatic;
 
 /// Traversal structure built from the binary SAH tree (scene/accelerator.h).
 enum class BvhLayout : uint8_t {

@@ -75,6 +75,7 @@ nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file, c
     const BvhBuilder builder = chosen.value_or(scene.render.bvh_builder);
     AcceleratorOptions opt;
     opt.builder = builder;
+    opt.expected_rays = scene.expected_render_rays();
     opt.layout = layout;
     opt.keep_binary_tree = true;  // for the statistics below
     omp_set_num_threads(threads);
@@ -88,7 +89,7 @@ nlohmann::ordered_json bvh_report(const Scene& scene, const std::string& file, c
     nlohmann::ordered_json j = {
         {"mesh", file},
         {"input", o.from_scene_file ? "scene" : "mesh"},
-        {"builder", bvh_builder_name(builder)},
+        {"builder", bvh_builder_name(accel.builder())},
         {"primitives", prims},
         {"primitives_by_kind", primitive_kinds_json(scene)},
         {"primitive_kinds", primitive_kinds_text(scene)},

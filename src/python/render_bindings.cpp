@@ -286,7 +286,7 @@ py::object bvh_stats(const PyScene& ps, const py::object& builder, const py::obj
     if (auto name = str_arg(builder, "builder")) {
         BvhBuilder b{};
         if (!parse_bvh_builder(*name, b))
-            throw py::value_error("builder: expected binned|sweep|reinsert, got '" + *name + "'");
+            throw py::value_error("builder: expected binned|sweep|reinsert|sbvh|auto, got '" + *name + "'");
         o.builder = b;
     }
     if (auto name = str_arg(layout, "layout")) {

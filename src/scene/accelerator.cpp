@@ -60,6 +60,17 @@ PrimitiveList collect_primitives(const Scene& scene) {
     return list;
 }
 
+/// BvhBuilder::automatic resolved for these primitives (see choose_bvh_builder).
+BvhBuilder resolve_builder(const PrimitiveList& prims, const AcceleratorOptions& options) {
+    if (options.builder != BvhBuilder::automatic) return options.builder;
+    BvhWorkload w;
+    w.primitives = prims.boxes.size();
+    w.expected_rays = options.expected_rays;
+    if (w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives))
+        w.largest_share = largest_box_area_share(prims.boxes);
+    return choose_bvh_builder(w);
+}
+
 /// Bytes of L2 cache per core (1 MiB when the system does not say).
 size_t l2_cache_bytes() {
     const long bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
@@ -150,7 +161,9 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
     const BvhBuildParams params = options.build_params();
-    bvh_ = uses_tree_ ? build_bvh({prims.boxes, prims.centers}, options.builder, params)
+    const BvhBuildInput input{prims.boxes, prims.centers, scene.triangles.positions, scene.triangles.indices};
+    builder_ = resolve_builder(prims, options);
+    bvh_ = uses_tree_ ? build_bvh(input, builder_, params)
                       : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
@@ -180,6 +193,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
+    unique_primitive_count_ = prims.ids.size();
     if (layout_has_blocks(layout_) && !options.keep_binary_tree) bvh_ = Bvh{};
     if (layout_ == BvhLayout::wide8 && options.node_pairing != NodePairing::never) {
         if (options.node_pairing == NodePairing::always)

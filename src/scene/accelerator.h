@@ -58,6 +58,8 @@ struct AcceleratorOptions {
     /// tree, the reference.
     BvhLayout layout = kDefaultBvhLayout;
     BvhBuilder builder = kDefaultBvhBuilder;
+    /// Rays the caller expects to trace (0: unknown), for BvhBuilder::automatic.
+    double expected_rays = 0;
     BvhBuildParams params;
     /// The wide8 layout builds with params.intersection_cost times this and counts
     /// leaves in whole blocks of four (BvhBuildParams::leaf_block_size): a block
@@ -104,6 +106,14 @@ struct AcceleratorOptions {
 /// (2^26 slots). The Accelerator checks before it builds anything.
 void check_accelerator_capacity(size_t total, size_t largest_kind, BvhLayout layout);
 
+/// Options for an Accelerator whose leaves feed the all-crossings queries
+/// (accel/crossings.h): a builder that references every primitive exactly once.
+inline AcceleratorOptions crossings_accelerator_options() {
+    AcceleratorOptions o;
+    o.builder = BvhBuilder::binned;
+    return o;
+}
+
 class Accelerator {
    public:
     explicit Accelerator(const Scene& scene, const AcceleratorOptions& options = {});
@@ -149,7 +159,16 @@ class Accelerator {
     double build_ms() const { return build_ms_; }
     /// CPU time of the build summed over threads (steadier than build_ms on shared cores).
     double build_cpu_ms() const { return build_cpu_ms_; }
-    size_t primitive_count() const { return primitive_count_; }
+    /// The builder that made the tree (BvhBuilder::automatic resolved).
+    BvhBuilder builder() const { return builder_; }
+    /// Primitives in the tree (each counted once, however many leaves reference it).
+    size_t primitive_count() const { return unique_primitive_count_; }
+    /// Leaf references: primitive_count() plus the duplicates of spatial splits.
+    size_t reference_count() const { return primitive_count_; }
+    /// Whether some primitive is referenced from several leaves (BvhBuilder::sbvh). The
+    /// all-crossings queries (accel/crossings.h) would count such a primitive once per
+    /// leaf the ray enters: they need a tree built with crossings_accelerator_options().
+    bool has_split_references() const { return primitive_count_ > unique_primitive_count_; }
     /// Whether traversal runs the cut-out (alpha-tested) variant: the scene has
     /// triangles with a cut-out material (scene/alpha_filter.h).
     bool has_cutouts() const { return !alpha_.empty(); }
@@ -255,6 +274,8 @@ class Accelerator {
     Bounds3 bounds_;
     bool uses_tree_ = false;
     size_t primitive_count_ = 0;
+    size_t unique_primitive_count_ = 0;  ///< primitives given to the builder
+    BvhBuilder builder_ = BvhBuilder::binned;
     double build_ms_ = 0;
     double build_cpu_ms_ = 0;
 };

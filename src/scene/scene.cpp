@@ -27,6 +27,7 @@ size_t Scene::primitive_count() const {
 void Scene::build_accelerator() {
     AcceleratorOptions options;
     options.builder = render.bvh_builder;
+    options.expected_rays = expected_render_rays();
     options.layout = render.bvh_layout;
     accel_ = std::make_unique<Accelerator>(*this, options);
     bounds_ = accel_->bounds();

@@ -127,6 +127,12 @@ class Scene {
     /// Bounds of all bounded primitives (planes excluded), instances included.
     Bounds3 bounds() const { return bounds_; }
     size_t primitive_count() const;
+    /// Rays a render with the scene's settings traces, roughly (the automatic BVH
+    /// builder's workload): a path's camera ray, bounces and light samples, about four
+    /// per sample.
+    double expected_render_rays() const {
+        return 4.0 * double(render.width) * double(render.height) * double(render.spp);
+    }
 
     // geometry
     std::vector<Sphere> spheres;

@@ -207,3 +207,67 @@ TEST_CASE("crossings: random rays through icosphere edge midpoints count the rig
     }
     CHECK(tested > 15000);
 }
+
+namespace {
+
+/// A closed box of big wall triangles around an icosphere, and big triangles across the
+/// box: spatial splits cut them.
+TriangleMesh make_walled_sphere() {
+    TriangleMesh m = make_icosphere(3, 0.3f, Vec3(0.4f, 0.2f, 0.1f));
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(-1.9f, 1.9f);
+    for (int i = 0; i < 30; ++i) {
+        const auto base = uint32_t(m.positions.size());
+        for (int k = 0; k < 3; ++k) m.positions.push_back(Vec3(u(rng), u(rng), u(rng)));
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    const Vec3 c[8] = {{-2, -2, -2}, {2, -2, -2}, {2, 2, -2}, {-2, 2, -2},
+                       {-2, -2, 2},  {2, -2, 2},  {2, 2, 2},  {-2, 2, 2}};
+    const uint32_t faces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                  {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}};
+    for (const auto& f : faces) {
+        const auto base = uint32_t(m.positions.size());
+        for (const uint32_t k : f) m.positions.push_back(c[k]);
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    return m;
+}
+
+uint32_t brute_force_crossings(const TriangleMesh& m, const Ray& r) {
+    const TriangleRay tr(r);
+    uint32_t n = 0;
+    for (size_t t = 0; t < m.triangle_count(); ++t) {
+        const Vec3* p = m.positions.data();
+        const uint32_t* i = &m.indices[3 * t];
+        n += TriangleVerts::of(p[i[0]], p[i[1]], p[i[2]]).intersect(tr, r.tmin, r.tmax).has_value();
+    }
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("crossings: the crossings options reference each triangle once where sbvh splits") {
+    const TriangleMesh m = make_walled_sphere();
+    const Scene scene = scene_from_mesh(m);
+    AcceleratorOptions split_options;
+    split_options.builder = BvhBuilder::sbvh;
+    const Accelerator split(scene, split_options), once(scene, crossings_accelerator_options());
+    REQUIRE(split.has_split_references());
+    CHECK_FALSE(once.has_split_references());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.9f, 1.9f);
+    int split_wrong = 0, once_wrong = 0;
+    for (int i = 0; i < 2000; ++i) {
+        Ray r;
+        r.origin = Vec3(u(rng), u(rng), u(rng));
+        r.dir = normalize(Vec3(u(rng), u(rng), u(rng)));
+        const uint32_t expected = brute_force_crossings(m, r);
+        const std::span<const TriangleBlock4> split_blocks(split.leaf_blocks()), once_blocks(once.leaf_blocks());
+        split_wrong += count_crossings(split.bvh8(), split_blocks, r) != expected;
+        once_wrong += count_crossings(once.bvh8(), once_blocks, r) != expected;
+    }
+    // The split tree counts a wall once per leaf the ray enters: the scene exposes the
+    // double count, and the crossings options must not have it.
+    CHECK(split_wrong > 0);
+    CHECK(once_wrong == 0);
+}
