@@ -16,6 +16,6 @@ TEST_CASE("omp wait policy: restart only when the user chose no policy") {
 }
 
 TEST_CASE("omp wait policy: no restart under valgrind") {
-    CHECK_FALSE(wants_passive_restart(nullptr, nullptr,
-                                      "/usr/libexec/valgrind/vgpreload_core-amd64-linux.so"));
+    CHECK_FALSE(
+        wants_passive_restart(nullptr, nullptr, "/usr/libexec/valgrind/vgpreload_core-amd64-linux.so"));
 }
