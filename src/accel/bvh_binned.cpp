@@ -25,6 +25,8 @@ namespace sahara {
 namespace {
 
 constexpr uint32_t kMaxBins = 64;
+/// Ranges binned into two sets of bins (fill_bins): the merge costs a few hundred instructions.
+constexpr uint32_t kTwoBinSetsMin = 256;
 using build::chunk_begin;
 using build::for_chunks;
 using build::kParallelScanThreshold;
@@ -284,18 +286,34 @@ class BinnedBuild {
         return params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + s.cost;
     }
 
+    static void bin_one(const PrimRef& p, const BinMap& map, __m128i last, Bins& out) {
+        alignas(16) uint32_t k[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(k), map.bins(_mm_load_ps(p.c), last));
+        const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
+        for (int a = 0; a < 3; ++a) {
+            out.box[a][k[a]].extend(lo, hi);
+            ++out.count[a][k[a]];
+        }
+    }
+
+    /// Long ranges bin alternate primitives into two sets, merged at the end: neighbours
+    /// often share a bin, and one set would chain each box update to the store before it.
     static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
         const __m128i last = _mm_set1_epi32(map.last);
-        for (uint32_t i = begin; i < end; ++i) {
-            const PrimRef& p = refs[i];
-            alignas(16) uint32_t k[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(k), map.bins(_mm_load_ps(p.c), last));
-            const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
-            for (int a = 0; a < 3; ++a) {
-                out.box[a][k[a]].extend(lo, hi);
-                ++out.count[a][k[a]];
-            }
+        if (end - begin < kTwoBinSetsMin) {
+            for (uint32_t i = begin; i < end; ++i) bin_one(refs[i], map, last, out);
+            return;
         }
+        thread_local Bins odd;  // not used across a task scheduling point
+        const uint32_t bins = uint32_t(map.last) + 1;
+        odd.clear(bins);
+        uint32_t i = begin;
+        for (; i + 1 < end; i += 2) {
+            bin_one(refs[i], map, last, out);
+            bin_one(refs[i + 1], map, last, odd);
+        }
+        if (i < end) bin_one(refs[i], map, last, out);
+        out.add(odd, bins);
     }
 
     /// fill_bins for fewer primitives than bins: clears all counts but only the boxes of
