@@ -11,23 +11,9 @@
 #include "math/ray.h"
 #include "desc/scene_desc.h"
 #include "io/mesh_utils.h"  // mesh_bounds
+#include "sanitizer_build.h"
 
 namespace sahara::test {
-
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kSanitized = true;
-#else
-inline constexpr bool kSanitized = false;
-#endif
-#else
-inline constexpr bool kSanitized = false;
-#endif
-
-/// Ray counts are divided by this under ASan (roughly its slowdown), to keep tests short.
-inline constexpr int kSanitizerDivisor = kSanitized ? 20 : 1;
 
 /// Closed icosphere: an icosahedron with each triangle split into 4, `level` times,
 /// vertices pushed to the sphere; shared vertices are deduplicated (watertight topology).

@@ -123,8 +123,8 @@ struct BvhBuildInput {
     std::span<const uint32_t> triangle_indices = {};
 };
 
-/// Builds a BVH with the chosen builder (automatic: binned, as for an unknown workload). Primitives with empty boxes are kept
-/// (they land in some leaf but can never be reached by a ray). Only sbvh may reference
+/// Builds a BVH with the chosen builder (automatic: binned, as for an unknown workload). Primitives with
+/// empty boxes are kept (they land in some leaf but can never be reached by a ray). Only sbvh may reference
 /// a primitive from several leaves (never twice in one leaf).
 Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildParams& params = {});
 

@@ -29,7 +29,8 @@ namespace {
 constexpr const char* kBenchUsage =
     "usage: sahara bench FILE [--threads N] [--ray-set primary|primary_packet|diffuse|shadow|all]\n"
     "                         [--json]\n"
-    "                         [--builder binned|sweep|reinsert|sbvh|auto] [--layout L] [--size WxH|N] [--repeat K]\n"
+    "                         [--builder binned|sweep|reinsert|sbvh|auto] [--layout L] [--size WxH|N] "
+    "[--repeat K]\n"
     "                         [--no-embree] [--embree-robust] [--embree-isa ISA]\n"
     "                         [--embree-quality low|medium|high]\n"
     "       sahara bench --generated-mesh N [options above]\n"

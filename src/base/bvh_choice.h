@@ -8,10 +8,11 @@
 namespace sahara {
 
 enum class BvhBuilder : uint8_t {
-    binned,    ///< binned SAH, parallel over subtrees (fast default)
-    sweep,     ///< exact sweep SAH over all centroid-sorted splits (quality reference)
-    reinsert,  ///< binned SAH, then insertion-based reinsertion (accel/bvh_optimize.cpp)
-    sbvh,      ///< object and spatial splits (accel/bvh_sbvh.cpp): triangles may be in several leaves
+    binned,     ///< binned SAH, parallel over subtrees (fast; what automatic picks unless a long render of
+                ///< uneven triangles)
+    sweep,      ///< exact sweep SAH over all centroid-sorted splits (quality reference)
+    reinsert,   ///< binned SAH, then insertion-based reinsertion (accel/bvh_optimize.cpp)
+    sbvh,       ///< object and spatial splits (accel/bvh_sbvh.cpp): triangles may be in several leaves
     automatic,  ///< "auto": binned or reinsert per scene (choose_bvh_builder in accel/bvh.h)
 };
 

@@ -33,7 +33,8 @@ void parse_render(JsonObject o, RenderSettings& r) {
     if (auto v = o.get("exposure")) r.exposure = v->number_f(NumberRange::closed(-64, 64));
     if (auto v = o.get("tonemap")) r.tonemap = Tonemap(v->one_of({"clamp", "reinhard", "aces", "filmic"}));
     // Same order as BvhBuilder.
-    if (auto v = o.get("bvh_builder")) r.bvh_builder = BvhBuilder(v->one_of({"binned", "sweep", "reinsert", "sbvh", "auto"}));
+    if (auto v = o.get("bvh_builder"))
+        r.bvh_builder = BvhBuilder(v->one_of({"binned", "sweep", "reinsert", "sbvh", "auto"}));
     o.finish();
 }
 

@@ -50,7 +50,8 @@ CastMesh::CastMesh(std::vector<Vec3> positions, std::vector<uint32_t> indices) {
     scene.triangles.positions = std::move(positions);
     scene.triangles.indices = std::move(indices);
     // Crossings count each leaf reference: the tree must reference every triangle once.
-    if (scene.triangles.size() > 0) accel_ = std::make_unique<Accelerator>(scene, crossings_accelerator_options());
+    if (scene.triangles.size() > 0)
+        accel_ = std::make_unique<Accelerator>(scene, crossings_accelerator_options());
     positions_ = std::move(scene.triangles.positions);
     indices_ = std::move(scene.triangles.indices);
     normals_.resize(triangle_count());

@@ -163,8 +163,7 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     const BvhBuildParams params = options.build_params();
     const BvhBuildInput input{prims.boxes, prims.centers, scene.triangles.positions, scene.triangles.indices};
     builder_ = resolve_builder(prims, options);
-    bvh_ = uses_tree_ ? build_bvh(input, builder_, params)
-                      : single_leaf_bvh(prims);
+    bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
     const size_t slots = bvh_.prim_indices.size();
     std::vector<uint32_t> ids(slots);

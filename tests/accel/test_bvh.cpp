@@ -93,7 +93,8 @@ TEST_CASE("every builder produces valid trees") {
     std::vector<TriangleMesh> meshes = procedural_meshes();
     for (TriangleMesh& m : realistic_meshes()) meshes.push_back(std::move(m));
     for (const TriangleMesh& m : meshes)
-        for (BvhBuilder builder : {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert, BvhBuilder::automatic}) {
+        for (BvhBuilder builder :
+             {BvhBuilder::binned, BvhBuilder::sweep, BvhBuilder::reinsert, BvhBuilder::automatic}) {
             INFO(m.name, " ", std::string(bvh_builder_name(builder)));
             const Bvh bvh = build_for_mesh(m, builder);
             CHECK(validate_bvh(bvh, triangle_boxes(m)) == "");

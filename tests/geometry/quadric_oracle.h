@@ -14,20 +14,11 @@
 #include "geometry/spawn.h"
 #include "math/rng.h"
 #include "math/sampling.h"
+#include "sanitizer_build.h"
 
 namespace sahara::quadric_test {
 
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kSanitized = true;
-#else
-inline constexpr bool kSanitized = false;
-#endif
-#else
-inline constexpr bool kSanitized = false;
-#endif
+using test::kSanitized;
 
 using LD = long double;
 using VL = TVec3<long double>;

@@ -262,7 +262,8 @@ TEST_CASE("crossings: the crossings options reference each triangle once where s
         r.origin = Vec3(u(rng), u(rng), u(rng));
         r.dir = normalize(Vec3(u(rng), u(rng), u(rng)));
         const uint32_t expected = brute_force_crossings(m, r);
-        const std::span<const TriangleBlock4> split_blocks(split.leaf_blocks()), once_blocks(once.leaf_blocks());
+        const std::span<const TriangleBlock4> split_blocks(split.leaf_blocks()),
+            once_blocks(once.leaf_blocks());
         split_wrong += count_crossings(split.bvh8(), split_blocks, r) != expected;
         once_wrong += count_crossings(once.bvh8(), once_blocks, r) != expected;
     }
