@@ -4,6 +4,8 @@
 /// spheres by the solid angle of their visible cap, triangles and boxes by
 /// area, the envmap by its luminance. The densities are also evaluated for
 /// directions found by BSDF sampling, for multiple importance sampling.
+#include <limits>
+
 #include "geometry/hit.h"
 #include "scene/scene.h"
 
@@ -41,7 +43,18 @@ Ray shadow_ray(const Vec3& p, const Vec3& ng, const LightSample& ls, float time)
 /// Power heuristic with beta = 2 (Veach 1997) for two one-sample strategies.
 inline float power_heuristic(float pdf_a, float pdf_b) {
     const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-    return a + b > 0 ? a / (a + b) : 0.0f;
+    if (a + b <= std::numeric_limits<float>::max()) return a + b > 0 ? a / (a + b) : 0.0f;
+    // A square overflowed: densities of 1e19 and more are real (a light seen edge-on
+    // from a point on an infinite plane far away), and inf/inf would give NaN.
+    // Compare the densities by their ratio instead.
+    if (!(pdf_a > 0)) return 0.0f;
+    if (!(pdf_b > 0) || pdf_b < pdf_a) {
+        const float r = pdf_b > 0 ? pdf_b / pdf_a : 0.0f;
+        return 1.0f / (1.0f + r * r);
+    }
+    if (pdf_a == pdf_b) return 0.5f;  // both infinite
+    const float r = pdf_a / pdf_b;
+    return r * r / (1.0f + r * r);
 }
 
 }  // namespace sahara

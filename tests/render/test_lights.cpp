@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "math/sampling.h"
@@ -268,5 +269,50 @@ TEST_CASE("envmap lighting: MIS agrees with BSDF sampling") {
         CHECK(agree(mis, bsdf, 4));
         CHECK(agree(mis, stats(LightStrategy::light_only, scaled(8000)), 4));
         CHECK(mis.se.x < bsdf.se.x);
+    }
+}
+
+TEST_CASE("the power heuristic stays in 0..1 and complementary when a density overflows its square") {
+    const float inf = std::numeric_limits<float>::infinity();
+    CHECK(power_heuristic(1.0f, 1.0f) == 0.5f);
+    CHECK(power_heuristic(0.0f, 0.0f) == 0.0f);
+    CHECK(power_heuristic(2.0f, 0.0f) == 1.0f);
+    for (const float big : {1e19f, 1e25f, 3e38f, inf}) {
+        for (const float other : {0.0f, 1e-3f, 1.0f, 1e18f, 1e30f}) {
+            const float w = power_heuristic(big, other), w_other = power_heuristic(other, big);
+            CAPTURE(big);
+            CAPTURE(other);
+            REQUIRE(std::isfinite(w));
+            REQUIRE(std::isfinite(w_other));
+            CHECK((w >= 0.5f) == (big >= other));
+            CHECK(w <= 1.0f);
+            CHECK(w + w_other == doctest::Approx(1.0f).epsilon(1e-6));
+        }
+    }
+    CHECK(power_heuristic(inf, inf) == 0.5f);
+    CHECK(power_heuristic(1e30f, 1e20f) == doctest::Approx(1.0f));
+    CHECK(power_heuristic(2e20f, 1e20f) == doctest::Approx(0.8f));
+}
+
+TEST_CASE("an area light seen from a plane far towards the horizon gives finite radiance") {
+    // A camera ray grazing the infinite floor hits it some 1e9 away; from there the
+    // emitting triangle is edge-on and its solid-angle density exceeds 1e19, whose
+    // square overflowed the MIS weight to inf/inf = NaN before.
+    SceneDesc d = floor_scene(Rgb(0.5f));
+    d.materials.push_back(emissive({4, 4, 4}));
+    TriangleMesh m;
+    m.positions = {{-0.5f, -0.5f, 1}, {0.5f, 0.5f, 1}, {0.5f, -0.5f, 1}};
+    m.indices = {0, 1, 2};
+    m.material = 2;
+    d.meshes.push_back(m);
+    const Scene scene = build_scene(d);
+    for (const float slope : {1e-7f, 1e-8f, 1e-9f, 1e-10f}) {
+        const Ray ray{{0, -3, 2}, normalize(Vec3{0, 1, -slope}), 0.0f, kInfinity, 0.0f};
+        const Stat s = sample_stats(
+            2000, 5, [&](Sampler& smp) { return path_trace_with(scene, ray, smp, 3, LightStrategy::mis); });
+        CAPTURE(slope);
+        CHECK(std::isfinite(s.mean.x));
+        CHECK(std::isfinite(s.mean.y));
+        CHECK(std::isfinite(s.mean.z));
     }
 }
