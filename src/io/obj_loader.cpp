@@ -270,7 +270,7 @@ Vec3d far_model_centre(const std::vector<tinyobj::real_t>& v) {
     Vec3d lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     double reach = 0;
     for (size_t i = 0; i + 2 < v.size(); i += 3) {
-        const Vec3d p(double(v[i]), double(v[i + 1]), double(v[i + 2]));
+        const Vec3d p{double(v[i]), double(v[i + 1]), double(v[i + 2])};
         lo = min(lo, p);
         hi = max(hi, p);
         reach = std::max({reach, std::abs(p.x), std::abs(p.y), std::abs(p.z)});

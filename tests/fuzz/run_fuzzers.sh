@@ -9,7 +9,10 @@ out=${FUZZ_OUT:-$root/build-fuzz}
 mkdir -p "$out"
 # Line tables are all a crash report's stack trace needs (file:line), and cheaper than -g.
 flags="-std=c++20 -O1 -gline-tables-only -fno-omit-frame-pointer -DSAHARA_VERSION=\"fuzz\" -I$root/src -I/usr/include/opencv4"
-libs="-ltinyobjloader -ltinygltf -lOpenImageIO -lOpenImageIO_Util -ldl"
+# OBJ numbers are read in double, as in the CMake build (CMakeLists.txt gives the define
+# to the OBJ sources only; here it reaches every loader source, where only those two use it).
+flags="$flags -DTINYOBJLOADER_USE_DOUBLE"
+libs="-ltinyobjloader_double -ltinygltf -lOpenImageIO -lOpenImageIO_Util -ldl"
 # Every OBJ and glTF source by pattern, so a loader split into a new file is linked too.
 srcs="$(ls "$root"/src/io/obj_*.cpp "$root"/src/io/gltf_*.cpp | tr '\n' ' ')
       $root/src/io/model_loader.cpp $root/src/io/mesh_utils.cpp $root/src/io/image_bytes.cpp
