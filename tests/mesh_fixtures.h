@@ -226,4 +226,15 @@ inline std::vector<Ray> make_random_rays(const Bounds3& b, int count, uint32_t s
     return rays;
 }
 
+/// Each triangle's bounding box, in index order (the BVH builders' input).
+inline std::vector<Bounds3> triangle_boxes(const TriangleMesh& m) {
+    std::vector<Bounds3> boxes;
+    for (size_t i = 0; i < m.triangle_count(); ++i) {
+        Bounds3 b;
+        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
+        boxes.push_back(b);
+    }
+    return boxes;
+}
+
 }  // namespace sahara::test

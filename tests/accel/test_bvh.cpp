@@ -66,16 +66,6 @@ void check_against_brute_force(const TriangleMesh& mesh, BvhBuilder builder, uin
     CHECK(count_disagreements(acc, rays) == 0);
 }
 
-std::vector<Bounds3> triangle_boxes(const TriangleMesh& m) {
-    std::vector<Bounds3> boxes;
-    for (size_t i = 0; i < m.triangle_count(); ++i) {
-        Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
-        boxes.push_back(b);
-    }
-    return boxes;
-}
-
 Bvh build_for_mesh(const TriangleMesh& m, BvhBuilder builder, const BvhBuildParams& params = {}) {
     const std::vector<Bounds3> boxes = triangle_boxes(m);
     std::vector<Vec3> centers;

@@ -19,16 +19,6 @@ using namespace test;
 
 namespace {
 
-std::vector<Bounds3> boxes_of(const TriangleMesh& m) {
-    std::vector<Bounds3> boxes;
-    for (size_t i = 0; i < m.triangle_count(); ++i) {
-        Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
-        boxes.push_back(b);
-    }
-    return boxes;
-}
-
 double blocked_leaf(uint32_t n, const BvhBuildParams& p) {
     return double((n + p.leaf_block_size - 1) / p.leaf_block_size * p.leaf_block_size);
 }
@@ -102,7 +92,7 @@ TEST_CASE("binned build: a leaf is never more expensive than its cheapest binned
         BvhBuildParams p;
         p.leaf_block_size = 4;
         p.intersection_cost = 0.5f;  // the wide layout's weights (AcceleratorOptions::build_params)
-        const std::vector<Bounds3> boxes = boxes_of(m);
+        const std::vector<Bounds3> boxes = triangle_boxes(m);
         std::vector<Vec3> centers;
         for (const Bounds3& b : boxes) centers.push_back(b.center());
         const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::binned, p);
@@ -130,7 +120,7 @@ TEST_CASE("binned build: every node's box is exactly the union of what it holds"
             BvhBuildParams p;
             p.bin_count = bins;
             p.leaf_block_size = 4;
-            const std::vector<Bounds3> boxes = boxes_of(m);
+            const std::vector<Bounds3> boxes = triangle_boxes(m);
             std::vector<Vec3> centers;
             for (const Bounds3& b : boxes) centers.push_back(b.center());
             const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::binned, p);

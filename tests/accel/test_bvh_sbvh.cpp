@@ -63,12 +63,8 @@ struct TriangleInput {
 
 TriangleInput boxes_of(const TriangleMesh& m) {
     TriangleInput in;
-    for (size_t i = 0; i < m.triangle_count(); ++i) {
-        Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(m.positions[m.indices[3 * i + size_t(k)]]);
-        in.boxes.push_back(b);
-        in.centers.push_back(b.center());
-    }
+    in.boxes = triangle_boxes(m);
+    for (const Bounds3& b : in.boxes) in.centers.push_back(b.center());
     return in;
 }
 

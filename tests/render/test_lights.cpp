@@ -168,7 +168,10 @@ TEST_CASE("a sphere light is sampled by solid angle: the cone pdf matches the hi
     CHECK(ok > 300);
 }
 
-TEST_CASE("an emissive triangle is an area light (needs triangles in the accelerator)") {
+namespace {
+
+/// The floor under one emissive triangle (radiance 4) at height 1, facing down.
+Scene floor_under_triangle_light() {
     SceneDesc d = floor_scene(Rgb(0.5f));
     d.materials.push_back(emissive({4, 4, 4}));
     TriangleMesh m;
@@ -177,7 +180,13 @@ TEST_CASE("an emissive triangle is an area light (needs triangles in the acceler
     m.indices = {0, 1, 2};
     m.material = 2;
     d.meshes.push_back(m);
-    const Scene scene = build_scene(d);
+    return build_scene(d);
+}
+
+}  // namespace
+
+TEST_CASE("an emissive triangle is an area light (needs triangles in the accelerator)") {
+    const Scene scene = floor_under_triangle_light();
     REQUIRE(scene.emitters.size() == 1);
     Ray probe{{0.2f, -0.2f, 0.5f}, {0, 0, 1}, 0.0f, kInfinity, 0.0f};
     Hit hit;
@@ -298,14 +307,7 @@ TEST_CASE("an area light seen from a plane far towards the horizon gives finite 
     // A camera ray grazing the infinite floor hits it some 1e9 away; from there the
     // emitting triangle is edge-on and its solid-angle density exceeds 1e19, whose
     // square overflowed the MIS weight to inf/inf = NaN before.
-    SceneDesc d = floor_scene(Rgb(0.5f));
-    d.materials.push_back(emissive({4, 4, 4}));
-    TriangleMesh m;
-    m.positions = {{-0.5f, -0.5f, 1}, {0.5f, 0.5f, 1}, {0.5f, -0.5f, 1}};
-    m.indices = {0, 1, 2};
-    m.material = 2;
-    d.meshes.push_back(m);
-    const Scene scene = build_scene(d);
+    const Scene scene = floor_under_triangle_light();
     for (const float slope : {1e-7f, 1e-8f, 1e-9f, 1e-10f}) {
         const Ray ray{{0, -3, 2}, normalize(Vec3{0, 1, -slope}), 0.0f, kInfinity, 0.0f};
         const Stat s = sample_stats(
