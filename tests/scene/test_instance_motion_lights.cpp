@@ -152,11 +152,12 @@ namespace {
 
 /// A lambertian floor lit only by a small emissive square 2 above it, facing down;
 /// instanced (once, or twice when `second`) or flattened into the scene's own triangles.
-SceneDesc lit_floor(bool instanced, bool second) {
+SceneDesc lit_floor(bool instanced, bool second,
+                    const MaterialDesc& lamp = emissive(Rgb(20.0f, 12.0f, 6.0f))) {
     SceneDesc d = empty_scene(Rgb(0.0f));
     d.source = "test";
     d.materials.push_back(lambertian(Rgb(0.8f)));
-    d.materials.push_back(emissive(Rgb(20.0f, 12.0f, 6.0f)));
+    d.materials.push_back(lamp);
     d.planes.push_back({{0, 0, 0}, {0, 0, 1}, 1});
     const Mat4 place[2] = {
         Mat4::translate({0.3, 0.1, 2}) * Mat4::rotate_euler({180, 0, 20}) * Mat4::scale({0.4, 0.3, 1}),
@@ -211,6 +212,38 @@ TEST_CASE("instance lights: an instanced emissive square is light-sampled like t
             CHECK(a.se.x < 1.5f * b.se.x);
         }
     }
+}
+
+TEST_CASE("instance lights: textured emission on an instanced square is sampled like the flat square") {
+    // A 2 x 2 texture, bright in one quadrant only: light sampling must look the
+    // radiance up at the sampled point's own uv, through the instance's transform.
+    auto img = std::make_shared<Image>();
+    img->width = img->height = 2;
+    img->rgba = {40, 30, 10, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    MaterialDesc lamp = emissive(Rgb(1.0f));
+    lamp.radiance.kind = ColorSource::Kind::texture;
+    lamp.radiance.texture = 0;
+    lamp.radiance.color = Rgb(1.0f);
+    SceneDesc inst_desc = lit_floor(true, true, lamp), flat_desc = lit_floor(false, true, lamp);
+    for (SceneDesc* d : {&inst_desc, &flat_desc}) d->textures.push_back(TextureDesc{"quadrant", img});
+    const Scene inst = build_scene(inst_desc);
+    const Scene flat = build_scene(flat_desc);
+    REQUIRE(inst.instanced_emitters.size() == 4u);
+    const Ray ray{{0, -3, 1}, normalize(Vec3(0, 3, -1)), 0.0f, kInfinity, 0.0f};
+    const Stat a = radiance_stats(inst, ray, scaled(20000), 2, 3);
+    const Stat b = radiance_stats(flat, ray, scaled(20000), 2, 4);
+    // A lamp glowing everywhere like the bright quadrant: the texture really is looked up
+    // (a quarter of each lamp is bright, the rest 40 times dimmer).
+    const Scene uniform = build_scene(lit_floor(false, true, emissive(Rgb(40.0f, 30.0f, 10.0f))));
+    const Stat c = radiance_stats(uniform, ray, scaled(20000), 2, 5);
+    CAPTURE(a.mean.x);
+    CAPTURE(b.mean.x);
+    CAPTURE(c.mean.x);
+    CHECK(a.mean.x > 0.05f);
+    CHECK(agree(a, b, 4.0f));
+    CHECK(a.se.x < 1.5f * b.se.x);
+    CHECK(a.mean.x < 0.6f * c.mean.x);
+    CHECK(a.mean.x > 0.1f * c.mean.x);
 }
 
 TEST_CASE("instance lights: a moving instanced emitter is sampled where it is at the ray's time") {
