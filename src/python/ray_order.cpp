@@ -132,9 +132,10 @@ void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uin
 
 }  // namespace
 
-UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads) {
+void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
+    const RayBatch& rays = out.batch;
     const size_t n = rays.size();
-    if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return {};
+    if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return;
     if (threads <= 0) threads = omp_get_max_threads();
     UninitializedVector<uint64_t> keys = keyed_indices(rays, box, threads);
     UninitializedVector<uint64_t> scratch(n);
@@ -142,10 +143,22 @@ UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box
         radix_pass(keys, scratch, shift, threads);
         keys.swap(scratch);
     }
-    UninitializedVector<uint32_t> order(n);
+    out.order.resize(n);
+    out.rays.resize(n);
+    out.position.resize(n);
+    // The batch's rows are read at random here, kGatherAhead rays ahead of their use:
+    // a loop with nothing else to do keeps many loads in flight.
+    constexpr int64_t kGatherAhead = 48;
+    const auto count = int64_t(n);
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t i = 0; i < int64_t(n); ++i) order[size_t(i)] = uint32_t(keys[size_t(i)]);
-    return order;
+    for (int64_t k = 0; k < count; ++k) {
+        if (k + kGatherAhead < count) rays.prefetch(uint32_t(keys[size_t(k + kGatherAhead)]));
+        const auto index = uint32_t(keys[size_t(k)]);
+        out.order[size_t(k)] = index;
+        out.position[index] = uint32_t(k);
+        const Ray r = rays.ray(index);
+        out.rays[size_t(k)] = SortedRay{r.origin, r.tmin, r.dir, r.tmax};
+    }
 }
 
 bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset) {

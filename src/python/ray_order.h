@@ -44,33 +44,55 @@ struct UninitializedAllocator {
 template <class T>
 using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
 
-/// The batch's rays by a Morton code of the points where each ray enters and leaves
-/// `box` (the mesh's bounds; 5 bits per coordinate, 30 in all), ties in batch order. Empty (meaning the
-/// identity) below kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
-UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
+/// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
+/// over the sorted copies loads two rays per line.
+struct alignas(32) SortedRay {
+    Vec3 origin;
+    float tmin;
+    Vec3 dir;
+    float tmax;
+    Ray ray() const {
+        Ray r;
+        r.origin = origin, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
+        return r;
+    }
+};
+static_assert(sizeof(SortedRay) == 32);
+
+/// A nearest hit as it waits in sorted order for the write-back (Hit without its
+/// instance field: 16 bytes, four per cache line).
+struct SortedHit {
+    float t;
+    uint32_t prim;
+    float u, v;
+};
 
 /// The rays a query traces, in the order it traces them: the batch itself, or the
-/// batch read through a permutation whose position k holds the batch's ray order[k].
-/// Tracers prefetch() a packet ahead, so the rays are read in place without a cache
-/// miss each and without a sorted copy.
+/// batch sorted (sort_rays) into contiguous copies, position k holding the batch's
+/// ray order[k]. The copies are gathered in one pass with deep prefetching, which
+/// keeps the traversal loop free of the scattered reads.
 struct TraceOrder {
     const RayBatch& batch;
-    UninitializedVector<uint32_t> order;  ///< empty: the batch's own order
+    UninitializedVector<uint32_t> order;     ///< empty: the batch's own order
+    UninitializedVector<SortedRay> rays;     ///< with `order`: the rays in that order
+    UninitializedVector<uint32_t> position;  ///< with `order`: its inverse (batch index -> k)
     /// Nearest hits in the sorted order (with `order` only): they reach the result
     /// arrays in one pass in batch order, which reads one scattered hit per ray instead
     /// of writing four scattered results.
-    UninitializedVector<Hit> hits;
+    UninitializedVector<SortedHit> hits;
 
+    bool sorted() const { return !order.empty(); }
     size_t size() const { return batch.size(); }
-    Ray ray(size_t k) const { return batch.ray(index(k)); }
+    Ray ray(size_t k) const { return sorted() ? rays[k].ray() : batch.ray(k); }
     /// The batch index of position k (where its result goes).
-    size_t index(size_t k) const { return order.empty() ? k : size_t(order[k]); }
-    /// Starts loading the ray at position k (in batch order the hardware prefetcher
-    /// follows the rows by itself).
-    void prefetch(size_t k) const {
-        if (k < order.size()) batch.prefetch(order[k]);
-    }
+    size_t index(size_t k) const { return sorted() ? size_t(order[k]) : k; }
 };
+
+/// Sorts the batch's rays into `out` (order, rays, position) by a Morton code of the
+/// points where each ray enters and leaves `box` (the mesh's bounds; 5 bits per
+/// coordinate, 30 in all), ties in batch order. Leaves `out` unsorted below
+/// kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
+void sort_rays(const Bounds3& box, int threads, TraceOrder& out);
 
 /// Whether the active rays of a packet are close enough for the packet traversal to
 /// beat tracing them one by one: unit directions within `max_chord` of the first
