@@ -6,18 +6,41 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 namespace sahara::python {
+
+void* allocate_sort_buffer(size_t bytes) {
+    constexpr size_t kHugePage = size_t(2) << 20;
+    if (bytes < 2 * kHugePage) {
+        if (void* p = std::malloc(std::max<size_t>(bytes, 1))) return p;
+        throw std::bad_alloc();
+    }
+    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    void* p = std::aligned_alloc(kHugePage, rounded);
+    if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: without huge pages the buffer still works
+#endif
+    return p;
+}
+
+void free_sort_buffer(void* p) noexcept { std::free(p); }
 
 namespace {
 
 constexpr int kBitsPerCoordinate = 5;
 constexpr int kCells = 1 << kBitsPerCoordinate;
 constexpr int kKeyBits = 6 * kBitsPerCoordinate;
-/// Three passes order all 30 bits: a million rays fill 2^20 cells, but the order within
-/// those cells still shortens traversal by more than the third pass costs.
+/// Three digits order all 30 bits (one global pass, two within each top bucket): a million
+/// rays fill 2^20 cells, but the order within those cells still shortens traversal.
 constexpr int kRadixBits = 10;
+static_assert(kKeyBits == 3 * kRadixBits);
 constexpr size_t kBuckets = size_t(1) << kRadixBits;
 
 /// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
@@ -84,49 +107,89 @@ void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& 
     }
 }
 
-/// Morton code (high 32 bits) and batch index (low 32 bits) of every ray.
-UninitializedVector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, int threads) {
-    float scale[3];
+/// The scale of each axis of `box` onto kCells cells (0 for an empty or unbounded axis).
+void cell_scales(const Bounds3& box, float (&scale)[3]) {
     for (int k = 0; k < 3; ++k) {
         const float extent = box.hi[k] - box.lo[k];
         scale[k] = extent > 0.0f && std::isfinite(extent) ? float(kCells) / extent : 0.0f;
     }
-    const auto n = int64_t(rays.size());
-    UninitializedVector<uint64_t> keys(static_cast<size_t>(n));
-    const int64_t blocks = (n + kKeyBlock - 1) / kKeyBlock;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const auto first = size_t(b * kKeyBlock);
-        segment_keys(rays, first, int(std::min<int64_t>(kKeyBlock, n - int64_t(first))), box, scale,
-                     &keys[first]);
-    }
-    return keys;
 }
 
-/// One stable counting pass of an LSD radix sort on the bits from `shift`: each thread
-/// counts and then places one contiguous block of `in`.
-void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uint64_t>& out, int shift,
-                int threads) {
-    const size_t n = in.size();
-    std::vector<size_t> counts(size_t(threads) * kBuckets);
-#pragma omp parallel num_threads(threads)
-    {
-        const auto t = size_t(omp_get_thread_num()), nt = size_t(omp_get_num_threads());
-        const size_t lo = n * t / nt, hi = n * (t + 1) / nt;
-        size_t* count = &counts[t * kBuckets];
-        for (size_t i = lo; i < hi; ++i) ++count[(in[i] >> shift) & (kBuckets - 1)];
-#pragma omp barrier
-#pragma omp single
-        {
-            size_t next = 0;  // bucket by bucket, thread by thread: keeps the pass stable
-            for (size_t bucket = 0; bucket < kBuckets; ++bucket)
-                for (size_t u = 0; u < nt; ++u) {
-                    const size_t c = counts[u * kBuckets + bucket];
-                    counts[u * kBuckets + bucket] = next;
-                    next += c;
-                }
+/// The top kRadixBits of a key's code: the bucket of the first, global pass.
+size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBits)); }
+
+/// The sort's working arrays. The first pass moves each ray's key and its copy to
+/// the key's top bucket (reading the batch in order, so without scattered reads);
+/// each bucket, a few thousand rays that stay in the cache, is then sorted on its
+/// own by the remaining bits.
+struct SortScratch {
+    UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
+    UninitializedVector<SortedRay> rays;           ///< bucketed ray copies
+    UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
+    std::vector<size_t> counts;                    ///< per thread and top bucket, then bucket starts
+    std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
+};
+
+/// Keys of rays [lo, hi) and their counts per top bucket.
+void key_range(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& box, const float (&scale)[3],
+               uint64_t* keys, size_t* count) {
+    for (size_t first = lo; first < hi; first += kKeyBlock)
+        segment_keys(rays, first, int(std::min<size_t>(kKeyBlock, hi - first)), box, scale, &keys[first]);
+    for (size_t i = lo; i < hi; ++i) ++count[top_bucket(keys[i])];
+}
+
+/// Bucket by bucket, thread by thread: each thread's first slot in each bucket (the
+/// pass stays stable), and where each bucket starts.
+void place_buckets(SortScratch& s, size_t threads) {
+    size_t next = 0;
+    for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
+        s.bucket_start[bucket] = next;
+        for (size_t u = 0; u < threads; ++u) {
+            const size_t c = s.counts[u * kBuckets + bucket];
+            s.counts[u * kBuckets + bucket] = next;
+            next += c;
         }
-        for (size_t i = lo; i < hi; ++i) out[count[(in[i] >> shift) & (kBuckets - 1)]++] = in[i];
+    }
+    s.bucket_start[kBuckets] = next;
+}
+
+/// Moves rays [lo, hi) to their top buckets: key (low half now the bucketed slot),
+/// batch index and ray copy; records each ray's slot.
+void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count, TraceOrder& out) {
+    for (size_t i = lo; i < hi; ++i) {
+        const uint64_t key = s.keys[i];
+        const size_t slot = count[top_bucket(key)]++;
+        s.bucketed[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
+        s.index[slot] = uint32_t(key);
+        out.slot_of[i] = uint32_t(slot);
+        const Ray r = rays.ray(i);
+        s.rays[slot] = SortedRay{r.origin, r.tmin, r.dir, r.tmax};
+    }
+}
+
+/// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
+/// through `tmp`) and writes its part of the order, slots and sorted rays.
+void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, TraceOrder& out) {
+    uint64_t* keys = &s.bucketed[lo];
+    const size_t n = hi - lo;
+    if (n > 1) {
+        uint32_t count[2][kBuckets] = {};
+        for (size_t i = 0; i < n; ++i) {
+            ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
+            ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
+        }
+        for (auto& c : count) {
+            uint32_t next = 0;
+            for (uint32_t& x : c) next += std::exchange(x, next);
+        }
+        for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
+        for (size_t i = 0; i < n; ++i) keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
+    }
+    for (size_t k = lo; k < hi; ++k) {
+        const auto slot = uint32_t(s.bucketed[k]);
+        out.order[k] = s.index[slot];
+        out.slot[k] = slot;
+        out.rays[k] = s.rays[slot];
     }
 }
 
@@ -137,27 +200,28 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     const size_t n = rays.size();
     if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return;
     if (threads <= 0) threads = omp_get_max_threads();
-    UninitializedVector<uint64_t> keys = keyed_indices(rays, box, threads);
-    UninitializedVector<uint64_t> scratch(n);
-    for (int shift = 32; shift < 32 + kKeyBits; shift += kRadixBits) {
-        radix_pass(keys, scratch, shift, threads);
-        keys.swap(scratch);
-    }
-    out.order.resize(n);
-    out.rays.resize(n);
-    out.position.resize(n);
-    // The batch's rows are read at random here, kGatherAhead rays ahead of their use:
-    // a loop with nothing else to do keeps many loads in flight.
-    constexpr int64_t kGatherAhead = 48;
-    const auto count = int64_t(n);
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t k = 0; k < count; ++k) {
-        if (k + kGatherAhead < count) rays.prefetch(uint32_t(keys[size_t(k + kGatherAhead)]));
-        const auto index = uint32_t(keys[size_t(k)]);
-        out.order[size_t(k)] = index;
-        out.position[index] = uint32_t(k);
-        const Ray r = rays.ray(index);
-        out.rays[size_t(k)] = SortedRay{r.origin, r.tmin, r.dir, r.tmax};
+    float scale[3];
+    cell_scales(box, scale);
+    SortScratch s;
+    s.keys.resize(n), s.bucketed.resize(n), s.rays.resize(n), s.index.resize(n);
+    s.counts.assign(size_t(threads) * kBuckets, 0);
+    s.bucket_start.resize(kBuckets + 1);
+    out.order.resize(n), out.slot.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+#pragma omp parallel num_threads(threads)
+    {
+        const auto t = size_t(omp_get_thread_num()), nt = size_t(omp_get_num_threads());
+        const size_t lo = n * t / nt, hi = n * (t + 1) / nt;
+        key_range(rays, lo, hi, box, scale, s.keys.data(), &s.counts[t * kBuckets]);
+#pragma omp barrier
+#pragma omp single
+        place_buckets(s, nt);
+        bucket_range(rays, lo, hi, s, &s.counts[t * kBuckets], out);
+#pragma omp barrier
+        // s.keys is free now: each bucket's counting passes use its slots as scratch.
+#pragma omp for schedule(dynamic, 4)
+        for (size_t bucket = 0; bucket < kBuckets; ++bucket)
+            sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
+                        &s.keys[s.bucket_start[bucket]], out);
     }
 }
 

@@ -100,7 +100,7 @@ float CastMesh::packet_max_offset() const {
 }
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
-    TraceOrder out{rays, {}, {}, {}, {}};
+    TraceOrder out{rays, {}, {}, {}, {}, {}};
     if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
@@ -113,19 +113,20 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
     if (!rays.sorted()) return;
     const auto n = int64_t(rays.order.size());
     const int team = threads > 0 ? threads : omp_get_max_threads();
-    // The hits are read in random order: prefetched kHitsAhead rays ahead, and the
-    // normal of a hit read half as far ahead (its triangle is known by then).
-    constexpr int64_t kHitsAhead = 32;
-    const uint32_t* position = rays.position.data();
+    const uint32_t* slot_of = rays.slot_of.data();
     const SortedHit* hits = rays.hits.data();
+    // The hits come from one sequential stream per bucket, too many streams for the
+    // hardware prefetcher: they are prefetched kHitsAhead rays ahead, and the normal of
+    // a hit (a table of the mesh's size, read at random) half as far ahead.
+    constexpr int64_t kHitsAhead = 32;
 #pragma omp parallel for schedule(static) num_threads(team)
     for (int64_t i = 0; i < n; ++i) {
-        if (i + kHitsAhead < n) __builtin_prefetch(&hits[position[size_t(i + kHitsAhead)]]);
+        if (i + kHitsAhead < n) __builtin_prefetch(&hits[slot_of[size_t(i + kHitsAhead)]]);
         if (i + kHitsAhead / 2 < n) {
-            const SortedHit& ahead = hits[position[size_t(i + kHitsAhead / 2)]];
+            const SortedHit& ahead = hits[slot_of[size_t(i + kHitsAhead / 2)]];
             if (ahead.prim != kNoPrim) __builtin_prefetch(&normals_[prim_index(ahead.prim)]);
         }
-        const SortedHit& h = hits[position[size_t(i)]];
+        const SortedHit& h = hits[slot_of[size_t(i)]];
         Hit hit;
         hit.t = h.t, hit.prim = h.prim, hit.u = h.u, hit.v = h.v;
         store(size_t(i), hit, out);
@@ -137,13 +138,14 @@ void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
     const int threads = team_size(slice);
     const int64_t item = work_item(slice, threads, 1);
     const SortedRay* in = rays.rays.data();
+    const uint32_t* slot = rays.slot.data();
     SortedHit* hits = rays.hits.data();
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
     for (int64_t k = first; k < last; ++k) {
         Ray r = in[k].ray();
         Hit h;
         if (accel_) accel_->intersect(r, h);
-        hits[k] = SortedHit{h.t, h.prim, h.u, h.v};
+        hits[slot[k]] = SortedHit{h.t, h.prim, h.u, h.v};
     }
 }
 
