@@ -169,7 +169,8 @@ void place_buckets(SortScratch& s, size_t threads) {
 
 /// Moves rays [lo, hi) to their top buckets: key (low half now the bucketed slot),
 /// batch index and ray copy; records each ray's slot.
-void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count, TraceOrder& out) {
+void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count,
+                  TraceOrder& out) {
     // float32 rows are copied as they are; other layouts go through the converting reader.
     const bool f32 = lo < hi && rays.f32_row(lo) != nullptr;
     for (size_t i = lo; i < hi; ++i) {
@@ -193,7 +194,7 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, si
 /// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
 /// through `tmp`) and writes its part of the order, slots and sorted rays.
 void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, TraceOrder& out) {
-    uint64_t* keys = &s.bucketed[lo];
+    uint64_t* keys = s.bucketed.data() + lo;
     const size_t n = hi - lo;
     if (n > 1) {
         uint32_t count[2][kBuckets] = {};
@@ -206,7 +207,8 @@ void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, TraceOrder
             for (uint32_t& x : c) next += std::exchange(x, next);
         }
         for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
-        for (size_t i = 0; i < n; ++i) keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
+        for (size_t i = 0; i < n; ++i)
+            keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
     }
     for (size_t k = lo; k < hi; ++k) {
         const auto slot = uint32_t(s.bucketed[k]);
@@ -244,7 +246,7 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
 #pragma omp for schedule(dynamic, 4)
         for (size_t bucket = 0; bucket < kBuckets; ++bucket)
             sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
-                        &s.keys[s.bucket_start[bucket]], out);
+                        s.keys.data() + s.bucket_start[bucket], out);
     }
 }
 
