@@ -45,6 +45,8 @@ constexpr int kKeyBits = 3 * (kEntryBits + kExitBits);
 constexpr int kRadixBits = 10;
 static_assert(kKeyBits == 3 * kRadixBits);
 constexpr size_t kBuckets = size_t(1) << kRadixBits;
+/// Chunks of the batch per thread in the key and bucket passes.
+constexpr int kChunksPerThread = 8;
 
 /// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
 /// cell 0 or the last (maxss and minss pass NaN through their first operand).
@@ -140,7 +142,7 @@ struct SortScratch {
     UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
     UninitializedVector<SortedRay> rays;           ///< bucketed ray copies
     UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
-    std::vector<size_t> counts;                    ///< per thread and top bucket, then bucket starts
+    std::vector<size_t> counts;                    ///< per chunk and top bucket, then each chunk's slots
     std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
 };
 
@@ -152,13 +154,13 @@ void key_range(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& box, c
     for (size_t i = lo; i < hi; ++i) ++count[top_bucket(keys[i])];
 }
 
-/// Bucket by bucket, thread by thread: each thread's first slot in each bucket (the
+/// Bucket by bucket, chunk by chunk: each chunk's first slot in each bucket (the
 /// pass stays stable), and where each bucket starts.
-void place_buckets(SortScratch& s, size_t threads) {
+void place_buckets(SortScratch& s, size_t chunks) {
     size_t next = 0;
     for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
         s.bucket_start[bucket] = next;
-        for (size_t u = 0; u < threads; ++u) {
+        for (size_t u = 0; u < chunks; ++u) {
             const size_t c = s.counts[u * kBuckets + bucket];
             s.counts[u * kBuckets + bucket] = next;
             next += c;
@@ -229,20 +231,26 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     cell_scales(box, scale);
     SortScratch s;
     s.keys.resize(n), s.bucketed.resize(n), s.rays.resize(n), s.index.resize(n);
-    s.counts.assign(size_t(threads) * kBuckets, 0);
+    // More chunks than threads, taken dynamically: a thread the system holds back
+    // (a shared machine) then delays the passes by one chunk, not by half the batch.
+    const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
+    s.counts.assign(chunks * kBuckets, 0);
     s.bucket_start.resize(kBuckets + 1);
     out.order.resize(n), out.slot.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+    const auto chunk_count = int64_t(chunks);
 #pragma omp parallel num_threads(threads)
     {
-        const auto t = size_t(omp_get_thread_num()), nt = size_t(omp_get_num_threads());
-        const size_t lo = n * t / nt, hi = n * (t + 1) / nt;
-        key_range(rays, lo, hi, box, scale, s.keys.data(), &s.counts[t * kBuckets]);
-#pragma omp barrier
+#pragma omp for schedule(dynamic, 1)
+        for (int64_t c = 0; c < chunk_count; ++c)
+            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, s.keys.data(),
+                      &s.counts[size_t(c) * kBuckets]);
 #pragma omp single
-        place_buckets(s, nt);
-        bucket_range(rays, lo, hi, s, &s.counts[t * kBuckets], out);
-#pragma omp barrier
-        // s.keys is free now: each bucket's counting passes use its slots as scratch.
+        place_buckets(s, chunks);
+#pragma omp for schedule(dynamic, 1)
+        for (int64_t c = 0; c < chunk_count; ++c)
+            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
+                         &s.counts[size_t(c) * kBuckets], out);
+            // s.keys is free now: each bucket's counting passes use its slots as scratch.
 #pragma omp for schedule(dynamic, 4)
         for (size_t bucket = 0; bucket < kBuckets; ++bucket)
             sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],

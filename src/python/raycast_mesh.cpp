@@ -119,7 +119,9 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
     // hardware prefetcher: they are prefetched kHitsAhead rays ahead, and the normal of
     // a hit (a table of the mesh's size, read at random) half as far ahead.
     constexpr int64_t kHitsAhead = 32;
-#pragma omp parallel for schedule(static) num_threads(team)
+    // Dynamic: on a shared machine a thread held back delays the pass by one chunk only.
+    constexpr int64_t kResultChunk = 16384;
+#pragma omp parallel for schedule(dynamic, kResultChunk) num_threads(team)
     for (int64_t i = 0; i < n; ++i) {
         if (i + kHitsAhead < n) __builtin_prefetch(&hits[slot_of[size_t(i + kHitsAhead)]]);
         if (i + kHitsAhead / 2 < n) {
