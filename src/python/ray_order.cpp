@@ -136,11 +136,12 @@ size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBi
 
 /// The sort's working arrays. The first pass moves each ray's key and its copy to
 /// the key's top bucket (reading the batch in order, so without scattered reads);
-/// each bucket, a few thousand rays that stay in the cache, is then sorted on its
-/// own by the remaining bits.
+/// each bucket, about a thousand rays per million that stay in the cache, is then
+/// sorted on its own by the remaining bits, its ray copies permuted in place (in
+/// TraceOrder::rays) through a per-thread buffer. Once the copies are bucketed,
+/// `keys` is free: each bucket's counting passes use its slots as scratch.
 struct SortScratch {
     UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
-    UninitializedVector<SortedRay> rays;           ///< bucketed ray copies
     UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
     std::vector<size_t> counts;                    ///< per chunk and top bucket, then each chunk's slots
     std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
@@ -181,7 +182,7 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, si
         s.bucketed[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
         s.index[slot] = uint32_t(key);
         out.slot_of[i] = uint32_t(slot);
-        SortedRay& r = s.rays[slot];
+        SortedRay& r = out.rays[slot];
         if (f32) {
             const float* row = rays.f32_row(i);
             r.origin = Vec3(row[0], row[1], row[2]), r.dir = Vec3(row[3], row[4], row[5]);
@@ -194,8 +195,10 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, si
 }
 
 /// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
-/// through `tmp`) and writes its part of the order, slots and sorted rays.
-void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, TraceOrder& out) {
+/// through `tmp`) and writes its part of the order and slots; its ray copies are
+/// put in that order through `held`.
+void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, UninitializedVector<SortedRay>& held,
+                 TraceOrder& out) {
     uint64_t* keys = s.bucketed.data() + lo;
     const size_t n = hi - lo;
     if (n > 1) {
@@ -212,11 +215,13 @@ void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, TraceOrder
         for (size_t i = 0; i < n; ++i)
             keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
     }
+    if (held.size() < n) held.resize(n);
+    std::copy(out.rays.begin() + ptrdiff_t(lo), out.rays.begin() + ptrdiff_t(hi), held.begin());
     for (size_t k = lo; k < hi; ++k) {
         const auto slot = uint32_t(s.bucketed[k]);
         out.order[k] = s.index[slot];
         out.slot[k] = slot;
-        out.rays[k] = s.rays[slot];
+        out.rays[k] = held[slot - lo];
     }
 }
 
@@ -230,7 +235,7 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     float scale[3];
     cell_scales(box, scale);
     SortScratch s;
-    s.keys.resize(n), s.bucketed.resize(n), s.rays.resize(n), s.index.resize(n);
+    s.keys.resize(n), s.bucketed.resize(n), s.index.resize(n);
     // More chunks than threads, taken dynamically: a thread the system holds back
     // (a shared machine) then delays the passes by one chunk, not by half the batch.
     const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
@@ -250,11 +255,11 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
         for (int64_t c = 0; c < chunk_count; ++c)
             bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
                          &s.counts[size_t(c) * kBuckets], out);
-            // s.keys is free now: each bucket's counting passes use its slots as scratch.
+        UninitializedVector<SortedRay> held;
 #pragma omp for schedule(dynamic, 4)
         for (size_t bucket = 0; bucket < kBuckets; ++bucket)
             sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
-                        s.keys.data() + s.bucket_start[bucket], out);
+                        s.keys.data() + s.bucket_start[bucket], held, out);
     }
 }
 
