@@ -40,6 +40,7 @@ struct UninitializedAllocator {
     template <class U>
     UninitializedAllocator(const UninitializedAllocator<U>&) {}
     T* allocate(size_t n) {
+        static_assert(alignof(T) <= 64, "allocate_sort_buffer aligns to a cache line");
         if (n > std::numeric_limits<size_t>::max() / sizeof(T)) throw std::bad_array_new_length();
         return static_cast<T*>(allocate_sort_buffer(n * sizeof(T)));
     }
