@@ -6,19 +6,46 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace sahara::python {
 
+void* allocate_sort_buffer(size_t bytes) {
+    constexpr size_t kHugePage = size_t(2) << 20;
+    // Cache-line aligned at least (SortedRay asks for 32 bytes, more than malloc's 16).
+    const size_t align = bytes < 2 * kHugePage ? size_t(64) : kHugePage;
+    const size_t rounded = (std::max<size_t>(bytes, 1) + align - 1) / align * align;
+    void* p = std::aligned_alloc(align, rounded);
+    if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    // Advice only: without huge pages the buffer still works.
+    if (align == kHugePage) madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+    return p;
+}
+
+void free_sort_buffer(void* p) noexcept { std::free(p); }
+
 namespace {
 
-constexpr int kBitsPerCoordinate = 5;
-constexpr int kCells = 1 << kBitsPerCoordinate;
-constexpr int kKeyBits = 6 * kBitsPerCoordinate;
-/// Three passes order all 30 bits: a million rays fill 2^20 cells, but the order within
-/// those cells still shortens traversal by more than the third pass costs.
+/// Bits of each coordinate of the entry point and of the exit point in the key.
+constexpr int kEntryBits = 5;
+constexpr int kExitBits = 5;
+static_assert(kExitBits <= kEntryBits);
+constexpr int kCells = 1 << kEntryBits;
+constexpr int kKeyBits = 3 * (kEntryBits + kExitBits);
+/// Three digits order all 30 bits (one global pass, two within each top bucket): a million
+/// rays fill 2^20 cells, but the order within those cells still shortens traversal.
 constexpr int kRadixBits = 10;
+static_assert(kKeyBits == 3 * kRadixBits);
 constexpr size_t kBuckets = size_t(1) << kRadixBits;
+/// Chunks of the batch per thread in the key and bucket passes.
+constexpr int kChunksPerThread = 8;
 
 /// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
 /// cell 0 or the last (maxss and minss pass NaN through their first operand).
@@ -27,16 +54,27 @@ uint32_t cell(float x, float lo, float scale) {
     return uint32_t(int(std::min(float(kCells - 1), std::max(f, 0.0f))));  // int: one cvttss2si
 }
 
-/// Bit b of a cell index moved to bit 6 b, for all kCells indices: coordinate k's
-/// spread bits shifted by k interleave the six coordinates (a Morton code), so nearby
-/// codes are nearby in all six.
-constexpr std::array<uint32_t, kCells> spread_table() {
-    std::array<uint32_t, kCells> t{};
-    for (uint32_t v = 0; v < uint32_t(kCells); ++v)
-        for (int b = 0; b < kBitsPerCoordinate; ++b) t[v] |= ((v >> b) & 1u) << (6 * b);
+/// Where each bit of the six cell indices goes in the key: level by level from the
+/// most significant, the entry point's x, y, z and then, on the exit point's
+/// kExitBits lowest levels, its x, y, z (a Morton code of the six, so nearby codes are
+/// nearby in all six). Table [k][cell] for coordinate k of the entry point (k < 3) or
+/// of the exit point (k >= 3; index: the cell at the entry point's resolution).
+/// Entry before exit within a level: the sorted rays then miss the L1 cache less
+/// while they are traced than with the exit point's bits first (docs/performance.md).
+constexpr std::array<std::array<uint32_t, kCells>, 6> spread_tables() {
+    std::array<std::array<uint32_t, kCells>, 6> t{};
+    int bit = kKeyBits;
+    for (int level = kEntryBits - 1; level >= 0; --level)
+        for (int k = 0; k < 6; ++k) {
+            const bool exit = k >= 3;
+            if (exit && level >= kExitBits) continue;
+            --bit;
+            const int shift = exit ? level + (kEntryBits - kExitBits) : level;
+            for (uint32_t v = 0; v < uint32_t(kCells); ++v) t[size_t(k)][v] |= ((v >> shift) & 1u) << bit;
+        }
     return t;
 }
-constexpr std::array<uint32_t, kCells> kSpread = spread_table();
+constexpr auto kSpread = spread_tables();
 
 /// Rays per block of the key computation: structure-of-arrays blocks let the compiler
 /// vectorise the slab test and the cells, the bulk of the work.
@@ -79,73 +117,149 @@ void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& 
         }
     for (int i = 0; i < count; ++i) {
         uint32_t code = 0;
-        for (int k = 0; k < 6; ++k) code |= kSpread[cells[k][i]] << k;
+        for (int k = 0; k < 6; ++k) code |= kSpread[size_t(k)][cells[k][i]];
         keys[i] = uint64_t(enter[i] <= leave[i] ? code : 0u) << 32 | uint64_t(first + size_t(i));
     }
 }
 
-/// Morton code (high 32 bits) and batch index (low 32 bits) of every ray.
-UninitializedVector<uint64_t> keyed_indices(const RayBatch& rays, const Bounds3& box, int threads) {
-    float scale[3];
+/// The scale of each axis of `box` onto kCells cells (0 for an empty or unbounded axis).
+void cell_scales(const Bounds3& box, float (&scale)[3]) {
     for (int k = 0; k < 3; ++k) {
         const float extent = box.hi[k] - box.lo[k];
         scale[k] = extent > 0.0f && std::isfinite(extent) ? float(kCells) / extent : 0.0f;
     }
-    const auto n = int64_t(rays.size());
-    UninitializedVector<uint64_t> keys(static_cast<size_t>(n));
-    const int64_t blocks = (n + kKeyBlock - 1) / kKeyBlock;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t b = 0; b < blocks; ++b) {
-        const auto first = size_t(b * kKeyBlock);
-        segment_keys(rays, first, int(std::min<int64_t>(kKeyBlock, n - int64_t(first))), box, scale,
-                     &keys[first]);
-    }
-    return keys;
 }
 
-/// One stable counting pass of an LSD radix sort on the bits from `shift`: each thread
-/// counts and then places one contiguous block of `in`.
-void radix_pass(const UninitializedVector<uint64_t>& in, UninitializedVector<uint64_t>& out, int shift,
-                int threads) {
-    const size_t n = in.size();
-    std::vector<size_t> counts(size_t(threads) * kBuckets);
-#pragma omp parallel num_threads(threads)
-    {
-        const auto t = size_t(omp_get_thread_num()), nt = size_t(omp_get_num_threads());
-        const size_t lo = n * t / nt, hi = n * (t + 1) / nt;
-        size_t* count = &counts[t * kBuckets];
-        for (size_t i = lo; i < hi; ++i) ++count[(in[i] >> shift) & (kBuckets - 1)];
-#pragma omp barrier
-#pragma omp single
-        {
-            size_t next = 0;  // bucket by bucket, thread by thread: keeps the pass stable
-            for (size_t bucket = 0; bucket < kBuckets; ++bucket)
-                for (size_t u = 0; u < nt; ++u) {
-                    const size_t c = counts[u * kBuckets + bucket];
-                    counts[u * kBuckets + bucket] = next;
-                    next += c;
-                }
+/// The top kRadixBits of a key's code: the bucket of the first, global pass.
+size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBits)); }
+
+/// The sort's working arrays. The first pass moves each ray's key and its copy to
+/// the key's top bucket (reading the batch in order, so without scattered reads);
+/// each bucket, about a thousand rays per million that stay in the cache, is then
+/// sorted on its own by the remaining bits, its ray copies permuted in place (in
+/// TraceOrder::rays) through a per-thread buffer. Once the copies are bucketed,
+/// `keys` is free: each bucket's counting passes use its slots as scratch.
+struct SortScratch {
+    UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
+    UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
+    std::vector<size_t> counts;                    ///< per chunk and top bucket, then each chunk's slots
+    std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
+};
+
+/// Keys of rays [lo, hi) and their counts per top bucket.
+void key_range(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& box, const float (&scale)[3],
+               uint64_t* keys, size_t* count) {
+    for (size_t first = lo; first < hi; first += kKeyBlock)
+        segment_keys(rays, first, int(std::min<size_t>(kKeyBlock, hi - first)), box, scale, &keys[first]);
+    for (size_t i = lo; i < hi; ++i) ++count[top_bucket(keys[i])];
+}
+
+/// Bucket by bucket, chunk by chunk: each chunk's first slot in each bucket (the
+/// pass stays stable), and where each bucket starts.
+void place_buckets(SortScratch& s, size_t chunks) {
+    size_t next = 0;
+    for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
+        s.bucket_start[bucket] = next;
+        for (size_t u = 0; u < chunks; ++u) {
+            const size_t c = s.counts[u * kBuckets + bucket];
+            s.counts[u * kBuckets + bucket] = next;
+            next += c;
         }
-        for (size_t i = lo; i < hi; ++i) out[count[(in[i] >> shift) & (kBuckets - 1)]++] = in[i];
+    }
+    s.bucket_start[kBuckets] = next;
+}
+
+/// Moves rays [lo, hi) to their top buckets: key (low half now the bucketed slot),
+/// batch index and ray copy; records each ray's slot.
+void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count,
+                  TraceOrder& out) {
+    // float32 rows are copied as they are; other layouts go through the converting reader.
+    const bool f32 = lo < hi && rays.f32_row(lo) != nullptr;
+    for (size_t i = lo; i < hi; ++i) {
+        const uint64_t key = s.keys[i];
+        const size_t slot = count[top_bucket(key)]++;
+        s.bucketed[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
+        s.index[slot] = uint32_t(key);
+        out.slot_of[i] = uint32_t(slot);
+        SortedRay& r = out.rays[slot];
+        if (f32) {
+            const float* row = rays.f32_row(i);
+            r.origin = Vec3(row[0], row[1], row[2]), r.dir = Vec3(row[3], row[4], row[5]);
+            r.tmin = rays.tmin(i), r.tmax = rays.tmax(i);
+        } else {
+            const Ray full = rays.ray(i);
+            r = SortedRay{full.origin, full.tmin, full.dir, full.tmax};
+        }
+    }
+}
+
+/// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
+/// through `tmp`) and writes its part of the order and slots; its ray copies are
+/// put in that order through `held`.
+void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, UninitializedVector<SortedRay>& held,
+                 TraceOrder& out) {
+    uint64_t* keys = s.bucketed.data() + lo;
+    const size_t n = hi - lo;
+    if (n > 1) {
+        uint32_t count[2][kBuckets] = {};
+        for (size_t i = 0; i < n; ++i) {
+            ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
+            ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
+        }
+        for (auto& c : count) {
+            uint32_t next = 0;
+            for (uint32_t& x : c) next += std::exchange(x, next);
+        }
+        for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
+        for (size_t i = 0; i < n; ++i)
+            keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
+    }
+    if (held.size() < n) held.resize(n);
+    std::copy(out.rays.begin() + ptrdiff_t(lo), out.rays.begin() + ptrdiff_t(hi), held.begin());
+    for (size_t k = lo; k < hi; ++k) {
+        const auto slot = uint32_t(s.bucketed[k]);
+        out.order[k] = s.index[slot];
+        out.slot[k] = slot;
+        out.rays[k] = held[slot - lo];
     }
 }
 
 }  // namespace
 
-UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads) {
+void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
+    const RayBatch& rays = out.batch;
     const size_t n = rays.size();
-    if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return {};
+    if (n < kMinSortedRays || n > size_t(std::numeric_limits<uint32_t>::max())) return;
     if (threads <= 0) threads = omp_get_max_threads();
-    UninitializedVector<uint64_t> keys = keyed_indices(rays, box, threads);
-    UninitializedVector<uint64_t> scratch(n);
-    for (int shift = 32; shift < 32 + kKeyBits; shift += kRadixBits) {
-        radix_pass(keys, scratch, shift, threads);
-        keys.swap(scratch);
+    float scale[3];
+    cell_scales(box, scale);
+    SortScratch s;
+    s.keys.resize(n), s.bucketed.resize(n), s.index.resize(n);
+    // More chunks than threads, taken dynamically: a thread the system holds back
+    // (a shared machine) then delays the passes by one chunk, not by half the batch.
+    const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
+    s.counts.assign(chunks * kBuckets, 0);
+    s.bucket_start.resize(kBuckets + 1);
+    out.order.resize(n), out.slot.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+    const auto chunk_count = int64_t(chunks);
+#pragma omp parallel num_threads(threads)
+    {
+#pragma omp for schedule(dynamic, 1)
+        for (int64_t c = 0; c < chunk_count; ++c)
+            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, s.keys.data(),
+                      &s.counts[size_t(c) * kBuckets]);
+#pragma omp single
+        place_buckets(s, chunks);
+#pragma omp for schedule(dynamic, 1)
+        for (int64_t c = 0; c < chunk_count; ++c)
+            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
+                         &s.counts[size_t(c) * kBuckets], out);
+        UninitializedVector<SortedRay> held;
+#pragma omp for schedule(dynamic, 4)
+        for (size_t bucket = 0; bucket < kBuckets; ++bucket)
+            sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
+                        s.keys.data() + s.bucket_start[bucket], held, out);
     }
-    UninitializedVector<uint32_t> order(n);
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int64_t i = 0; i < int64_t(n); ++i) order[size_t(i)] = uint32_t(keys[size_t(i)]);
-    return order;
 }
 
 bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset) {

@@ -5,6 +5,7 @@
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <new>
 #include <utility>
@@ -21,6 +22,13 @@ namespace sahara::python {
 /// sparse for neighbours to share much, and the sort would cost more than it saves.
 inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 
+/// Allocates `bytes` for a sort buffer: buffers of several MB on 2 MB pages where the
+/// system offers them (Linux's transparent huge pages), so that the bucket pass, which
+/// writes to a thousand places at once, does not miss the TLB on each write, and a
+/// buffer's first touch takes one page fault per 2 MB instead of one per 4 kB.
+void* allocate_sort_buffer(size_t bytes);
+void free_sort_buffer(void* p) noexcept;
+
 /// An allocator whose value-initialisation leaves the memory as it is: the sort's
 /// buffers (tens of MB for a million rays) are written in full by parallel loops,
 /// which then also take their first-touch page faults in parallel instead of one
@@ -31,8 +39,12 @@ struct UninitializedAllocator {
     UninitializedAllocator() = default;
     template <class U>
     UninitializedAllocator(const UninitializedAllocator<U>&) {}
-    T* allocate(size_t n) { return std::allocator<T>().allocate(n); }
-    void deallocate(T* p, size_t n) { std::allocator<T>().deallocate(p, n); }
+    T* allocate(size_t n) {
+        static_assert(alignof(T) <= 64, "allocate_sort_buffer aligns to a cache line");
+        if (n > std::numeric_limits<size_t>::max() / sizeof(T)) throw std::bad_array_new_length();
+        return static_cast<T*>(allocate_sort_buffer(n * sizeof(T)));
+    }
+    void deallocate(T* p, size_t) noexcept { free_sort_buffer(p); }
     template <class U, class... Args>
     void construct(U* p, Args&&... args) {
         if constexpr (sizeof...(Args) > 0) ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
@@ -44,33 +56,58 @@ struct UninitializedAllocator {
 template <class T>
 using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
 
-/// The batch's rays by a Morton code of the points where each ray enters and leaves
-/// `box` (the mesh's bounds; 5 bits per coordinate, 30 in all), ties in batch order. Empty (meaning the
-/// identity) below kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
-UninitializedVector<uint32_t> ray_order(const RayBatch& rays, const Bounds3& box, int threads);
-
-/// The rays a query traces, in the order it traces them: the batch itself, or the
-/// batch read through a permutation whose position k holds the batch's ray order[k].
-/// Tracers prefetch() a packet ahead, so the rays are read in place without a cache
-/// miss each and without a sorted copy.
-struct TraceOrder {
-    const RayBatch& batch;
-    UninitializedVector<uint32_t> order;  ///< empty: the batch's own order
-    /// Nearest hits in the sorted order (with `order` only): they reach the result
-    /// arrays in one pass in batch order, which reads one scattered hit per ray instead
-    /// of writing four scattered results.
-    UninitializedVector<Hit> hits;
-
-    size_t size() const { return batch.size(); }
-    Ray ray(size_t k) const { return batch.ray(index(k)); }
-    /// The batch index of position k (where its result goes).
-    size_t index(size_t k) const { return order.empty() ? k : size_t(order[k]); }
-    /// Starts loading the ray at position k (in batch order the hardware prefetcher
-    /// follows the rows by itself).
-    void prefetch(size_t k) const {
-        if (k < order.size()) batch.prefetch(order[k]);
+/// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
+/// over the sorted copies loads two rays per line.
+struct alignas(32) SortedRay {
+    Vec3 origin;
+    float tmin;
+    Vec3 dir;
+    float tmax;
+    Ray ray() const {
+        Ray r;
+        r.origin = origin, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
+        return r;
     }
 };
+static_assert(sizeof(SortedRay) == 32);
+
+/// A nearest hit as it waits in sorted order for the write-back (Hit without its
+/// instance field: 16 bytes, four per cache line).
+struct SortedHit {
+    float t;
+    uint32_t prim;
+    float u, v;
+};
+
+/// The rays a query traces, in the order it traces them: the batch itself, or the
+/// batch sorted (sort_rays) into contiguous copies, position k holding the batch's
+/// ray order[k]. The sort moves each ray first to a slot of its top bucket and then
+/// sorts each bucket in the cache; results go back the same way (by slot, then
+/// slot_of each batch index), so neither direction reads or writes one cache line
+/// per ray at random.
+struct TraceOrder {
+    const RayBatch& batch;
+    UninitializedVector<uint32_t> order;    ///< empty: the batch's own order
+    UninitializedVector<uint32_t> slot;     ///< with `order`: the bucketed slot of position k
+    UninitializedVector<uint32_t> slot_of;  ///< with `order`: the bucketed slot of each batch index
+    UninitializedVector<SortedRay> rays;    ///< with `order`: the rays in that order
+    /// Nearest hits by bucketed slot (with `order` only): a bucket's hits are written
+    /// while its rays are traced, then read back in batch order as one sequential
+    /// stream per bucket.
+    UninitializedVector<SortedHit> hits;
+
+    bool sorted() const { return !order.empty(); }
+    size_t size() const { return batch.size(); }
+    Ray ray(size_t k) const { return sorted() ? rays[k].ray() : batch.ray(k); }
+    /// The batch index of position k (where its result goes).
+    size_t index(size_t k) const { return sorted() ? size_t(order[k]) : k; }
+};
+
+/// Sorts the batch's rays into `out` (order, slot, slot_of, rays) by a Morton code of the
+/// points where each ray enters and leaves `box` (the mesh's bounds; 5 bits per
+/// coordinate, 30 in all), ties in batch order. Leaves `out` unsorted below
+/// kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
+void sort_rays(const Bounds3& box, int threads, TraceOrder& out);
 
 /// Whether the active rays of a packet are close enough for the packet traversal to
 /// beat tracing them one by one: unit directions within `max_chord` of the first

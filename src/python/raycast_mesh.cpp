@@ -100,50 +100,62 @@ float CastMesh::packet_max_offset() const {
 }
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
-    TraceOrder out{rays, {}, {}};
+    TraceOrder out{rays, {}, {}, {}, {}, {}};
     if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
-    out.order = ray_order(rays, accel_->bounds(), threads);
-    if (!out.order.empty()) out.hits.resize(out.order.size());
+    sort_rays(accel_->bounds(), threads, out);
+    if (out.sorted()) out.hits.resize(out.order.size());
     return out;
 }
 
 void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const {
-    if (rays.order.empty()) return;
+    if (!rays.sorted()) return;
     const auto n = int64_t(rays.order.size());
-    UninitializedVector<uint32_t> position(static_cast<size_t>(n));  // the inverse permutation
     const int team = threads > 0 ? threads : omp_get_max_threads();
-#pragma omp parallel num_threads(team)
-    {
-#pragma omp for schedule(static)
-        for (int64_t k = 0; k < n; ++k) position[rays.order[size_t(k)]] = uint32_t(k);
-        // The hits are read in random order: prefetched kHitsAhead rays ahead, and the
-        // normal of a hit read half as far ahead (its triangle is known by then).
-        constexpr int64_t kHitsAhead = 32;
-#pragma omp for schedule(static)
-        for (int64_t i = 0; i < n; ++i) {
-            if (i + kHitsAhead < n) __builtin_prefetch(&rays.hits[position[size_t(i + kHitsAhead)]]);
-            if (i + kHitsAhead / 2 < n) {
-                const Hit& ahead = rays.hits[position[size_t(i + kHitsAhead / 2)]];
-                if (ahead.hit()) __builtin_prefetch(&normals_[prim_index(ahead.prim)]);
-            }
-            store(size_t(i), rays.hits[position[size_t(i)]], out);
+    const uint32_t* slot_of = rays.slot_of.data();
+    const SortedHit* hits = rays.hits.data();
+    // The hits come from one sequential stream per bucket, too many streams for the
+    // hardware prefetcher: they are prefetched kHitsAhead rays ahead, and the normal of
+    // a hit (a table of the mesh's size, read at random) half as far ahead.
+    constexpr int64_t kHitsAhead = 32;
+    // Dynamic: on a shared machine a thread held back delays the pass by one chunk only.
+    constexpr int64_t kResultChunk = 16384;
+#pragma omp parallel for schedule(dynamic, kResultChunk) num_threads(team)
+    for (int64_t i = 0; i < n; ++i) {
+        if (i + kHitsAhead < n) __builtin_prefetch(&hits[slot_of[size_t(i + kHitsAhead)]]);
+        if (i + kHitsAhead / 2 < n) {
+            const SortedHit& ahead = hits[slot_of[size_t(i + kHitsAhead / 2)]];
+            if (ahead.prim != kNoPrim) __builtin_prefetch(&normals_[prim_index(ahead.prim)]);
         }
+        const SortedHit& h = hits[slot_of[size_t(i)]];
+        Hit hit;
+        hit.t = h.t, hit.prim = h.prim, hit.u = h.u, hit.v = h.v;
+        store(size_t(i), hit, out);
+    }
+}
+
+void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
+    const auto first = int64_t(slice.first), last = int64_t(slice.last);
+    const int threads = team_size(slice);
+    const int64_t item = work_item(slice, threads, 1);
+    const SortedRay* in = rays.rays.data();
+    const uint32_t* slot = rays.slot.data();
+    SortedHit* hits = rays.hits.data();
+#pragma omp parallel for schedule(dynamic, item) num_threads(threads)
+    for (int64_t k = first; k < last; ++k) {
+        Ray r = in[k].ray();
+        Hit h;
+        if (accel_) accel_->intersect(r, h);
+        hits[slot[k]] = SortedHit{h.t, h.prim, h.u, h.v};
     }
 }
 
 void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out) const {
+    if (rays.sorted()) return nearest_sorted(rays, slice);
     const auto first = int64_t(slice.first), last = int64_t(slice.last);
-    Hit* sorted_hits = rays.order.empty() ? nullptr : rays.hits.data();
-    const auto put = [&](int64_t k, const Hit& h) {
-        if (sorted_hits)
-            sorted_hits[k] = h;
-        else
-            store(size_t(k), h, out);
-    };
     if (!accel_) {
-        for (int64_t k = first; k < last; ++k) put(k, Hit{});
+        for (int64_t k = first; k < last; ++k) store(size_t(k), Hit{}, out);
         return;
     }
     const float max_offset = packet_max_offset();
@@ -158,17 +170,15 @@ void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out)
         const int lanes = int(std::min<int64_t>(kPacketSize, last - start));
         for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(start + l)));
         if (lanes > 1 && packet_is_coherent(packet, kPacketMaxChord, max_offset)) {
-            for (int l = 0; l < lanes; ++l) rays.prefetch(size_t(start + kPacketSize + l));
             accel_->intersect_packet(packet, hits);
-            for (int l = 0; l < lanes; ++l) put(start + l, hits.hit(l));
+            for (int l = 0; l < lanes; ++l) store(size_t(start + l), hits.hit(l), out);
             continue;
         }
         for (int l = 0; l < lanes; ++l) {
-            rays.prefetch(size_t(start + kPacketSize + l));  // one per ray: spread over the packet
             Ray r = packet.ray(l);
             Hit h;
             accel_->intersect(r, h);
-            put(start + l, h);
+            store(size_t(start + l), h, out);
         }
     }
 }
@@ -179,7 +189,6 @@ void CastMesh::occluded(const TraceOrder& rays, RaySlice slice, bool* out) const
     const int64_t item = work_item(slice, threads, 1);
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
     for (int64_t k = first; k < last; ++k) {
-        rays.prefetch(size_t(k + kPacketSize));
         out[rays.index(size_t(k))] = accel_ && accel_->occluded(rays.ray(size_t(k)));
     }
 }
