@@ -36,6 +36,34 @@ using build::for_chunks;
 using build::kParallelScanThreshold;
 using build::kScanChunks;
 
+/// The build's own arrays (primitive records, node regions), uninitialised, on huge pages
+/// where they are large: every level of the build streams through the records, and with
+/// 4 KiB pages the first touch of every page is a fault.
+template <class T>
+class BuildBuffer {
+   public:
+    BuildBuffer() = default;
+    BuildBuffer(const BuildBuffer&) = delete;
+    BuildBuffer& operator=(const BuildBuffer&) = delete;
+    ~BuildBuffer() { release(); }
+    void allocate(size_t n) {
+        release();
+        data_ = Alloc().allocate(n);  // every element is written before it is read
+        size_ = n;
+    }
+    T* get() const { return data_; }
+    T& operator[](size_t i) const { return data_[i]; }
+
+   private:
+    using Alloc = AlignedAllocator<T, 64>;
+    void release() {
+        if (data_) Alloc().deallocate(data_, size_);
+        data_ = nullptr;
+    }
+    T* data_ = nullptr;
+    size_t size_ = 0;
+};
+
 /// A node's work item: its primitives, box and centroid bounds, and the buffer that
 /// holds the primitives (a parallel partition moves them to the other buffer).
 struct Range {
@@ -53,10 +81,10 @@ class BinnedBuild {
         out_.nodes.clear();
         out_.prim_indices.assign(n_, 0);
         if (n_ == 0) return;
-        refs_.reset(new PrimRef[n_]);
-        nodes_.reset(new BvhNode[2 * size_t(n_)]);
+        refs_.allocate(n_);
+        nodes_.allocate(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
-        if (n_ > kParallelScanThreshold) scratch_.reset(new PrimRef[n_]);
+        if (n_ > kParallelScanThreshold) scratch_.allocate(n_);
 #pragma omp parallel
 #pragma omp single
         {
@@ -253,7 +281,7 @@ class BinnedBuild {
         PrimRef* lo = &r.refs[r.begin];
         PrimRef* hi = &r.refs[r.end];
         Box4 lc, rc;
-        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis]);
+        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis], r.end - r.begin);
         for (;;) {
             while (lo < hi && side.left(*lo)) lc.extend(_mm_load_ps(lo->c)), ++lo;
             while (lo < hi && !side.left(hi[-1])) --hi, rc.extend(_mm_load_ps(hi->c));
@@ -291,7 +319,7 @@ class BinnedBuild {
         }
         Box4 lc[kScanChunks], rc[kScanChunks];
         PrimRef* const to = r.refs == refs_.get() ? scratch_.get() : refs_.get();
-        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis]);
+        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis], r.end - r.begin);
         for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
             uint32_t l = left_at[c], h = right_at[c];
             for (uint32_t i = b; i < e; ++i) {
@@ -376,8 +404,8 @@ class BinnedBuild {
     const BvhBuildParams params_;
     Bvh& out_;
     const uint32_t n_;
-    std::unique_ptr<PrimRef[]> refs_, scratch_;
-    std::unique_ptr<BvhNode[]> nodes_;
+    BuildBuffer<PrimRef> refs_, scratch_;
+    BuildBuffer<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
 };
 

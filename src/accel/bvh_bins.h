@@ -117,11 +117,13 @@ struct BinMap {
 /// bin() is monotonic in the centroid over the range's centroid bounds when the extent and
 /// the scale are finite, so there the test is one comparison against the smallest
 /// centroid of the right side, found by bisection over the floats between the bounds (a
-/// NaN centroid goes left either way: bin() clamps its integer conversion to 0).
+/// NaN centroid goes left either way: bin() clamps its integer conversion to 0). The
+/// bisection costs about as much as binning 50 centroids, so short ranges bin.
 class SideTest {
    public:
-    SideTest(const BinMap& map, int axis, uint32_t pos, float centroid_hi)
+    SideTest(const BinMap& map, int axis, uint32_t pos, float centroid_hi, uint32_t primitives)
         : map_(map), axis_(axis), pos_(pos) {
+        if (primitives < 64) return;
         const float lo = map.lo_s[axis];
         const float extent = centroid_hi - lo;
         if (!(extent <= kMaxFloat && map.scale_s[axis] <= kMaxFloat) || !(lo >= -kMaxFloat)) return;
