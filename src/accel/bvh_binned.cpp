@@ -152,7 +152,7 @@ class BinnedBuild {
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
         if (may_be_leaf && params_.intersection_cost > 0.0f && leaf_is_certain(r)) return false;
-        const uint32_t bins = params_.bin_count;
+        const uint32_t bins = binned_bin_count(n, params_.bin_count);
         const BinMap map(r.centroids, bins);
         Split best;
         if (n <= kParallelScanThreshold) {
