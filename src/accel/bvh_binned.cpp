@@ -24,8 +24,8 @@ namespace {
 
 /// Ranges binned into two sets of bins (fill_bins): the merge costs a few hundred instructions.
 constexpr uint32_t kTwoBinSetsMin = 256;
-using binned::Bins;
 using binned::BinMap;
+using binned::Bins;
 using binned::Box4;
 using binned::kMaxBins;
 using binned::load_lo;

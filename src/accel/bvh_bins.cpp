@@ -17,7 +17,8 @@ uint64_t nonzero_mask(const uint32_t* count, uint32_t nb) {
     uint64_t bits = 0;
     for (uint32_t b = 0; b < nb; b += 4) {
         const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(count + b));
-        const auto zero = uint64_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128()))));
+        const auto zero =
+            uint64_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128()))));
         bits |= (~zero & 15u) << b;
     }
     return nb == 64 ? bits : bits & ((uint64_t(1) << nb) - 1);
@@ -39,7 +40,8 @@ BinSplit sparse_search(const Bins& bins, const BinMap& map, const SplitCosts& co
         const Box4* box = bins.box[axis];
         const uint32_t* count = bins.count[axis];
         uint32_t m = 0;
-        for (uint64_t bits = nonzero_mask(count, nb); bits; bits &= bits - 1) used[m++] = uint32_t(__builtin_ctzll(bits));
+        for (uint64_t bits = nonzero_mask(count, nb); bits; bits &= bits - 1)
+            used[m++] = uint32_t(__builtin_ctzll(bits));
         if (m < 2) continue;
         Box4 acc;  // right_*[j]: bins used[j..m) together
         uint32_t cnt = 0;
@@ -56,8 +58,8 @@ BinSplit sparse_search(const Bins& bins, const BinMap& map, const SplitCosts& co
         for (uint32_t j = 1; j < m; ++j) {
             acc.extend(box[used[j - 1]]);
             cnt += count[used[j - 1]];
-            const float cost = costs.intersection_cost *
-                               (acc.area() * blocked(cnt, block) + right_area[j] * blocked(right_count[j], block));
+            const float cost = costs.intersection_cost * (acc.area() * blocked(cnt, block) +
+                                                          right_area[j] * blocked(right_count[j], block));
             if (cost < best.cost) {
                 best.cost = cost;
                 best.left_count = cnt;

@@ -68,9 +68,8 @@ double cheapest_binned_split(const Bvh& bvh, std::span<const Bounds3> prims, uin
             uint32_t nl = 0, nr = 0;
             for (uint32_t s = first; s < first + count; ++s) {
                 const Bounds3& b = prims[bvh.prim_indices[s]];
-                const int bin =
-                    std::clamp(int((b.center()[axis] - centroids.lo[axis]) * (float(bins) / extent)), 0,
-                               int(bins) - 1);
+                const int bin = std::clamp(
+                    int((b.center()[axis] - centroids.lo[axis]) * (float(bins) / extent)), 0, int(bins) - 1);
                 if (uint32_t(bin) < pos)
                     left.extend(b), ++nl;
                 else
