@@ -94,7 +94,7 @@ struct BvhBuildParams {
     /// Leaves are tested in blocks of this many primitives (a partly filled block
     /// costs as much as a full one), so the SAH counts ceil(n / size) * size.
     uint32_t leaf_block_size = 1;
-    uint32_t bin_count = 16;  ///< binned builder: centroid bins per axis
+    uint32_t bin_count = 16;  ///< binned builder: centroid bins per axis (at most 8 for ranges of up to 64)
     /// Subtrees with more primitives than this are built as OpenMP tasks.
     uint32_t parallel_threshold = 4096;
     /// Reinsertion: inner nodes removed and reinserted per round (the most inefficient ones), as a

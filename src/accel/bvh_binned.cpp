@@ -11,10 +11,8 @@
 /// on the thread count, and every node owns a fixed region of the node array
 /// (compacted at the end), so the tree is the same for any thread count.
 #include "accel/bvh_binned.h"
+#include "accel/bvh_bins.h"
 #include "accel/build_chunks.h"
-
-#include <emmintrin.h>
-#include <xmmintrin.h>
 
 #include <algorithm>
 #include <memory>
@@ -24,117 +22,46 @@ namespace sahara {
 
 namespace {
 
-constexpr uint32_t kMaxBins = 64;
 /// Ranges binned into two sets of bins (fill_bins): the merge costs a few hundred instructions.
 constexpr uint32_t kTwoBinSetsMin = 256;
+using binned::BinMap;
+using binned::Bins;
+using binned::Box4;
+using binned::kMaxBins;
+using binned::load_lo;
+using binned::PrimRef;
+using Split = binned::BinSplit;
 using build::chunk_begin;
 using build::for_chunks;
 using build::kParallelScanThreshold;
 using build::kScanChunks;
 
-struct alignas(16) PrimRef {
-    float lo[3];
-    uint32_t id;
-    float hi[3];
-    float pad0;
-    float c[3];
-    float pad1;
-};
-static_assert(sizeof(PrimRef) == 48);
+/// The build's own arrays (primitive records, node regions), uninitialised, on huge pages
+/// where they are large: every level of the build streams through the records, and with
+/// 4 KiB pages the first touch of every page is a fault.
+template <class T>
+class BuildBuffer {
+   public:
+    BuildBuffer() = default;
+    BuildBuffer(const BuildBuffer&) = delete;
+    BuildBuffer& operator=(const BuildBuffer&) = delete;
+    ~BuildBuffer() { release(); }
+    void allocate(size_t n) {
+        release();
+        data_ = Alloc().allocate(n);  // every element is written before it is read
+        size_ = n;
+    }
+    T* get() const { return data_; }
+    T& operator[](size_t i) const { return data_[i]; }
 
-/// lo with lane 3 (the id's bits, often a denormal float: slow in arithmetic) cleared.
-inline __m128 load_lo(const PrimRef& p) {
-    return _mm_and_ps(_mm_load_ps(p.lo), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
-}
-
-/// A box in two SSE registers (lane 3 unused). The min/max argument order
-/// matches std::min/std::max in Bounds3::extend, bit for bit.
-struct Box4 {
-    __m128 lo = _mm_set1_ps(kInfinity);
-    __m128 hi = _mm_set1_ps(-kInfinity);
-
-    void extend(__m128 l, __m128 h) {
-        lo = _mm_min_ps(l, lo);
-        hi = _mm_max_ps(h, hi);
+   private:
+    using Alloc = AlignedAllocator<T, 64>;
+    void release() {
+        if (data_) Alloc().deallocate(data_, size_);
+        data_ = nullptr;
     }
-    void extend(__m128 p) { extend(p, p); }
-    void extend(const Box4& b) { extend(b.lo, b.hi); }
-    /// Bounds3::surface_area, the same operations in the same order.
-    float area() const {
-        if (_mm_movemask_ps(_mm_cmpgt_ps(lo, hi)) & 7) return 0.0f;
-        const __m128 e = _mm_sub_ps(hi, lo);
-        const __m128 yzx = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));
-        const __m128 p = _mm_mul_ps(e, yzx);  // x*y, y*z, z*x
-        const float sum = (_mm_cvtss_f32(p) + _mm_cvtss_f32(_mm_shuffle_ps(p, p, 1))) +
-                          _mm_cvtss_f32(_mm_shuffle_ps(p, p, 2));
-        return 2.0f * sum;
-    }
-    Bounds3 bounds() const {
-        alignas(16) float l[4], h[4];
-        _mm_store_ps(l, lo);
-        _mm_store_ps(h, hi);
-        return {{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
-    }
-};
-
-/// The bins of the three axes of one range (or of one chunk of it).
-struct Bins {
-    Box4 box[3][kMaxBins];
-    uint32_t count[3][kMaxBins];
-
-    void clear(uint32_t bins) {
-        clear_counts(bins);
-        for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins; ++k) box[a][k] = Box4{};
-    }
-    /// Zeroes the counts of bins [0, bins) in whole groups of four (a few stores, where
-    /// std::fill_n calls memset for every small node).
-    void clear_counts(uint32_t bins) {
-        for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins; k += 4)
-                _mm_storeu_si128(reinterpret_cast<__m128i*>(&count[a][k]), _mm_setzero_si128());
-    }
-    void add(const Bins& o, uint32_t bins) {
-        for (int a = 0; a < 3; ++a)
-            for (uint32_t k = 0; k < bins; ++k) box[a][k].extend(o.box[a][k]), count[a][k] += o.count[a][k];
-    }
-};
-
-/// Maps centroids to bins: bin = clamp(int((c - lo) * scale), 0, bins - 1) per axis.
-struct BinMap {
-    __m128 lo, scale;
-    float lo_s[3], scale_s[3];
-    int last;
-
-    BinMap(const Bounds3& centroids, uint32_t bins) : last(int(bins) - 1) {
-        for (int a = 0; a < 3; ++a) {
-            const float extent = centroids.hi[a] - centroids.lo[a];
-            lo_s[a] = centroids.lo[a];
-            scale_s[a] = extent > 0.0f ? float(bins) / extent : 0.0f;
-        }
-        lo = _mm_setr_ps(lo_s[0], lo_s[1], lo_s[2], 0.0f);
-        scale = _mm_setr_ps(scale_s[0], scale_s[1], scale_s[2], 0.0f);
-    }
-    uint32_t clamp(int b) const { return uint32_t(std::clamp(b, 0, last)); }
-    /// The bins of centroid c on the three axes (lanes 0-2), clamped as clamp() does, in SSE2.
-    __m128i bins(__m128 c, __m128i last_bin) const {
-        __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale));
-        k = _mm_and_si128(k, _mm_cmpgt_epi32(k, _mm_setzero_si128()));
-        const __m128i over = _mm_cmpgt_epi32(k, last_bin);
-        return _mm_or_si128(_mm_andnot_si128(over, k), _mm_and_si128(over, last_bin));
-    }
-    /// Bin on one axis (the same arithmetic as the three-axis version).
-    uint32_t bin(const PrimRef& p, int axis) const {
-        return clamp(_mm_cvtt_ss2si(_mm_set_ss((p.c[axis] - lo_s[axis]) * scale_s[axis])));
-    }
-};
-
-struct Split {
-    int axis = -1;
-    uint32_t pos = 0;  ///< first bin of the right side
-    float cost = kInfinity;
-    uint32_t left_count = 0;
-    Bounds3 left, right;
+    T* data_ = nullptr;
+    size_t size_ = 0;
 };
 
 /// A node's work item: its primitives, box and centroid bounds, and the buffer that
@@ -154,10 +81,10 @@ class BinnedBuild {
         out_.nodes.clear();
         out_.prim_indices.assign(n_, 0);
         if (n_ == 0) return;
-        refs_.reset(new PrimRef[n_]);
-        nodes_.reset(new BvhNode[2 * size_t(n_)]);
+        refs_.allocate(n_);
+        nodes_.allocate(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
-        if (n_ > kParallelScanThreshold) scratch_.reset(new PrimRef[n_]);
+        if (n_ > kParallelScanThreshold) scratch_.allocate(n_);
 #pragma omp parallel
 #pragma omp single
         {
@@ -225,7 +152,7 @@ class BinnedBuild {
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
         if (may_be_leaf && params_.intersection_cost > 0.0f && leaf_is_certain(r)) return false;
-        const uint32_t bins = params_.bin_count;
+        const uint32_t bins = binned_bin_count(n, params_.bin_count);
         const BinMap map(r.centroids, bins);
         Split best;
         if (n <= kParallelScanThreshold) {
@@ -296,6 +223,14 @@ class BinnedBuild {
         }
     }
 
+    /// A thread's second set of bins (not used across a task scheduling point). Out of line:
+    /// with -fPIC a thread_local access is a call, which GCC repeated for every primitive
+    /// of the loop, spilling its registers each time.
+    [[gnu::noinline]] static Bins& odd_bins() {
+        thread_local Bins bins;
+        return bins;
+    }
+
     /// Long ranges bin alternate primitives into two sets, merged at the end: neighbours
     /// often share a bin, and one set would chain each box update to the store before it.
     static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
@@ -304,8 +239,8 @@ class BinnedBuild {
             for (uint32_t i = begin; i < end; ++i) bin_one(refs[i], map, last, out);
             return;
         }
-        thread_local Bins odd;  // not used across a task scheduling point
-        const uint32_t bins = uint32_t(map.last) + 1;
+        Bins& odd = odd_bins();
+        const uint32_t bins = map.count();
         odd.clear(bins);
         uint32_t i = begin;
         for (; i + 1 < end; i += 2) {
@@ -337,72 +272,8 @@ class BinnedBuild {
         }
     }
 
-    /// Bit b set where count[b] != 0, for b < nb (count has kMaxBins entries).
-    static uint64_t nonzero_mask(const uint32_t* count, uint32_t nb) {
-        uint64_t bits = 0;
-        for (uint32_t b = 0; b < nb; b += 4) {
-            const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(count + b));
-            const auto zero =
-                uint64_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, _mm_setzero_si128()))));
-            bits |= (~zero & 15u) << b;
-        }
-        return nb == 64 ? bits : bits & ((uint64_t(1) << nb) - 1);
-    }
-
-    /// The cheapest bin boundary over the axes with a non-zero centroid extent. Only the
-    /// non-empty bins are visited: the boundaries between two of them all cost the same, and
-    /// the first of them (the one a sweep over every boundary keeps) follows the left one.
     Split find_split(const Bins& bins, const BinMap& map) const {
-        const uint32_t nb = params_.bin_count;
-        Split best;
-        int best_axis = -1;
-        uint32_t best_pos = 0;
-        uint32_t used[kMaxBins];
-        float right_area[kMaxBins];
-        uint32_t right_count[kMaxBins];
-        __m128 right_lo[kMaxBins], right_hi[kMaxBins];  // not cleared: written before read
-        Box4 best_left, best_right;
-        for (int axis = 0; axis < 3; ++axis) {
-            if (!(map.scale_s[axis] > 0.0f)) continue;
-            const Box4* box = bins.box[axis];
-            const uint32_t* count = bins.count[axis];
-            uint32_t m = 0;
-            for (uint64_t bits = nonzero_mask(count, nb); bits; bits &= bits - 1)
-                used[m++] = uint32_t(__builtin_ctzll(bits));
-            if (m < 2) continue;
-            // right_*[j]: bins used[j..m) together.
-            Box4 acc;
-            uint32_t cnt = 0;
-            for (uint32_t j = m - 1; j > 0; --j) {
-                acc.extend(box[used[j]]);
-                cnt += count[used[j]];
-                right_lo[j] = acc.lo;
-                right_hi[j] = acc.hi;
-                right_area[j] = acc.area();
-                right_count[j] = cnt;
-            }
-            acc = Box4{};
-            cnt = 0;
-            for (uint32_t j = 1; j < m; ++j) {
-                acc.extend(box[used[j - 1]]);
-                cnt += count[used[j - 1]];
-                const float cost = params_.intersection_cost *
-                                   (acc.area() * blocked(cnt) + right_area[j] * blocked(right_count[j]));
-                if (cost < best.cost) {
-                    best.cost = cost;
-                    best.left_count = cnt;
-                    best_axis = axis;
-                    best_pos = used[j - 1] + 1;
-                    best_left = acc;
-                    best_right.lo = right_lo[j];
-                    best_right.hi = right_hi[j];
-                }
-            }
-        }
-        best.axis = best_axis;
-        best.pos = best_pos;
-        if (best_axis >= 0) best.left = best_left.bounds(), best.right = best_right.bounds();
-        return best;
+        return binned::find_bin_split(bins, map, {params_.intersection_cost, params_.leaf_block_size});
     }
 
     /// In-place partition of a short range; accumulates the children's centroid bounds.
@@ -410,10 +281,10 @@ class BinnedBuild {
         PrimRef* lo = &r.refs[r.begin];
         PrimRef* hi = &r.refs[r.end];
         Box4 lc, rc;
-        const int axis = s.axis;
+        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis], r.end - r.begin);
         for (;;) {
-            while (lo < hi && map.bin(*lo, axis) < s.pos) lc.extend(_mm_load_ps(lo->c)), ++lo;
-            while (lo < hi && map.bin(hi[-1], axis) >= s.pos) --hi, rc.extend(_mm_load_ps(hi->c));
+            while (lo < hi && side.left(*lo)) lc.extend(_mm_load_ps(lo->c)), ++lo;
+            while (lo < hi && !side.left(hi[-1])) --hi, rc.extend(_mm_load_ps(hi->c));
             if (lo >= hi) break;
             std::swap(*lo, hi[-1]);
             lc.extend(_mm_load_ps(lo->c));
@@ -448,11 +319,12 @@ class BinnedBuild {
         }
         Box4 lc[kScanChunks], rc[kScanChunks];
         PrimRef* const to = r.refs == refs_.get() ? scratch_.get() : refs_.get();
+        const binned::SideTest side(map, s.axis, s.pos, r.centroids.hi[s.axis], r.end - r.begin);
         for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
             uint32_t l = left_at[c], h = right_at[c];
             for (uint32_t i = b; i < e; ++i) {
                 const PrimRef& p = r.refs[i];
-                if (map.bin(p, s.axis) < s.pos) {
+                if (side.left(p)) {
                     to[l++] = p;
                     lc[c].extend(_mm_load_ps(p.c));
                 } else {
@@ -532,8 +404,8 @@ class BinnedBuild {
     const BvhBuildParams params_;
     Bvh& out_;
     const uint32_t n_;
-    std::unique_ptr<PrimRef[]> refs_, scratch_;
-    std::unique_ptr<BvhNode[]> nodes_;
+    BuildBuffer<PrimRef> refs_, scratch_;
+    BuildBuffer<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
 };
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "accel/bvh_binned.h"
 #include "mesh_fixtures.h"
 #include "scene/accelerator.h"
 #include "scene/mesh_scene.h"
@@ -44,7 +45,8 @@ Bounds3 union_below(const Bvh& bvh, std::span<const Bounds3> prims, uint32_t nod
 }
 
 /// Reference for a leaf of `count` primitives from slot `first`: the cheapest split over
-/// `bins` centroid bins per axis (the builder's rule, recomputed here in plain code), as
+/// the centroid bins per axis the builder uses for `count` primitives (its rule, recomputed
+/// here in plain code), as
 /// traversal + intersection * sum(child area * blocked child count); +inf if none.
 double cheapest_binned_split(const Bvh& bvh, std::span<const Bounds3> prims, uint32_t first, uint32_t count,
                              const BvhBuildParams& p) {
@@ -56,18 +58,18 @@ double cheapest_binned_split(const Bvh& bvh, std::span<const Bounds3> prims, uin
     auto blocked = [&](uint32_t n) {
         return double((n + p.leaf_block_size - 1) / p.leaf_block_size * p.leaf_block_size);
     };
+    const uint32_t bins = binned_bin_count(count, p.bin_count);
     double best = std::numeric_limits<double>::infinity();
     for (int axis = 0; axis < 3; ++axis) {
         const float extent = centroids.hi[axis] - centroids.lo[axis];
         if (!(extent > 0.0f)) continue;
-        for (uint32_t pos = 1; pos < p.bin_count; ++pos) {
+        for (uint32_t pos = 1; pos < bins; ++pos) {
             Bounds3 left, right;
             uint32_t nl = 0, nr = 0;
             for (uint32_t s = first; s < first + count; ++s) {
                 const Bounds3& b = prims[bvh.prim_indices[s]];
-                const int bin =
-                    std::clamp(int((b.center()[axis] - centroids.lo[axis]) * (float(p.bin_count) / extent)),
-                               0, int(p.bin_count) - 1);
+                const int bin = std::clamp(
+                    int((b.center()[axis] - centroids.lo[axis]) * (float(bins) / extent)), 0, int(bins) - 1);
                 if (uint32_t(bin) < pos)
                     left.extend(b), ++nl;
                 else
