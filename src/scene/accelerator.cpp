@@ -246,8 +246,7 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     wide8_.occlusion_far_first = order == OcclusionOrder::far_first;
     if (order != OcclusionOrder::automatic) return;
     // Farthest first sorts the hit children, which slot order does not: it must save
-    // enough nodes and leaf tests to pay for that (docs/performance.md: the shipped
-    // interior's sample rays do 0.6 of the work and are faster; the ogre's 0.83, slower).
+    // enough nodes and leaf tests to pay for that (docs/performance.md, "Occlusion order").
     constexpr double kFarFirstMaxWork = 0.75;
     const std::vector<Ray> rays = occlusion_sample_rays(blocks_, 512);
     uint64_t work[2] = {0, 0};
