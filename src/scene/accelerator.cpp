@@ -439,7 +439,7 @@ bool Accelerator::occluded(const Ray& ray, OcclusionCache& cache) const {
     NoTraversalCounters none;
     Hit h;
     if (!trace<true>(const_cast<Ray&>(ray), h, none)) return false;
-    // The pairs layout and the flat root leaf leave prim unset: nothing to remember.
+    // The pairs layout leaves prim unset: nothing to remember.
     if (h.prim < blocks_.size()) cache = OcclusionCache{this, h.prim};
     return true;
 }
