@@ -57,6 +57,11 @@ struct BvhWide {
     std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>>
         nodes;  ///< nodes[0]: the root's children
     bool empty = true;
+    /// Any-hit traversal visits the hit children farthest entry first, not in slot order
+    /// (traverse_wide). Rays that leave a surface inside an enclosure (a room) are mostly
+    /// stopped by the far shell, not by what lies around their origin; set per tree by
+    /// whoever knows which order suits it (Accelerator: OcclusionOrder).
+    bool occlusion_far_first = false;
 
     /// An inner child holds its node's byte offset (index * sizeof(node)), not its
     /// index: the traversal's next node address is then one addition. The address

@@ -21,7 +21,8 @@ enum class LeafResult : uint8_t {
 
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
-/// pushed farthest first. kAvx: 8-wide box tests in AVX (caller compiled for AVX2);
+/// pushed farthest first. Any-hit rays visit children in slot order instead, or
+/// farthest entry first where the tree says so (BvhWide::occlusion_far_first). kAvx: 8-wide box tests in AVX (caller compiled for AVX2);
 /// kAvx512: 8-wide nodes take the AVX-512 step (intersect_bvh8_compress_avx512).
 /// kPairNodes (8-wide; closest hit on the AVX2 and AVX-512 steps, any hit on the AVX2
 /// step): until the first hit, the inner node on top of the stack is tested in the same
@@ -107,6 +108,14 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         _mm_prefetch(p + 64, _MM_HINT_T0);
         _mm_prefetch(p + 128, _MM_HINT_T0);
     };
+    // The sort key of an any-hit entry visited farthest first (BvhWide::occlusion_far_first):
+    // finite non-negative distances mapped to finite non-negative floats in reverse order,
+    // so the nearest-first sorting below serves both orders. A ray's answer does not depend
+    // on the order, only its cost.
+    const bool far_first = kAnyHit && bvh.occlusion_far_first;
+    auto far_key = [](float t) __attribute__((always_inline)) {
+        return std::bit_cast<float>(0x7F7FFFFFu - std::bit_cast<uint32_t>(t));
+    };
     // Pops the nearest pending entry that can still hold a closer hit into `cur`.
     auto pop = [&]() __attribute__((always_inline)) {
         for (;;) {
@@ -143,6 +152,24 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
                 if constexpr (kAvx512 && N == 8 && kAnyHit) {
+                    if (far_first) {
+                        alignas(32) uint32_t ref[N];
+                        alignas(32) float t[N];
+                        const Bvh8HitChildren h =
+                            intersect_bvh8_compress_avx512(n, rw.avx, ray.tmin, tmax_far, ref, t);
+                        if (!h.mask) {
+                            if (!pop()) return found;
+                            continue;
+                        }
+                        cur = Entry{h.ref0, far_key(h.t0)};
+                        const int hits = __builtin_popcount(h.mask), base = top;
+                        for (int i = 1; i < hits; ++i) {
+                            Entry in{ref[i], far_key(t[i])};
+                            nearer_first(cur, in);
+                            push_sorted(base, in);
+                        }
+                        continue;
+                    }
                     const Bvh8HitChildren h = intersect_bvh8_entries_avx512(
                         n, rw.avx, ray.tmin, tmax_far, reinterpret_cast<uint64_t*>(&stack[top]));
                     if (h.mask) {
@@ -205,7 +232,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     // entry): the hit children of both pushed in slot order, b's beneath, the
                     // last of a's visited next. (Not on the AVX-512 step: pairing cannot keep
                     // that step's first-hit-first order, without which its shadow rays are slower.)
-                    if (top > 0 && top <= kPairMaxTop && ref_count(stack[top - 1].ref) == 0) {
+                    if (!far_first && top > 0 && top <= kPairMaxTop && ref_count(stack[top - 1].ref) == 0) {
                         const auto& b = *reinterpret_cast<const BvhWideNode<N>*>(nodes + stack[--top].ref);
                         alignas(32) float ta[N], tb[N];
                         int ma = rw.test(n, ray.tmin, tmax_far, ta);
@@ -271,8 +298,21 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                     cur = Entry{n.child[c], t[c]};
                     if (!mask) continue;  // one child hit: no ordering, no stack
                     if constexpr (kAnyHit) {
-                        // Any hit ends the search, so order buys little: push in child order
-                        // (Embree's occlusion traversal does the same), the last becomes `cur`.
+                        if (far_first) {
+                            cur.t = far_key(cur.t);
+                            const int base = top;
+                            do {
+                                c = unsigned(__builtin_ctz(unsigned(mask)));
+                                mask &= mask - 1;
+                                Entry in{n.child[c], far_key(t[c])};
+                                nearer_first(cur, in);
+                                push_sorted(base, in);
+                            } while (mask);
+                            continue;
+                        }
+                        // In slot order the search is cheapest when order buys little: push
+                        // in child order (Embree's occlusion traversal does the same), the
+                        // last becomes `cur`.
                         do {
                             stack[top++] = cur;
                             c = unsigned(__builtin_ctz(unsigned(mask)));

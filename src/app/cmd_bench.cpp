@@ -50,6 +50,9 @@ constexpr const char* kBenchUsage =
     "              diffuse = cosine-distributed bounces from the primary hits, shadow = occlusion\n"
     "              rays from the primary hits to a square light above the geometry (a scene: along\n"
     "              the camera's up axis, or towards its first directional light, a sun)\n"
+    "              (shadow rays are also traced with a per-thread shadow cache, which tests the\n"
+    "              block that stopped the thread's last ray first: figures marked cached,\n"
+    "              beside, never in place of, the traversal's own)\n"
     "  --layout L  traversal structure: wide8 (default: 8-wide BVH, leaf triangles tested 4 at a\n"
     "              time, 8 with AVX2) or pairs (binary BVH, the reference); wide8 uses the widest\n"
     "              of AVX-512, AVX2 and SSE2 the CPU has (SAHARA_SIMD=avx2 or sse2 asks for a\n"
@@ -134,18 +137,35 @@ void add_embree_json(nlohmann::ordered_json& j, double count, const PassTimes& t
     j["confirmed_for_sahara"] = d.confirmed_for_a;
 }
 
+/// The occlusion pass with the shadow cache (OcclusionCache), apart from the plain
+/// traversal's figures: "cached" ones, and how many answers differ from the plain pass
+/// (none should).
+void add_cached_json(nlohmann::ordered_json& j, double count, const PassTimes& cached, const PassTimes& theirs,
+                     const RayAnswers& plain, const RayAnswers& with_cache, bool embree) {
+    j["cached_mrays_s"] = count / median(cached.wall) * 1e-6;
+    j["cached_mrays_cpu_s"] = count / median(cached.cpu) * 1e-6;
+    size_t differ = 0;
+    for (size_t i = 0; i < plain.prim.size(); ++i) differ += plain.prim[i] != with_cache.prim[i];
+    j["cached_answers_differ"] = differ;
+    if (!embree) return;
+    j["cached_ratio"] = j["cached_mrays_s"].get<double>() / (count / median(theirs.wall) * 1e-6);
+    j["cached_ratio_cpu"] = j["cached_mrays_cpu_s"].get<double>() / (count / median(theirs.cpu) * 1e-6);
+}
+
 nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& accel,
                                  const EmbreeReference* embree, const std::vector<Ray>& rays, bool occlusion,
                                  const BenchOptions& opt) {
-    PassTimes ours, theirs;
-    RayAnswers a, b;
+    PassTimes ours, cached, theirs;
+    RayAnswers a, b, c;
     for (int k = 0; k < opt.repeat; ++k) {
         ours.add(trace_sahara(accel, rays, occlusion, opt.threads, true, a));
+        if (occlusion) cached.add(trace_sahara_cached(accel, rays, opt.threads, true, c));
         if (embree) theirs.add(trace_embree(*embree, rays, occlusion, opt.threads, true, b));
     }
     const double count = double(rays.size());
     nlohmann::ordered_json j = throughput_json(count, ours, a);
     if (embree) add_embree_json(j, count, theirs, compare_answers(a, b, rays, mesh));
+    if (occlusion) add_cached_json(j, count, cached, theirs, a, c, embree != nullptr);
     return j;
 }
 
@@ -250,6 +270,7 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
         {"layout", bvh_layout_name(opt.layout)},
         {"simd", simd_path_name(active_simd_path())},
         {"node_pairing", accel.pairs_nodes() && active_simd_path() != SimdPath::sse2},
+        {"occlusion_order", accel.occlusion_far_first() ? "far_first" : "slot"},
         {"tree_bytes_per_primitive",
          double(accel.bytes()) / double(std::max<size_t>(accel.primitive_count(), 1))},
         {"build_ms", accel.build_ms()},
@@ -318,11 +339,12 @@ void print_text(const nlohmann::ordered_json& j) {
     std::printf("threads     %d\n", j["threads"].get<int>());
     std::printf(
         "build       %.1f ms (%.2f Mprims/s, %.2f per thread), CPU %.1f ms (%.2f Mprims/s) (%s SAH, %s "
-        "layout, %s%s)",
+        "layout, %s%s%s)",
         j["build_ms"].get<double>(), j["mprims_s"].get<double>(), j["mprims_s_per_thread"].get<double>(),
         j["build_cpu_ms"].get<double>(), j["mprims_cpu_s"].get<double>(),
         j["builder"].get<std::string>().c_str(), j["layout"].get<std::string>().c_str(),
-        j["simd"].get<std::string>().c_str(), j["node_pairing"].get<bool>() ? ", node pairing" : "");
+        j["simd"].get<std::string>().c_str(), j["node_pairing"].get<bool>() ? ", node pairing" : "",
+        j["occlusion_order"] == "far_first" ? ", occlusion rays farthest child first" : "");
     if (j.contains("embree_build_ms"))
         std::printf(
             "\nEmbree      build %.1f ms (%.2f Mtris/s, %.2f per thread), CPU %.1f ms (%.2f Mtris/s) "
@@ -357,6 +379,16 @@ void print_text(const nlohmann::ordered_json& j) {
                         r["ratio_cpu"].get<double>(), r["disagreements"].get<size_t>(),
                         r["ties"].get<size_t>(), r["confirmed_for_sahara"].get<size_t>());
         std::printf("\n");
+    }
+    if (j["rays"].contains("shadow") && j["rays"]["shadow"].contains("cached_mrays_s")) {
+        const auto& r = j["rays"]["shadow"];
+        std::printf("shadow, cached: %.2f MRays/s, CPU %.2f", r["cached_mrays_s"].get<double>(),
+                    r["cached_mrays_cpu_s"].get<double>());
+        if (r.contains("cached_ratio"))
+            std::printf(", ratio %.2f, CPU %.2f", r["cached_ratio"].get<double>(),
+                        r["cached_ratio_cpu"].get<double>());
+        std::printf(" (per-thread shadow cache; %zu answers differ from the plain traversal)\n",
+                    r["cached_answers_differ"].get<size_t>());
     }
     if (j["rays"].contains("primary_packet")) {
         const auto& r = j["rays"]["primary_packet"];

@@ -4,6 +4,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -114,6 +115,18 @@ PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bo
         Ray r = rays[i];
         Hit h;
         if (accel.intersect(r, h)) t = h.t, prim = prim_index(h.prim);
+    });
+}
+
+PassTime trace_sahara_cached(const Accelerator& accel, const std::vector<Ray>& rays, int threads, bool ftz,
+                             RayAnswers& out) {
+    // One cache line per thread: the caches are written on most rays.
+    struct alignas(64) ThreadCache {
+        OcclusionCache cache;
+    };
+    std::vector<ThreadCache> caches(size_t(std::max(threads, 1)));
+    return timed_pass(rays.size(), threads, ftz, out, [&](size_t i, float& t, uint32_t& prim) {
+        if (accel.occluded(rays[i], caches[size_t(omp_get_thread_num())].cache)) t = 0.0f, prim = 0;
     });
 }
 

@@ -27,6 +27,10 @@ struct PassTime {
 /// Traces `rays` with sahara on `threads` threads (FTZ/DAZ as given).
 PassTime trace_sahara(const Accelerator& accel, const std::vector<Ray>& rays, bool occlusion, int threads,
                       bool ftz, RayAnswers& out);
+/// Occlusion rays through Accelerator::occluded with one OcclusionCache per thread
+/// (the shadow cache; the renderer keeps one per light and thread).
+PassTime trace_sahara_cached(const Accelerator& accel, const std::vector<Ray>& rays, int threads, bool ftz,
+                             RayAnswers& out);
 /// The same with Embree's rtcIntersect1 / rtcOccluded1.
 PassTime trace_embree(const EmbreeReference& embree, const std::vector<Ray>& rays, bool occlusion,
                       int threads, bool ftz, RayAnswers& out);

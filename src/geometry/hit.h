@@ -34,4 +34,15 @@ struct Hit {
 };
 static_assert(sizeof(Hit) == 20);
 
+/// What stopped the last occlusion ray of one light on one thread: a shadow cache
+/// (Haines and Greenberg, "The Light Buffer", 1986, reduced to one entry). The next ray
+/// tests that leaf block first and skips the traversal when it still blocks, as it
+/// mostly does for neighbouring shading points. The answer is exactly the traversal's:
+/// the block goes through the same leaf test (cut-outs and one-sided triangles
+/// included), and any primitive that blocks the ray makes it occluded.
+struct OcclusionCache {
+    const void* owner = nullptr;  ///< the Accelerator (scene/accelerator.h) that filled it; another ignores it
+    uint32_t block = 0;           ///< the occluder's leaf block (wide8 layout)
+};
+
 }  // namespace sahara

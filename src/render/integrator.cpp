@@ -86,7 +86,7 @@ Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading
     float bsdf_pdf = 0;
     const Rgb f_cos = eval_shading(bsdf, wo, ls.wi, &bsdf_pdf);
     if (max_component(f_cos) <= 0 || max_component(ls.li) <= 0) return Rgb(0.0f);
-    if (scene.occluded(shadow_ray(si.p, si.ng, ls, time))) return Rgb(0.0f);
+    if (scene.occluded(shadow_ray(si.p, si.ng, ls, time), shadow_cache(ls.emitter))) return Rgb(0.0f);
     const float w = (S == Strategy::mis && !ls.delta) ? power_heuristic(ls.pdf, bsdf_pdf) : 1.0f;
     return f_cos * ls.li * (w / ls.pdf);
 }

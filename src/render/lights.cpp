@@ -1,5 +1,6 @@
 #include "render/lights.h"
 
+#include <array>
 #include <cmath>
 
 #include "geometry/spawn.h"
@@ -195,11 +196,19 @@ bool sample_envmap(const Scene& scene, Vec2 u, LightSample& ls) {
 
 }  // namespace
 
+OcclusionCache& shadow_cache(uint32_t index) {
+    // Per thread: each keeps its own neighbouring shading points, and no entry is shared.
+    thread_local std::array<OcclusionCache, 32> caches;
+    return caches[index % caches.size()];
+}
+
 bool sample_light(const Scene& scene, const Vec3& p, float time, float u_select, Vec2 u, LightSample& ls) {
     if (scene.emitters.empty()) return false;
     float select_pdf = 0;
-    const Emitter& e = scene.emitters[scene.emitter_distribution.sample_discrete(u_select, &select_pdf)];
+    const auto chosen = uint32_t(scene.emitter_distribution.sample_discrete(u_select, &select_pdf));
+    const Emitter& e = scene.emitters[chosen];
     ls.pdf = select_pdf;
+    ls.emitter = chosen;
     switch (e.kind) {
         case Emitter::Kind::point: {
             const LightDesc& l = scene.lights[e.index];

@@ -18,7 +18,13 @@ struct LightSample {
     Rgb li{0.0f};        ///< radiance (area, envmap) or irradiance at normal incidence (delta)
     float pdf = 0;       ///< selection probability times solid-angle density (delta: selection only)
     bool delta = false;  ///< point or directional light: no MIS
+    uint32_t emitter = 0;  ///< which of Scene::emitters (its shadow cache: shadow_cache)
 };
+
+/// The calling thread's shadow cache for emitter or light `index`, for
+/// Scene::occluded. Lights whose indices are equal modulo the table's size share an
+/// entry, which costs cache hits, never answers.
+OcclusionCache& shadow_cache(uint32_t index);
 
 /// Samples one emitter of the scene as seen from p at the given time; false if
 /// there is nothing to sample or the sample carries no light.

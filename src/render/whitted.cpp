@@ -5,6 +5,7 @@
 #include "render/bsdf.h"
 #include "render/bsdf_pbr.h"
 #include "render/integrator.h"
+#include "render/lights.h"
 #include "scene/texture.h"
 
 namespace sahara {
@@ -18,7 +19,8 @@ constexpr float kMinBranchWeight = 1e-4f;
 /// Lambert shading from point and directional lights, with hard shadows.
 Rgb direct_lights(const Scene& scene, const SurfaceInteraction& si, const Rgb& albedo, float time) {
     Rgb sum(0.0f);
-    for (const LightDesc& l : scene.lights) {
+    for (uint32_t light = 0; light < scene.lights.size(); ++light) {
+        const LightDesc& l = scene.lights[light];
         Vec3 wi;
         Rgb e;
         float tmax = kInfinity;
@@ -36,7 +38,8 @@ Rgb direct_lights(const Scene& scene, const SurfaceInteraction& si, const Rgb& a
         }
         const float cos = dot(wi, si.ns);
         if (cos <= 0 || dot(wi, si.ng) <= 0) continue;
-        if (scene.occluded(Ray{offset_ray_origin(si.p, si.ng), wi, 0.0f, tmax, time})) continue;
+        if (scene.occluded(Ray{offset_ray_origin(si.p, si.ng), wi, 0.0f, tmax, time}, shadow_cache(light)))
+            continue;
         sum += e * cos;
     }
     return albedo * sum * kInvPi;

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <span>
 #include <string>
 
 #include "base/error.h"
 #include "base/process_usage.h"
+#include "geometry/spawn.h"
 #include "scene/leaf_blocks.inl"
 #include "scene/scene.h"
 
@@ -200,8 +202,61 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
         else if (bytes() > l2_cache_bytes())
             pair_rays_ = PairRays::inside;
     }
+    if (layout_ == BvhLayout::wide8 && uses_tree_) choose_occlusion_order(options.occlusion_order);
     build_cpu_ms_ = process_cpu_ms() - cpu_start;
     build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+namespace {
+
+/// Occlusion rays that choose_occlusion_order traces: from the centroids of up to
+/// `count` triangles spread over the leaf blocks, to either side, in directions from
+/// a fixed hash (the same tree always gets the same order).
+std::vector<Ray> occlusion_sample_rays(std::span<const TriangleBlock4> blocks, size_t count) {
+    std::vector<Ray> rays;
+    if (blocks.empty()) return rays;
+    const size_t step = std::max<size_t>(1, blocks.size() / count);
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    auto uniform = [&h]() {
+        h ^= h >> 33, h *= 0xFF51AFD7ED558CCDull, h ^= h >> 33, h += 0x9E3779B97F4A7C15ull;
+        return float(h >> 40) * 0x1p-24f;
+    };
+    for (size_t b = 0; b < blocks.size(); b += step) {
+        const TriangleBlock4& blk = blocks[b];
+        if ((blk.slot[0] & TriangleBlock4::kOtherKind) || blk.slot[0] == TriangleBlock4::kEmptyLane) continue;
+        const Vec3 a(blk.p[0][0][0], blk.p[0][1][0], blk.p[0][2][0]);
+        const Vec3 e1 = Vec3(blk.p[1][0][0], blk.p[1][1][0], blk.p[1][2][0]) - a;
+        const Vec3 e2 = Vec3(blk.p[2][0][0], blk.p[2][1][0], blk.p[2][2][0]) - a;
+        Vec3 n = normalize(cross(e1, e2));
+        if (!is_finite(n)) continue;
+        if (uniform() < 0.5f) n = -n;
+        // A direction in the hemisphere of n: uniform on the sphere, flipped.
+        const float z = 2.0f * uniform() - 1.0f, phi = 6.2831853f * uniform();
+        const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        Vec3 d(r * std::cos(phi), r * std::sin(phi), z);
+        if (dot(d, n) < 0.0f) d = -d;
+        rays.push_back(Ray{offset_ray_origin(a + (e1 + e2) * (1.0f / 3.0f), n), d});
+    }
+    return rays;
+}
+
+}  // namespace
+
+void Accelerator::choose_occlusion_order(OcclusionOrder order) {
+    wide8_.occlusion_far_first = order == OcclusionOrder::far_first;
+    if (order != OcclusionOrder::automatic) return;
+    // Farthest first sorts the hit children, which slot order does not: it must save
+    // enough nodes and leaf tests to pay for that (docs/performance.md, "Occlusion order").
+    constexpr double kFarFirstMaxWork = 0.75;
+    const std::vector<Ray> rays = occlusion_sample_rays(blocks_, 512);
+    uint64_t work[2] = {0, 0};
+    for (int far = 0; far < 2; ++far) {
+        wide8_.occlusion_far_first = far != 0;
+        TraversalCounters c;
+        for (const Ray& r : rays) occluded_counted(r, c);
+        work[far] = c.nodes_visited + c.prims_tested;
+    }
+    wide8_.occlusion_far_first = double(work[1]) < kFarFirstMaxWork * double(work[0]);
 }
 
 /// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
@@ -370,6 +425,23 @@ bool Accelerator::occluded(const Ray& ray) const {
     // Any-hit traces only read the ray (only closest-hit ones write tmax back), so it
     // is not copied: reading a copy just made waits for its stores to be forwarded.
     return trace<true>(const_cast<Ray&>(ray), h, none);
+}
+
+bool Accelerator::occluded(const Ray& ray, OcclusionCache& cache) const {
+    if (cache.owner == this && cache.block < blocks_.size()) {
+        const TriangleRay tr(ray);  // as the any-hit traversal makes it: the same leaf test
+        float tmax = ray.tmax;
+        Hit h;
+        if (alpha_.empty() ? test_blocks<true, false, false>(ray, tr, cache.block, 4, tmax, h)
+                           : test_blocks<true, true, false>(ray, tr, cache.block, 4, tmax, h))
+            return true;
+    }
+    NoTraversalCounters none;
+    Hit h;
+    if (!trace<true>(const_cast<Ray&>(ray), h, none)) return false;
+    // The pairs layout leaves prim unset: nothing to remember.
+    if (h.prim < blocks_.size()) cache = OcclusionCache{this, h.prim};
+    return true;
 }
 
 bool Accelerator::intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const {

@@ -52,6 +52,14 @@ enum class NodePairing : uint8_t {
     never,
 };
 
+/// In which order occlusion rays on a wide8 tree visit the children a node test hits
+/// (BvhWide::occlusion_far_first).
+enum class OcclusionOrder : uint8_t {
+    automatic,  ///< farthest first when it saves work on sample rays (Accelerator::choose_occlusion_order)
+    slot,       ///< slot order: no sorting, best where an occluder is as likely near as far
+    far_first,  ///< farthest entry distance first: interiors, where the room's shell stops most rays
+};
+
 /// Build choices for an Accelerator.
 struct AcceleratorOptions {
     /// wide8 by default: one AVX step tests eight children; pairs is the plain binary
@@ -82,6 +90,7 @@ struct AcceleratorOptions {
     /// bounds usually hit in the first subtree they enter, so the paired node would never
     /// have been visited: automatic pairing leaves them out.
     NodePairing node_pairing = NodePairing::automatic;
+    OcclusionOrder occlusion_order = OcclusionOrder::automatic;
     /// Keep the binary tree after the block layout has collapsed it (bvh(), for
     /// `sahara bvh` statistics); otherwise its memory is released.
     bool keep_binary_tree = false;
@@ -122,6 +131,9 @@ class Accelerator {
     bool intersect(Ray& ray, Hit& hit) const;
     /// Whether any primitive blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
+    /// occluded() that tests `cache`'s block first and remembers the occluder there
+    /// (one cache per light and thread; same answers as occluded()).
+    bool occluded(const Ray& ray, OcclusionCache& cache) const;
     /// intersect() that also counts node visits and primitive tests into `counters`.
     bool intersect_counted(Ray& ray, Hit& hit, TraversalCounters& counters) const;
     /// occluded() that also counts node visits and primitive tests into `counters`.
@@ -150,6 +162,8 @@ class Accelerator {
     /// Whether rays pair nodes (NodePairing; with NodePairing::automatic only rays from
     /// inside bounds()). The SSE2 path never does.
     bool pairs_nodes() const { return pair_rays_ != PairRays::none; }
+    /// Whether occlusion rays visit hit children farthest first (OcclusionOrder resolved).
+    bool occlusion_far_first() const { return wide8_.occlusion_far_first; }
     BvhLayout layout() const { return layout_; }
     /// The 8-wide tree (empty unless the layout is wide8; a leaf's child index is its first block).
     const Bvh8& bvh8() const { return wide8_; }
@@ -204,6 +218,7 @@ class Accelerator {
     friend struct TraceWideEntry;
     /// Packets over the wide8 tree with the single-ray box and leaf tests (packet_wide8.cpp).
     __attribute__((target("avx2"))) void trace_packet8_avx2(const RayPacket& p, HitPacket& out) const;
+    /// Any hit: hit.prim receives the block index of the occluder (OcclusionCache).
     template <bool kAnyHit, bool kCutouts, bool kAvx>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,
                      Hit& hit) const;
@@ -212,6 +227,8 @@ class Accelerator {
     LeafResult test_blocks_fast(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count,
                                 uint32_t next_first, uint32_t next_count, bool& paired, float& tmax,
                                 Hit& hit) const;
+    /// Resolves OcclusionOrder::automatic: traces sample occlusion rays in both orders.
+    void choose_occlusion_order(OcclusionOrder order);
     template <int N>
     void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
                           const std::vector<TriangleVerts>& tris);

@@ -94,6 +94,8 @@ __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(
         const int best = nearest_lane(mask, t);
         tmax = t[best];
         hit = Hit{t[best], (best < 4 ? b0 : b1)->slot[best & 3], u[best], v[best]};
+    } else {
+        hit.prim = uint32_t(((mask & 0xF) ? b0 : b1) - blocks_.data());  // for OcclusionCache
     }
     return LeafResult::hit;
 }
@@ -126,7 +128,10 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
         if constexpr (kCutouts)
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
-            if constexpr (kAnyHit) return true;
+            if constexpr (kAnyHit) {
+                hit.prim = b + ((mask & 0xF) ? 0 : 1);  // the occluder's block, for OcclusionCache
+                return true;
+            }
             const int best = nearest_lane(mask, t);
             tmax = t[best];
             hit = Hit{t[best], block_slot(b, best), u[best], v[best]};
@@ -136,7 +141,10 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             const uint32_t id =
                 others_[block_slot(b, __builtin_ctz(unsigned(m))) & ~TriangleBlock4::kOtherKind];
             if constexpr (kAnyHit) {
-                if (occluded_other(ray, id, tmax)) return true;
+                if (occluded_other(ray, id, tmax)) {
+                    hit.prim = b + uint32_t(__builtin_ctz(unsigned(m)) >> 2);
+                    return true;
+                }
             } else if (const std::optional<ShapeHit> h = intersect_other(ray, id, tmax)) {
                 tmax = h->t;
                 hit = Hit{h->t, id, 0.0f, 0.0f};  // a quadric's part: Scene::interact (Quadric::hit_at)

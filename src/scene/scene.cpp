@@ -89,6 +89,13 @@ bool Scene::occluded(const Ray& ray) const {
     return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
 }
 
+bool Scene::occluded(const Ray& ray, OcclusionCache& cache) const {
+    count_ray(RayKind::shadow);
+    if (accel_ && accel_->occluded(ray, cache)) return true;
+    if (instances_ && instances_->occluded(ray)) return true;
+    return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
+}
+
 uint64_t Scene::traversal_steps(const Ray& ray) const {
     if (!accel_) return 0;
     TraversalCounters counters;

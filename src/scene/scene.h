@@ -106,6 +106,10 @@ class Scene {
     void intersect_packet(RayPacket& packet, HitPacket& hits) const;
     /// Whether anything blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
+    /// occluded() that first tests the primitive that stopped the last ray of the same
+    /// cache (one per light and thread, geometry/hit.h); the answers are the same.
+    /// Instanced occluders are not remembered.
+    bool occluded(const Ray& ray, OcclusionCache& cache) const;
     /// Shading data for an accepted hit.
     SurfaceInteraction interact(const Ray& ray, const Hit& hit) const;
 

@@ -58,6 +58,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
         hit = best;
         ray.tmax = best.t;
     }
+    if (found && kAnyHit) hit.prim = best.prim;  // the occluder's block (OcclusionCache)
     return found;
 }
 

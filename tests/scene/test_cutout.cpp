@@ -410,3 +410,25 @@ TEST_CASE("cut-outs: glTF COLOR_0 alpha scales MASK and BLEND alpha and OPAQUE i
     for (Vec2 c : square_centres()) CHECK(opaque.occluded(ray_through({0.5f, 0.5f, 1.0f}, c)));
     fs::remove_all(dir);
 }
+
+TEST_CASE("cut-outs: the shadow cache keeps the alpha test") {
+    const Scene scene = build_scene(checker_scene(true));
+    const Accelerator accel(scene);
+    REQUIRE(accel.has_cutouts());
+    SimdGuard guard;
+    for (SimdPath path : simd_paths()) {
+        force_simd_path(path);
+        OcclusionCache cache;
+        int wrong = 0, blocked = 0;
+        // Straight down through the square centres in row order: opaque and transparent
+        // squares alternate, often within one cached block.
+        for (const Vec2 q : square_centres()) {
+            const Ray r{{q.x, q.y, 1.0f}, {0, 0, -1}, 0.0f, 2.0f};
+            const bool want = !checker_transparent(q.x, q.y);
+            wrong += int(accel.occluded(r, cache) != want) + int(accel.occluded(r) != want);
+            blocked += int(want);
+        }
+        CHECK(wrong == 0);
+        CHECK(blocked == kChecker * kChecker / 2);
+    }
+}

@@ -156,6 +156,11 @@ TEST_CASE("instances: shading normals follow the inverse transpose under non-uni
     // Occlusion sees the instance too.
     CHECK(s.occluded(Ray{{3, 3, 0.2f}, {-1, -1, 0}, 0, 10}));
     CHECK_FALSE(s.occluded(Ray{{3, 3, 0.2f}, {-1, -1, 0}, 0, 1}));
+    // And so does the shadow cache's form, which remembers no instanced occluder.
+    OcclusionCache cache;
+    CHECK(s.occluded(Ray{{3, 3, 0.2f}, {-1, -1, 0}, 0, 10}, cache));
+    CHECK(cache.owner == nullptr);
+    CHECK_FALSE(s.occluded(Ray{{3, 3, 0.2f}, {-1, -1, 0}, 0, 1}, cache));
 }
 
 TEST_CASE("instances: the scene format places named meshes and nested instances") {

@@ -171,3 +171,22 @@ TEST_CASE("one-sided: a glTF quad with doubleSided false renders from the front 
         }
     }
 }
+
+TEST_CASE("one-sided: the shadow cache does not let a back face block the next ray") {
+    const Scene scene = build_scene(one_sided_scene(false));
+    const Accelerator accel(scene);
+    for (SimdPath path : runnable_simd_paths()) {
+        force_simd_path(path);
+        OcclusionCache cache;
+        // From between the grids downwards: the one-sided grid's front face blocks the ray
+        // and fills the cache with its block.
+        REQUIRE(accel.occluded(Ray{{0.3f, 0.3f, 0.5f}, {0, 0, -1}}, cache));
+        REQUIRE(cache.owner == &accel);
+        // From below upwards through the same block's back face, stopping short of the
+        // double-sided grid: nothing blocks it, cached block or not.
+        const Ray up{{0.3f, 0.3f, -0.5f}, {0, 0, 1}, 0.0f, 1.2f};
+        CHECK_FALSE(accel.occluded(up));
+        CHECK_FALSE(accel.occluded(up, cache));
+    }
+    force_simd_path(best_simd_path());
+}

@@ -1,0 +1,130 @@
+// Occlusion rays on a generated interior: the shadow cache (OcclusionCache) and the
+// any-hit child order (OcclusionOrder) change what the traversal costs, never its answers.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "accel/simd_path.h"
+#include "mesh_fixtures.h"
+#include "scene/accelerator.h"
+#include "scene/scene.h"
+
+using namespace sahara;
+using namespace sahara::test;
+
+namespace {
+
+/// An axis-aligned box as 12 triangles.
+TriangleMesh box_mesh(Vec3 lo, Vec3 hi) {
+    TriangleMesh m;
+    m.name = "box";
+    for (int k = 0; k < 8; ++k) m.positions.push_back({k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
+    m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    return m;
+}
+
+/// A room 10 x 8 x 3 of slab walls with a window in the wall at y = 8, furnished with
+/// rows of small boxes (chairs, books): an enclosure whose shell stops most rays, and
+/// clutter around their origins that rarely does.
+SceneDesc room() {
+    SceneDesc d;
+    d.materials.push_back(MaterialDesc{});
+    d.meshes.push_back(box_mesh({0, 0, -0.2f}, {10, 8, 0}));    // floor
+    d.meshes.push_back(box_mesh({0, 0, 3}, {10, 8, 3.2f}));     // ceiling
+    d.meshes.push_back(box_mesh({-0.2f, 0, 0}, {0, 8, 3}));     // walls x = 0, x = 10, y = 0
+    d.meshes.push_back(box_mesh({10, 0, 0}, {10.2f, 8, 3}));
+    d.meshes.push_back(box_mesh({0, -0.2f, 0}, {10, 0, 3}));
+    // Wall y = 8 around a window x in [3, 6], z in [1, 2.5].
+    d.meshes.push_back(box_mesh({0, 8, 0}, {3, 8.2f, 3}));
+    d.meshes.push_back(box_mesh({6, 8, 0}, {10, 8.2f, 3}));
+    d.meshes.push_back(box_mesh({3, 8, 0}, {6, 8.2f, 1}));
+    d.meshes.push_back(box_mesh({3, 8, 2.5f}, {6, 8.2f, 3}));
+    for (int j = 0; j < 20; ++j)
+        for (int i = 0; i < 25; ++i) {
+            const Vec3 lo{0.2f + 0.4f * float(i), 0.2f + 0.38f * float(j), 0.0f};
+            d.meshes.push_back(box_mesh(lo, lo + Vec3(0.1f, 0.1f, 0.1f + 0.05f * float((i * 7 + j * 3) % 5))));
+        }
+    return d;
+}
+
+/// Rays from a grid of floor points in row order (as pixels are traced) towards a low
+/// sun shining in through the window.
+std::vector<Ray> sun_rays() {
+    const Vec3 to_sun = normalize(Vec3(0.1f, 1.0f, 0.45f));
+    std::vector<Ray> rays;
+    for (int j = 0; j < 40; ++j)
+        for (int i = 0; i < 50; ++i)
+            rays.push_back(Ray{{0.1f + 0.2f * float(i), 0.1f + 0.2f * float(j), 1e-3f}, to_sun});
+    return rays;
+}
+
+/// Restores automatic SIMD path selection when a test ends.
+struct SimdGuard {
+    ~SimdGuard() { force_simd_path(best_simd_path()); }
+};
+
+}  // namespace
+
+TEST_CASE("occlusion cache and child order: brute-force answers on a generated room on every SIMD path") {
+    SimdGuard guard;
+    const Scene scene = build_scene(room());
+    const std::vector<Ray> rays = sun_rays();
+    for (OcclusionOrder order : {OcclusionOrder::slot, OcclusionOrder::far_first}) {
+        AcceleratorOptions o;
+        o.occlusion_order = order;
+        const Accelerator accel(scene, o);
+        CHECK(accel.occlusion_far_first() == (order == OcclusionOrder::far_first));
+        for (SimdPath path : runnable_simd_paths()) {
+            force_simd_path(path);
+            OcclusionCache cache;
+            int wrong = 0, occluded = 0, served = 0;
+            for (const Ray& r : rays) {
+                Ray b = r;
+                Hit h;
+                const bool want = accel.intersect_brute_force(b, h);
+                const OcclusionCache before = cache;
+                const bool cached = accel.occluded(r, cache);
+                wrong += int(accel.occluded(r) != want) + int(cached != want);
+                occluded += int(want);
+                // The cache served the ray when it kept its block and the ray is blocked.
+                served += int(cached && before.owner == &accel && before.block == cache.block);
+            }
+            CHECK(wrong == 0);
+            // Some rays leave through the window, most are stopped, mostly by the block
+            // that stopped the ray before.
+            CHECK(occluded > int(rays.size()) / 2);
+            CHECK(occluded < int(rays.size()));
+            CHECK(served > occluded / 2);
+        }
+    }
+}
+
+TEST_CASE("occlusion cache: another accelerator's or an out-of-range entry is ignored") {
+    const Scene scene = build_scene(room());
+    const Accelerator a(scene), b(scene);
+    const Ray up{{5, 4, 1}, {0, 0, 1}};
+    OcclusionCache cache;
+    REQUIRE(a.occluded(up, cache));
+    CHECK(cache.owner == &a);
+    // b ignores a's entry, answers right and takes the cache over.
+    CHECK(b.occluded(up, cache));
+    CHECK(cache.owner == &b);
+    // An entry past the blocks is not read; the ray through the window is free.
+    cache.block = 0xFFFFFFF0u;
+    const Ray out{{4.5f, 7, 1.7f}, {0, 1, 0}};
+    CHECK_FALSE(b.occluded(out, cache));
+    CHECK(cache.block == 0xFFFFFFF0u);  // a free ray leaves the cache as it was
+}
+
+TEST_CASE("occlusion order: automatic picks farthest first in a room and slot order on open ground") {
+    const Accelerator room_accel(build_scene(room()));
+    CHECK(room_accel.occlusion_far_first());
+    // Nothing stops the sample rays of a flat grid: sorting would buy nothing.
+    SceneDesc d;
+    d.materials.push_back(MaterialDesc{});
+    d.meshes.push_back(unit_grid(32, 0.0f, 0));
+    const Accelerator ground_accel(build_scene(d));
+    CHECK_FALSE(ground_accel.occlusion_far_first());
+}
