@@ -13,6 +13,8 @@
 #include <new>
 #include <span>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "base/bvh_choice.h"
@@ -70,6 +72,57 @@ struct AlignedAllocator {
     }
     void deallocate(T* p, size_t n) { ::operator delete(p, std::align_val_t(alignment(n * sizeof(T)))); }
     friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
+};
+
+/// AlignedAllocator whose resize() default-initialises (leaves trivial elements
+/// unwritten): for arrays that are filled right after they are sized, where value
+/// initialisation would write every byte twice.
+template <class T, size_t Align>
+struct FillLaterAllocator : AlignedAllocator<T, Align> {
+    template <class U>
+    struct rebind {
+        using other = FillLaterAllocator<U, Align>;
+    };
+    FillLaterAllocator() = default;
+    template <class U>
+    FillLaterAllocator(const FillLaterAllocator<U, Align>&) {}
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// Uninitialised build scratch of `n` trivially copyable T (aligned and huge-page
+/// advised like AlignedAllocator's arrays): the builders' big temporaries are written
+/// before they are read, and with 4 KiB pages a fresh array costs a page fault every
+/// 4 KiB, a large share of a build.
+template <class T>
+class BuildArray {
+   public:
+    BuildArray() = default;
+    explicit BuildArray(size_t n) : p_(n ? Alloc().allocate(n) : nullptr), n_(n) {}
+    BuildArray(BuildArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), n_(std::exchange(o.n_, 0)) {}
+    BuildArray& operator=(BuildArray&& o) noexcept {
+        std::swap(p_, o.p_);
+        std::swap(n_, o.n_);
+        return *this;
+    }
+    ~BuildArray() {
+        if (p_) Alloc().deallocate(p_, n_);
+    }
+    T* get() const { return p_; }
+    T& operator[](size_t i) const { return p_[i]; }
+    size_t size() const { return n_; }
+
+   private:
+    static_assert(std::is_trivially_copyable_v<T>);
+    using Alloc = AlignedAllocator<T, 64>;
+    T* p_ = nullptr;
+    size_t n_ = 0;
 };
 
 /// The hierarchy. An empty Bvh (no nodes) has no primitives.

@@ -154,10 +154,10 @@ class BinnedBuild {
         out_.nodes.clear();
         out_.prim_indices.assign(n_, 0);
         if (n_ == 0) return;
-        refs_.reset(new PrimRef[n_]);
-        nodes_.reset(new BvhNode[2 * size_t(n_)]);
+        refs_ = BuildArray<PrimRef>(n_);
+        nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
-        if (n_ > kParallelScanThreshold) scratch_.reset(new PrimRef[n_]);
+        if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
 #pragma omp parallel
 #pragma omp single
         {
@@ -532,8 +532,8 @@ class BinnedBuild {
     const BvhBuildParams params_;
     Bvh& out_;
     const uint32_t n_;
-    std::unique_ptr<PrimRef[]> refs_, scratch_;
-    std::unique_ptr<BvhNode[]> nodes_;
+    BuildArray<PrimRef> refs_, scratch_;
+    BuildArray<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
 };
 

@@ -31,6 +31,8 @@
 namespace sahara {
 
 class Scene;
+struct TriangleSoup;
+struct SlotIds;
 struct RayPacket;
 struct HitPacket;
 /// One instruction set's traversal entry point for one form (trace_wide.inl).
@@ -212,9 +214,11 @@ class Accelerator {
     LeafResult test_blocks_fast(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count,
                                 uint32_t next_first, uint32_t next_count, bool& paired, float& tmax,
                                 Hit& hit) const;
+    /// The constructor's work: primitive boxes, tree, leaf data.
+    void build(const Scene& scene, const AcceleratorOptions& options);
+    void fill_slots(const SlotIds& ids, const TriangleSoup& soup);
     template <int N>
-    void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
-                          const std::vector<TriangleVerts>& tris);
+    void make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool has_others, const TriangleSoup& soup);
     /// Sphere, box or quadric `id` over (ray.tmin, tmax): the shape's intersect() or occluded().
     std::optional<ShapeHit> intersect_other(const Ray& ray, uint32_t id, float tmax) const;
     bool occluded_other(const Ray& ray, uint32_t id, float tmax) const;
@@ -247,7 +251,7 @@ class Accelerator {
     Bvh bvh_;         ///< the binary tree (see bvh())
     BvhPairs pairs_;  ///< the same tree in pair layout (layout_ == pairs)
     Bvh8 wide8_;      ///< the same tree collapsed to 8-wide nodes (wide8 layout)
-    std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>>
+    std::vector<TriangleBlock4, FillLaterAllocator<TriangleBlock4, 64>>
         blocks_;  ///< wide8 layout: each leaf's slots in blocks of four
     BvhLayout layout_ = kDefaultBvhLayout;
     /// Which closest-hit rays pair nodes (NodePairing resolved for this tree).
