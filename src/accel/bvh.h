@@ -96,15 +96,22 @@ struct FillLaterAllocator : AlignedAllocator<T, Align> {
     }
 };
 
-/// Uninitialised build scratch of `n` trivially copyable T (aligned and huge-page
-/// advised like AlignedAllocator's arrays): the builders' big temporaries are written
-/// before they are read, and with 4 KiB pages a fresh array costs a page fault every
-/// 4 KiB, a large share of a build.
+/// Uninitialised build scratch of `n` trivially copyable T: the builders' big
+/// temporaries are written before they are read. From kBuildHugeMinBytes up the
+/// storage is whole 2 MiB pages, marked for transparent huge pages: with 4 KiB pages a
+/// fresh array costs a page fault every 4 KiB, a large share of a build, and the few
+/// bytes of a last huge page past the end cost less to clear than those faults.
+inline constexpr size_t kBuildHugeMinBytes = size_t(1) << 20;
+
 template <class T>
 class BuildArray {
    public:
     BuildArray() = default;
-    explicit BuildArray(size_t n) : p_(n ? Alloc().allocate(n) : nullptr), n_(n) {}
+    explicit BuildArray(size_t n) : n_(n) {
+        if (!n) return;
+        p_ = static_cast<T*>(::operator new(reserved(n), std::align_val_t(alignment(n))));
+        if (alignment(n) == kHugePageBytes) advise_huge_pages(p_, reserved(n));
+    }
     BuildArray(BuildArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), n_(std::exchange(o.n_, 0)) {}
     BuildArray& operator=(BuildArray&& o) noexcept {
         std::swap(p_, o.p_);
@@ -112,7 +119,7 @@ class BuildArray {
         return *this;
     }
     ~BuildArray() {
-        if (p_) Alloc().deallocate(p_, n_);
+        if (p_) ::operator delete(p_, std::align_val_t(alignment(n_)));
     }
     T* get() const { return p_; }
     T& operator[](size_t i) const { return p_[i]; }
@@ -120,7 +127,11 @@ class BuildArray {
 
    private:
     static_assert(std::is_trivially_copyable_v<T>);
-    using Alloc = AlignedAllocator<T, 64>;
+    static size_t alignment(size_t n) { return n * sizeof(T) >= kBuildHugeMinBytes ? kHugePageBytes : 64; }
+    static size_t reserved(size_t n) {
+        const size_t a = alignment(n);
+        return (n * sizeof(T) + a - 1) / a * a;
+    }
     T* p_ = nullptr;
     size_t n_ = 0;
 };

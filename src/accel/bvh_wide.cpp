@@ -89,6 +89,34 @@ class CollapsePlan {
         combine(x);
     }
 
+    /// opened[k]: the least cost of both children sharing k slots of the parent's node, the
+    /// left child's share in plan.left_slots[k] (the first best). Branch-free: which share
+    /// wins is data-dependent. Two leaves cost the same in any slots, so j = 1 wins.
+    static Costs open_costs(const Costs& left, const Costs& right, bool two_leaves, Choice& plan) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        Costs opened;
+        opened.fill(inf);
+        if (two_leaves) {
+            const double sum = left[1] + right[1];
+            if (!(sum < inf)) return opened;
+            for (int k = 2; k <= N; ++k) opened[k] = sum, plan.left_slots[k] = 1;
+            return opened;
+        }
+        for (int k = 2; k <= N; ++k) {
+            double best = inf;
+            int best_j = 0;
+            for (int j = 1; j < k; ++j) {
+                const double c = left[j] + right[k - j];
+                const bool lower = c < best;
+                best = lower ? c : best;
+                best_j = lower ? j : best_j;
+            }
+            opened[k] = best;
+            plan.left_slots[k] = uint8_t(best_j);
+        }
+        return opened;
+    }
+
     /// The collapse's dynamic programme at node x, its children solved.
     void combine(uint32_t x) {
         constexpr double inf = std::numeric_limits<double>::infinity();
@@ -109,15 +137,9 @@ class CollapsePlan {
         range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
         const Costs& left = cost_[node.index];
         const Costs& right = cost_[node.index + 1];
-        // opened[k]: both children share k slots of the parent's node.
-        Costs opened;
-        opened.fill(inf);
-        for (int k = 2; k <= N; ++k)
-            for (int j = 1; j < k; ++j)
-                if (left[j] + right[k - j] < opened[k]) {
-                    opened[k] = left[j] + right[k - j];
-                    plan.left_slots[k] = uint8_t(j);
-                }
+        const Costs opened = open_costs(left, right, bvh_.nodes[node.index].is_leaf() &&
+                                                         bvh_.nodes[node.index + 1].is_leaf(),
+                                        plan);
         // As one child, x is a node of its own (its area plus its children in N
         // slots) or, when small enough, a leaf.
         const double as_node = area + opened[N];
