@@ -10,6 +10,7 @@
 /// primitives are the slots prim_indices[index .. index + count).
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <new>
 #include <span>
 #include <string_view>
@@ -43,10 +44,14 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");
 
-/// Allocations of at least this size are 2 MiB aligned and marked for
-/// transparent huge pages: traversal jumps across node and leaf arrays of
-/// several MiB, and with 4 KiB pages nearly every node visit also misses the TLB.
+/// Arrays of at least kHugePageMinBytes are 2 MiB aligned, rounded up to whole 2 MiB
+/// pages and marked for transparent huge pages: traversal jumps across node and leaf
+/// arrays of several MiB, and with 4 KiB pages nearly every node visit also misses the
+/// TLB; and a fresh array on 4 KiB pages costs a page fault every 4 KiB as it is
+/// written, a large share of an acceleration build (clearing the unused end of the
+/// last huge page costs less).
 inline constexpr size_t kHugePageBytes = size_t(2) << 20;
+inline constexpr size_t kHugePageMinBytes = size_t(1) << 20;
 /// Marks [p, p + bytes) for transparent huge pages (a hint; no effect where unsupported).
 void advise_huge_pages(void* p, size_t bytes);
 
@@ -62,12 +67,18 @@ struct AlignedAllocator {
     template <class U>
     AlignedAllocator(const AlignedAllocator<U, Align>&) {}
     static constexpr size_t alignment(size_t bytes) {
-        return bytes >= kHugePageBytes && Align < kHugePageBytes ? kHugePageBytes : Align;
+        return bytes >= kHugePageMinBytes && Align < kHugePageBytes ? kHugePageBytes : Align;
+    }
+    /// Bytes actually reserved for `bytes`: whole huge pages when huge-page aligned.
+    static constexpr size_t reserved(size_t bytes) {
+        return alignment(bytes) == kHugePageBytes ? (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes
+                                                  : bytes;
     }
     T* allocate(size_t n) {
+        if (n > std::numeric_limits<size_t>::max() / 4 / sizeof(T)) throw std::bad_array_new_length();
         const size_t bytes = n * sizeof(T);
-        void* p = ::operator new(bytes, std::align_val_t(alignment(bytes)));
-        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, bytes);
+        void* p = ::operator new(reserved(bytes), std::align_val_t(alignment(bytes)));
+        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, reserved(bytes));
         return static_cast<T*>(p);
     }
     void deallocate(T* p, size_t n) { ::operator delete(p, std::align_val_t(alignment(n * sizeof(T)))); }
@@ -96,22 +107,14 @@ struct FillLaterAllocator : AlignedAllocator<T, Align> {
     }
 };
 
-/// Uninitialised build scratch of `n` trivially copyable T: the builders' big
-/// temporaries are written before they are read. From kBuildHugeMinBytes up the
-/// storage is whole 2 MiB pages, marked for transparent huge pages: with 4 KiB pages a
-/// fresh array costs a page fault every 4 KiB, a large share of a build, and the few
-/// bytes of a last huge page past the end cost less to clear than those faults.
-inline constexpr size_t kBuildHugeMinBytes = size_t(1) << 20;
-
+/// Uninitialised build scratch of `n` trivially copyable T (aligned and on huge pages
+/// like AlignedAllocator's arrays): the builders' big temporaries are written before
+/// they are read, so zero-filling them (std::vector) would write every byte twice.
 template <class T>
 class BuildArray {
    public:
     BuildArray() = default;
-    explicit BuildArray(size_t n) : n_(n) {
-        if (!n) return;
-        p_ = static_cast<T*>(::operator new(reserved(n), std::align_val_t(alignment(n))));
-        if (alignment(n) == kHugePageBytes) advise_huge_pages(p_, reserved(n));
-    }
+    explicit BuildArray(size_t n) : p_(n ? Alloc().allocate(n) : nullptr), n_(n) {}
     BuildArray(BuildArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), n_(std::exchange(o.n_, 0)) {}
     BuildArray& operator=(BuildArray&& o) noexcept {
         std::swap(p_, o.p_);
@@ -119,7 +122,7 @@ class BuildArray {
         return *this;
     }
     ~BuildArray() {
-        if (p_) ::operator delete(p_, std::align_val_t(alignment(n_)));
+        if (p_) Alloc().deallocate(p_, n_);
     }
     T* get() const { return p_; }
     T& operator[](size_t i) const { return p_[i]; }
@@ -127,11 +130,7 @@ class BuildArray {
 
    private:
     static_assert(std::is_trivially_copyable_v<T>);
-    static size_t alignment(size_t n) { return n * sizeof(T) >= kBuildHugeMinBytes ? kHugePageBytes : 64; }
-    static size_t reserved(size_t n) {
-        const size_t a = alignment(n);
-        return (n * sizeof(T) + a - 1) / a * a;
-    }
+    using Alloc = AlignedAllocator<T, 64>;
     T* p_ = nullptr;
     size_t n_ = 0;
 };
