@@ -71,8 +71,9 @@ struct AlignedAllocator {
     }
     /// Bytes actually reserved for `bytes`: whole huge pages when huge-page aligned.
     static constexpr size_t reserved(size_t bytes) {
-        return alignment(bytes) == kHugePageBytes ? (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes
-                                                  : bytes;
+        return alignment(bytes) == kHugePageBytes
+                   ? (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes
+                   : bytes;
     }
     T* allocate(size_t n) {
         if (n > std::numeric_limits<size_t>::max() / 4 / sizeof(T)) throw std::bad_array_new_length();

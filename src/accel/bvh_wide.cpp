@@ -137,9 +137,8 @@ class CollapsePlan {
         range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
         const Costs& left = cost_[node.index];
         const Costs& right = cost_[node.index + 1];
-        const Costs opened = open_costs(left, right, bvh_.nodes[node.index].is_leaf() &&
-                                                         bvh_.nodes[node.index + 1].is_leaf(),
-                                        plan);
+        const Costs opened = open_costs(
+            left, right, bvh_.nodes[node.index].is_leaf() && bvh_.nodes[node.index + 1].is_leaf(), plan);
         // As one child, x is a node of its own (its area plus its children in N
         // slots) or, when small enough, a leaf.
         const double as_node = area + opened[N];

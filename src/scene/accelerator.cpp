@@ -247,7 +247,8 @@ void Accelerator::fill_slots(const SlotIds& ids, const TriangleSoup& soup) {
 #pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
     for (size_t s = 0; s < slots; ++s) {
         const uint32_t id = ids[s];
-        slots_[s] = Slot{prim_kind(id) == PrimKind::triangle ? triangle_verts(soup, id) : TriangleVerts{}, id};
+        slots_[s] =
+            Slot{prim_kind(id) == PrimKind::triangle ? triangle_verts(soup, id) : TriangleVerts{}, id};
     }
 }
 
