@@ -10,9 +10,12 @@
 /// primitives are the slots prim_indices[index .. index + count).
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <new>
 #include <span>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "base/bvh_choice.h"
@@ -41,10 +44,14 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 32, "two nodes per cache line");
 
-/// Allocations of at least this size are 2 MiB aligned and marked for
-/// transparent huge pages: traversal jumps across node and leaf arrays of
-/// several MiB, and with 4 KiB pages nearly every node visit also misses the TLB.
+/// Arrays of at least kHugePageMinBytes are 2 MiB aligned, rounded up to whole 2 MiB
+/// pages and marked for transparent huge pages: traversal jumps across node and leaf
+/// arrays of several MiB, and with 4 KiB pages nearly every node visit also misses the
+/// TLB; and a fresh array on 4 KiB pages costs a page fault every 4 KiB as it is
+/// written, a large share of an acceleration build (clearing the unused end of the
+/// last huge page costs less).
 inline constexpr size_t kHugePageBytes = size_t(2) << 20;
+inline constexpr size_t kHugePageMinBytes = size_t(1) << 20;
 /// Marks [p, p + bytes) for transparent huge pages (a hint; no effect where unsupported).
 void advise_huge_pages(void* p, size_t bytes);
 
@@ -60,16 +67,73 @@ struct AlignedAllocator {
     template <class U>
     AlignedAllocator(const AlignedAllocator<U, Align>&) {}
     static constexpr size_t alignment(size_t bytes) {
-        return bytes >= kHugePageBytes && Align < kHugePageBytes ? kHugePageBytes : Align;
+        return bytes >= kHugePageMinBytes && Align < kHugePageBytes ? kHugePageBytes : Align;
+    }
+    /// Bytes actually reserved for `bytes`: whole huge pages when huge-page aligned.
+    static constexpr size_t reserved(size_t bytes) {
+        return alignment(bytes) == kHugePageBytes
+                   ? (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes
+                   : bytes;
     }
     T* allocate(size_t n) {
+        if (n > std::numeric_limits<size_t>::max() / 4 / sizeof(T)) throw std::bad_array_new_length();
         const size_t bytes = n * sizeof(T);
-        void* p = ::operator new(bytes, std::align_val_t(alignment(bytes)));
-        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, bytes);
+        void* p = ::operator new(reserved(bytes), std::align_val_t(alignment(bytes)));
+        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, reserved(bytes));
         return static_cast<T*>(p);
     }
     void deallocate(T* p, size_t n) { ::operator delete(p, std::align_val_t(alignment(n * sizeof(T)))); }
     friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
+};
+
+/// AlignedAllocator whose resize() default-initialises (leaves trivial elements
+/// unwritten): for arrays that are filled right after they are sized, where value
+/// initialisation would write every byte twice.
+template <class T, size_t Align>
+struct FillLaterAllocator : AlignedAllocator<T, Align> {
+    template <class U>
+    struct rebind {
+        using other = FillLaterAllocator<U, Align>;
+    };
+    FillLaterAllocator() = default;
+    template <class U>
+    FillLaterAllocator(const FillLaterAllocator<U, Align>&) {}
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// Uninitialised build scratch of `n` trivially copyable T (aligned and on huge pages
+/// like AlignedAllocator's arrays): the builders' big temporaries are written before
+/// they are read, so zero-filling them (std::vector) would write every byte twice.
+template <class T>
+class BuildArray {
+   public:
+    BuildArray() = default;
+    explicit BuildArray(size_t n) : p_(n ? Alloc().allocate(n) : nullptr), n_(n) {}
+    BuildArray(BuildArray&& o) noexcept : p_(std::exchange(o.p_, nullptr)), n_(std::exchange(o.n_, 0)) {}
+    BuildArray& operator=(BuildArray&& o) noexcept {
+        std::swap(p_, o.p_);
+        std::swap(n_, o.n_);
+        return *this;
+    }
+    ~BuildArray() {
+        if (p_) Alloc().deallocate(p_, n_);
+    }
+    T* get() const { return p_; }
+    T& operator[](size_t i) const { return p_[i]; }
+    size_t size() const { return n_; }
+
+   private:
+    static_assert(std::is_trivially_copyable_v<T>);
+    using Alloc = AlignedAllocator<T, 64>;
+    T* p_ = nullptr;
+    size_t n_ = 0;
 };
 
 /// The hierarchy. An empty Bvh (no nodes) has no primitives.

@@ -36,34 +36,6 @@ using build::for_chunks;
 using build::kParallelScanThreshold;
 using build::kScanChunks;
 
-/// The build's own arrays (primitive records, node regions), uninitialised, on huge pages
-/// where they are large: every level of the build streams through the records, and with
-/// 4 KiB pages the first touch of every page is a fault.
-template <class T>
-class BuildBuffer {
-   public:
-    BuildBuffer() = default;
-    BuildBuffer(const BuildBuffer&) = delete;
-    BuildBuffer& operator=(const BuildBuffer&) = delete;
-    ~BuildBuffer() { release(); }
-    void allocate(size_t n) {
-        release();
-        data_ = Alloc().allocate(n);  // every element is written before it is read
-        size_ = n;
-    }
-    T* get() const { return data_; }
-    T& operator[](size_t i) const { return data_[i]; }
-
-   private:
-    using Alloc = AlignedAllocator<T, 64>;
-    void release() {
-        if (data_) Alloc().deallocate(data_, size_);
-        data_ = nullptr;
-    }
-    T* data_ = nullptr;
-    size_t size_ = 0;
-};
-
 /// A node's work item: its primitives, box and centroid bounds, and the buffer that
 /// holds the primitives (a parallel partition moves them to the other buffer).
 struct Range {
@@ -81,10 +53,10 @@ class BinnedBuild {
         out_.nodes.clear();
         out_.prim_indices.assign(n_, 0);
         if (n_ == 0) return;
-        refs_.allocate(n_);
-        nodes_.allocate(2 * size_t(n_));
+        refs_ = BuildArray<PrimRef>(n_);
+        nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
-        if (n_ > kParallelScanThreshold) scratch_.allocate(n_);
+        if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
 #pragma omp parallel
 #pragma omp single
         {
@@ -404,8 +376,8 @@ class BinnedBuild {
     const BvhBuildParams params_;
     Bvh& out_;
     const uint32_t n_;
-    BuildBuffer<PrimRef> refs_, scratch_;
-    BuildBuffer<BvhNode> nodes_;
+    BuildArray<PrimRef> refs_, scratch_;
+    BuildArray<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
 };
 

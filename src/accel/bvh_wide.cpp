@@ -30,49 +30,16 @@ template <int N>
 class CollapsePlan {
    public:
     CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
-        : bvh_(bvh), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
-        constexpr double inf = std::numeric_limits<double>::infinity();
-        std::vector<Costs> cost(bvh.nodes.size());  // [x][k]: least cost of subtree x in k slots
-        // Children follow their parent in the canonical (depth-first) order.
-        for (size_t x = bvh.nodes.size(); x-- > 0;) {
-            const BvhNode& node = bvh.nodes[x];
-            const double area = double(half_area(node));
-            Costs& f = cost[x];
-            Choice& plan = plan_[x];
-            if (node.is_leaf()) {
-                range_[x] = {node.index, node.count};
-                f.fill(opt.block_cost * area * double(blocks(node.count)));
-                continue;
-            }
-            const Range& l = range_[node.index];
-            const Range& r = range_[node.index + 1];
-            // A subtree whose primitives are contiguous slots may become one leaf.
-            const bool contiguous = l.first != kNoNode && r.first == l.first + l.count;
-            range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
-            const Costs& left = cost[node.index];
-            const Costs& right = cost[node.index + 1];
-            // opened[k]: both children share k slots of the parent's node.
-            Costs opened;
-            opened.fill(inf);
-            for (int k = 2; k <= N; ++k)
-                for (int j = 1; j < k; ++j)
-                    if (left[j] + right[k - j] < opened[k]) {
-                        opened[k] = left[j] + right[k - j];
-                        plan.left_slots[k] = uint8_t(j);
-                    }
-            // As one child, x is a node of its own (its area plus its children in N
-            // slots) or, when small enough, a leaf.
-            const double as_node = area + opened[N];
-            const double as_leaf = contiguous && range_[x].count <= opt.merge_leaves_up_to
-                                       ? opt.block_cost * area * double(blocks(range_[x].count))
-                                       : inf;
-            plan.leaf = as_leaf < as_node;
-            f[1] = std::min(as_node, as_leaf);
-            for (int k = 2; k <= N; ++k) {
-                plan.open[k] = opened[k] < f[1];
-                f[k] = plan.open[k] ? opened[k] : f[1];
-            }
+        : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
+        // Each node's costs depend only on its children's, so the subtrees below the
+        // top levels are independent tasks; the result does not depend on the threads.
+        if (bvh.nodes.size() < kParallelNodes) {
+            solve(0, kTaskLevels);
+            return;
         }
+#pragma omp parallel
+#pragma omp single
+        solve(0, 0);
     }
 
     /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).
@@ -94,13 +61,98 @@ class CollapsePlan {
    private:
     using Costs = std::array<double, N + 1>;  ///< [k]: least cost of a subtree in k slots
     struct Choice {
-        std::array<uint8_t, N + 1> left_slots{};  ///< [k]: slots of the left child when opened
-        std::array<bool, N + 1> open{};           ///< [k]: opened into k slots, or kept as one child
-        bool leaf = false;                        ///< kept as one child: a leaf, not a node
+        std::array<uint8_t, N + 1> left_slots;  ///< [k]: slots of the left child when opened
+        std::array<bool, N + 1> open;           ///< [k]: opened into k slots, or kept as one child
+        bool leaf;                              ///< kept as one child: a leaf, not a node
     };
+    /// Trees with fewer nodes are solved without a parallel region; tasks are made for
+    /// the subtrees of the first kTaskLevels levels.
+    static constexpr size_t kParallelNodes = 1u << 14;
+    static constexpr int kTaskLevels = 6;
     struct Range {
         uint32_t first, count;  ///< the subtree's slots; first = kNoNode: not contiguous
     };
+    /// Costs and choices of the subtree of node x (at `level`), children first.
+    void solve(uint32_t x, int level) {
+        const BvhNode& node = bvh_.nodes[x];
+        if (!node.is_leaf()) {
+            if (level < kTaskLevels) {
+#pragma omp task default(shared) firstprivate(level)
+                solve(node.index, level + 1);
+                solve(node.index + 1, level + 1);
+#pragma omp taskwait
+            } else {
+                solve(node.index, level + 1);
+                solve(node.index + 1, level + 1);
+            }
+        }
+        combine(x);
+    }
+
+    /// opened[k]: the least cost of both children sharing k slots of the parent's node, the
+    /// left child's share in plan.left_slots[k] (the first best). Branch-free: which share
+    /// wins is data-dependent. Two leaves cost the same in any slots, so j = 1 wins.
+    static Costs open_costs(const Costs& left, const Costs& right, bool two_leaves, Choice& plan) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        Costs opened;
+        opened.fill(inf);
+        if (two_leaves) {
+            const double sum = left[1] + right[1];
+            if (!(sum < inf)) return opened;
+            for (int k = 2; k <= N; ++k) opened[k] = sum, plan.left_slots[k] = 1;
+            return opened;
+        }
+        for (int k = 2; k <= N; ++k) {
+            double best = inf;
+            int best_j = 0;
+            for (int j = 1; j < k; ++j) {
+                const double c = left[j] + right[k - j];
+                const bool lower = c < best;
+                best = lower ? c : best;
+                best_j = lower ? j : best_j;
+            }
+            opened[k] = best;
+            plan.left_slots[k] = uint8_t(best_j);
+        }
+        return opened;
+    }
+
+    /// The collapse's dynamic programme at node x, its children solved.
+    void combine(uint32_t x) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        const BvhNode& node = bvh_.nodes[x];
+        const double area = double(half_area(node));
+        Costs& f = cost_[x];
+        if (node.is_leaf()) {
+            range_[x] = {node.index, node.count};
+            f.fill(opt_.block_cost * area * double(blocks(node.count)));
+            return;
+        }
+        Choice& plan = plan_[x];
+        plan = Choice{};
+        const Range& l = range_[node.index];
+        const Range& r = range_[node.index + 1];
+        // A subtree whose primitives are contiguous slots may become one leaf.
+        const bool contiguous = l.first != kNoNode && r.first == l.first + l.count;
+        range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
+        const Costs& left = cost_[node.index];
+        const Costs& right = cost_[node.index + 1];
+        const Costs opened = open_costs(
+            left, right, bvh_.nodes[node.index].is_leaf() && bvh_.nodes[node.index + 1].is_leaf(), plan);
+        // As one child, x is a node of its own (its area plus its children in N
+        // slots) or, when small enough, a leaf.
+        const double as_node = area + opened[N];
+        const double as_leaf = contiguous && range_[x].count <= opt_.merge_leaves_up_to
+                                   ? opt_.block_cost * area * double(blocks(range_[x].count))
+                                   : inf;
+        plan.leaf = as_leaf < as_node;
+        f[1] = std::min(as_node, as_leaf);
+        for (int k = 2; k <= N; ++k) {
+            plan.open[k] = opened[k] < f[1];
+            f[k] = plan.open[k] ? opened[k] : f[1];
+        }
+    }
+
     static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
 
     void emit(uint32_t x, int k, Child out[N], int& n) const {
@@ -121,8 +173,10 @@ class CollapsePlan {
     }
 
     const Bvh& bvh_;
-    std::vector<Choice> plan_;
-    std::vector<Range> range_;
+    const WideCollapse opt_;
+    BuildArray<Costs> cost_;  ///< [x][k]: least cost of subtree x in k slots
+    BuildArray<Choice> plan_;
+    BuildArray<Range> range_;
 };
 
 /// Child slot `c` of `p`: the box of binary node `box`, a leaf of `count` slots

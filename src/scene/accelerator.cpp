@@ -1,6 +1,8 @@
 #include "scene/accelerator.h"
 
 #include <unistd.h>
+#include <xmmintrin.h>
+#include <emmintrin.h>
 
 #include <algorithm>
 #include <chrono>
@@ -16,18 +18,33 @@
 
 namespace sahara {
 
+/// Leaf slot s's primitive id: the builder's primitive bvh.prim_indices[s].
+struct SlotIds {
+    const BuildArray<uint32_t>& ids;
+    const std::vector<uint32_t>& prim_of_slot;
+    size_t size() const { return prim_of_slot.size(); }
+    uint32_t operator[](size_t s) const { return ids[prim_of_slot[s]]; }
+};
+
 namespace {
 
 /// Loops over fewer items than this stay serial (a parallel region costs more).
 constexpr int64_t kParallelLoopMin = 8192;
 
 /// The builder's view of the scene: one box, one centre and one id per primitive.
+/// Uninitialised arrays (BuildArray), each element written once by the thread that
+/// computes it.
 struct PrimitiveList {
-    std::vector<Bounds3> boxes;
-    std::vector<Vec3> centers;
-    std::vector<uint32_t> ids;
+    BuildArray<Bounds3> boxes;
+    BuildArray<Vec3> centers;
+    BuildArray<uint32_t> ids;
 
-    void set(size_t k, const Bounds3& b, uint32_t id) {
+    explicit PrimitiveList(size_t n) : boxes(n), centers(n), ids(n) {}
+    size_t size() const { return ids.size(); }
+    std::span<const Bounds3> box_span() const { return {boxes.get(), boxes.size()}; }
+    std::span<const Vec3> center_span() const { return {centers.get(), centers.size()}; }
+
+    void set(size_t k, const Bounds3& b, uint32_t id) const {
         // A primitive with non-finite coordinates can never be hit; give it an
         // empty box (ignored by node bounds) and a harmless centre.
         const bool finite = is_finite(b.lo) && is_finite(b.hi);
@@ -35,22 +52,42 @@ struct PrimitiveList {
         centers[k] = finite ? b.center() : Vec3(0.0f);
         ids[k] = id;
     }
+
+    /// set() for triangle i, in SSE: the same minima, maxima and centre bit for bit
+    /// (_mm_min_ps(p, lo) is std::min(lo, p), NaN coordinates skipped alike).
+    void set_triangle(const TriangleSoup& soup, uint32_t i) const {
+        const uint32_t* v = &soup.indices[3 * size_t(i)];
+        __m128 lo = _mm_set1_ps(kInfinity), hi = _mm_set1_ps(-kInfinity);
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& p = soup.positions[v[k]];
+            const __m128 q = _mm_setr_ps(p.x, p.y, p.z, 0.0f);
+            lo = _mm_min_ps(q, lo);
+            hi = _mm_max_ps(q, hi);
+        }
+        const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)), inf = _mm_set1_ps(kInfinity);
+        const __m128 finite = _mm_and_ps(_mm_cmplt_ps(_mm_and_ps(lo, abs_mask), inf),
+                                         _mm_cmplt_ps(_mm_and_ps(hi, abs_mask), inf));
+        if ((_mm_movemask_ps(finite) & 7) != 7) {
+            set(i, Bounds3{}, make_prim_id(PrimKind::triangle, i));
+            return;
+        }
+        alignas(16) float l[4], h[4], c[4];
+        _mm_store_ps(l, lo);
+        _mm_store_ps(h, hi);
+        _mm_store_ps(c, _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f)));
+        boxes[i] = Bounds3{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+        centers[i] = Vec3(c[0], c[1], c[2]);
+        ids[i] = make_prim_id(PrimKind::triangle, i);
+    }
 };
 
 PrimitiveList collect_primitives(const Scene& scene) {
-    PrimitiveList list;
     const TriangleSoup& soup = scene.triangles;
     const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
-    list.boxes.resize(n);
-    list.centers.resize(n);
-    list.ids.resize(n);
+    PrimitiveList list(n);
     const auto triangles = int64_t(soup.size());
 #pragma omp parallel for schedule(static) if (triangles > kParallelLoopMin)
-    for (int64_t i = 0; i < triangles; ++i) {
-        Bounds3 b;
-        for (int k = 0; k < 3; ++k) b.extend(soup.positions[soup.indices[3 * size_t(i) + size_t(k)]]);
-        list.set(size_t(i), b, make_prim_id(PrimKind::triangle, uint32_t(i)));
-    }
+    for (int64_t i = 0; i < triangles; ++i) list.set_triangle(soup, uint32_t(i));
     size_t k = soup.size();
     for (uint32_t i = 0; i < scene.spheres.size(); ++i)
         list.set(k++, scene.spheres[i].bounds(scene.camera.shutter_open, scene.camera.shutter_close),
@@ -66,10 +103,10 @@ PrimitiveList collect_primitives(const Scene& scene) {
 BvhBuilder resolve_builder(const PrimitiveList& prims, const AcceleratorOptions& options) {
     if (options.builder != BvhBuilder::automatic) return options.builder;
     BvhWorkload w;
-    w.primitives = prims.boxes.size();
+    w.primitives = prims.size();
     w.expected_rays = options.expected_rays;
     if (w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives))
-        w.largest_share = largest_box_area_share(prims.boxes);
+        w.largest_share = largest_box_area_share(prims.box_span());
     return choose_bvh_builder(w);
 }
 
@@ -82,10 +119,10 @@ size_t l2_cache_bytes() {
 /// The flat loop: one root leaf over every primitive.
 Bvh single_leaf_bvh(const PrimitiveList& prims) {
     Bvh bvh;
-    const auto n = uint32_t(prims.ids.size());
+    const auto n = uint32_t(prims.size());
     if (n == 0) return bvh;
     Bounds3 all;
-    for (const Bounds3& b : prims.boxes) all.extend(b);
+    for (const Bounds3& b : prims.box_span()) all.extend(b);
     BvhNode root{};
     root.set_box(all);
     root.index = 0;
@@ -98,10 +135,11 @@ Bvh single_leaf_bvh(const PrimitiveList& prims) {
 /// Non-triangle slots get consecutive entries of others_ in slot order: the rank of
 /// each among them (fixed before the parallel fill, so the result does not depend on
 /// the threads); empty when every slot is a triangle.
-std::vector<uint32_t> other_slot_ranks(const std::vector<uint32_t>& ids, size_t& other_count) {
-    other_count = size_t(std::count_if(ids.begin(), ids.end(),
-                                       [](uint32_t id) { return prim_kind(id) != PrimKind::triangle; }));
+std::vector<uint32_t> other_slot_ranks(const SlotIds& ids, bool has_others, size_t& other_count) {
+    other_count = 0;
     std::vector<uint32_t> rank;
+    if (!has_others) return rank;
+    for (size_t s = 0; s < ids.size(); ++s) other_count += prim_kind(ids[s]) != PrimKind::triangle;
     if (other_count) {
         rank.resize(ids.size());
         uint32_t k = 0;
@@ -109,6 +147,12 @@ std::vector<uint32_t> other_slot_ranks(const std::vector<uint32_t>& ids, size_t&
             if (prim_kind(ids[s]) != PrimKind::triangle) rank[s] = k++;
     }
     return rank;
+}
+
+/// Vertices of triangle `id` (a triangle's prim id).
+TriangleVerts triangle_verts(const TriangleSoup& soup, uint32_t id) {
+    const uint32_t* v = &soup.indices[3 * size_t(prim_index(id))];
+    return TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
 }
 
 }  // namespace
@@ -160,41 +204,35 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
         options.layout);
     const auto start = std::chrono::steady_clock::now();
     const double cpu_start = process_cpu_ms();
+    build(scene, options);
+    build_cpu_ms_ = process_cpu_ms() - cpu_start;
+    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
     const PrimitiveList prims = collect_primitives(scene);
-    uses_tree_ = prims.ids.size() > options.flat_loop_max_prims;
+    uses_tree_ = prims.size() > options.flat_loop_max_prims;
     const BvhBuildParams params = options.build_params();
-    const BvhBuildInput input{prims.boxes, prims.centers, scene.triangles.positions, scene.triangles.indices};
+    const BvhBuildInput input{prims.box_span(), prims.center_span(), scene.triangles.positions,
+                              scene.triangles.indices};
     builder_ = resolve_builder(prims, options);
     bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
-    // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s].
-    const size_t slots = bvh_.prim_indices.size();
-    std::vector<uint32_t> ids(slots);
-    std::vector<TriangleVerts> tris(slots);
-    const TriangleSoup& soup = scene.triangles;
-#pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
-    for (size_t s = 0; s < slots; ++s) {
-        ids[s] = prims.ids[bvh_.prim_indices[s]];
-        tris[s] = TriangleVerts{};
-        if (prim_kind(ids[s]) == PrimKind::triangle) {
-            const uint32_t* v = &soup.indices[3 * size_t(prim_index(ids[s]))];
-            tris[s] = TriangleVerts::of(soup.positions[v[0]], soup.positions[v[1]], soup.positions[v[2]]);
-        }
-    }
+    // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
+    // straight from the scene into the layout's leaf storage.
+    const SlotIds ids{prims.ids, bvh_.prim_indices};
+    const bool has_others = prims.size() > scene.triangles.size();
     layout_ = options.layout;
-    if (layout_ == BvhLayout::pairs)
+    if (layout_ == BvhLayout::pairs) {
         pairs_ = make_bvh_pairs(bvh_);
-    else
-        wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
-    if (layout_has_blocks(layout_)) {
-        // The tree and the blocks are all the block layout keeps (plus others_).
-        make_leaf_blocks(wide8_, ids, tris);
+        fill_slots(ids, scene.triangles);
     } else {
-        slots_.resize(slots);
-        for (size_t s = 0; s < slots; ++s) slots_[s] = Slot{tris[s], ids[s]};
+        wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
+        // The tree and the blocks are all the block layout keeps (plus others_).
+        make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
     }
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
-    unique_primitive_count_ = prims.ids.size();
+    unique_primitive_count_ = prims.size();
     if (layout_has_blocks(layout_) && !options.keep_binary_tree) bvh_ = Bvh{};
     if (layout_ == BvhLayout::wide8 && options.node_pairing != NodePairing::never) {
         if (options.node_pairing == NodePairing::always)
@@ -203,8 +241,18 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
             pair_rays_ = PairRays::inside;
     }
     if (layout_ == BvhLayout::wide8 && uses_tree_) choose_occlusion_order(options.occlusion_order);
-    build_cpu_ms_ = process_cpu_ms() - cpu_start;
-    build_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// The pairs layout's leaf data: slot s's vertices (zero for other kinds) and id.
+void Accelerator::fill_slots(const SlotIds& ids, const TriangleSoup& soup) {
+    const size_t slots = ids.size();
+    slots_.resize(slots);
+#pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
+    for (size_t s = 0; s < slots; ++s) {
+        const uint32_t id = ids[s];
+        slots_[s] =
+            Slot{prim_kind(id) == PrimKind::triangle ? triangle_verts(soup, id) : TriangleVerts{}, id};
+    }
 }
 
 namespace {
@@ -260,32 +308,34 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
 }
 
 /// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
-/// slots copied into blocks of four; lanes of other kinds and padding get NaN vertices.
-/// The blocks are in node order, leaves numbered by a serial prefix sum, filled in parallel.
+/// slots' triangles copied from the scene into blocks of four; lanes of other kinds and
+/// padding get NaN vertices. The blocks are in node order, leaves numbered by a serial
+/// prefix sum, filled in parallel (each block written once, by the thread that fills it).
 template <int N>
-void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
-                                   const std::vector<TriangleVerts>& tris) {
+void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool has_others,
+                                   const TriangleSoup& soup) {
     size_t other_count = 0;
-    const std::vector<uint32_t> other_rank = other_slot_ranks(ids, other_count);
+    const std::vector<uint32_t> other_rank = other_slot_ranks(ids, has_others, other_count);
     others_.assign(other_count, 0);
+    constexpr float nan = std::numeric_limits<float>::quiet_NaN();
     auto fill_leaf = [&](uint32_t first, uint32_t count, uint32_t block) {
         for (uint32_t s = first; s < first + count; s += 4, ++block) {
             TriangleBlock4& b = blocks_[block];
             for (int l = 0; l < 4; ++l) {
                 const uint32_t slot = s + uint32_t(l);
-                const bool in_leaf = slot < first + count;
-                const bool tri = in_leaf && prim_kind(ids[slot]) == PrimKind::triangle;
-                if (!in_leaf) {
+                const uint32_t id = slot < first + count ? ids[slot] : 0;
+                const bool tri = slot < first + count && prim_kind(id) == PrimKind::triangle;
+                if (slot >= first + count) {
                     b.slot[l] = TriangleBlock4::kEmptyLane;
                 } else if (tri) {
-                    b.slot[l] = ids[slot];
+                    b.slot[l] = id;
                 } else {
                     b.slot[l] = other_rank[slot] | TriangleBlock4::kOtherKind;
-                    others_[other_rank[slot]] = ids[slot];
+                    others_[other_rank[slot]] = id;
                 }
+                const TriangleVerts t = tri ? triangle_verts(soup, id) : TriangleVerts{};
                 for (int v = 0; v < 3; ++v)
-                    for (int a = 0; a < 3; ++a)
-                        b.p[v][a][l] = tri ? tris[slot].p[v][a] : std::numeric_limits<float>::quiet_NaN();
+                    for (int a = 0; a < 3; ++a) b.p[v][a][l] = tri ? t.p[v][a] : nan;
             }
         }
     };
@@ -299,7 +349,7 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>
         return;
     }
     const auto nodes = int64_t(tree.nodes.size());
-    std::vector<uint32_t> first_block(tree.nodes.size());
+    BuildArray<uint32_t> first_block(tree.nodes.size());
     auto total = uint32_t(blocks_.size());
     for (int64_t i = 0; i < nodes; ++i) {
         first_block[size_t(i)] = total;

@@ -31,6 +31,8 @@
 namespace sahara {
 
 class Scene;
+struct TriangleSoup;
+struct SlotIds;
 struct RayPacket;
 struct HitPacket;
 /// One instruction set's traversal entry point for one form (trace_wide.inl).
@@ -229,9 +231,11 @@ class Accelerator {
                                 Hit& hit) const;
     /// Resolves OcclusionOrder::automatic: traces sample occlusion rays in both orders.
     void choose_occlusion_order(OcclusionOrder order);
+    /// The constructor's work: primitive boxes, tree, leaf data.
+    void build(const Scene& scene, const AcceleratorOptions& options);
+    void fill_slots(const SlotIds& ids, const TriangleSoup& soup);
     template <int N>
-    void make_leaf_blocks(BvhWide<N>& tree, const std::vector<uint32_t>& ids,
-                          const std::vector<TriangleVerts>& tris);
+    void make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool has_others, const TriangleSoup& soup);
     /// Sphere, box or quadric `id` over (ray.tmin, tmax): the shape's intersect() or occluded().
     std::optional<ShapeHit> intersect_other(const Ray& ray, uint32_t id, float tmax) const;
     bool occluded_other(const Ray& ray, uint32_t id, float tmax) const;
@@ -264,7 +268,7 @@ class Accelerator {
     Bvh bvh_;         ///< the binary tree (see bvh())
     BvhPairs pairs_;  ///< the same tree in pair layout (layout_ == pairs)
     Bvh8 wide8_;      ///< the same tree collapsed to 8-wide nodes (wide8 layout)
-    std::vector<TriangleBlock4, AlignedAllocator<TriangleBlock4, 64>>
+    std::vector<TriangleBlock4, FillLaterAllocator<TriangleBlock4, 64>>
         blocks_;  ///< wide8 layout: each leaf's slots in blocks of four
     BvhLayout layout_ = kDefaultBvhLayout;
     /// Which closest-hit rays pair nodes (NodePairing resolved for this tree).
