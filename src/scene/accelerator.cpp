@@ -296,7 +296,7 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     // Farthest first sorts the hit children, which slot order does not: it must save
     // enough nodes and leaf tests to pay for that (docs/performance.md, "Occlusion order").
     constexpr double kFarFirstMaxWork = 0.75;
-    constexpr size_t kOcclusionSampleRays = 512;
+    constexpr size_t kOcclusionSampleRays = 256;
     constexpr int64_t kParallelOcclusionRays = 128;  // fewer: a parallel region costs more than it saves
     const std::vector<Ray> rays = occlusion_sample_rays(blocks_, kOcclusionSampleRays);
     const auto count = int64_t(rays.size());
