@@ -361,11 +361,7 @@ class BinnedBuild {
             pairs += used_pairs_[k];
         }
         out_.nodes.resize(2 * size_t(pairs));
-        // Every pair is written to its own place: the copy runs on all threads.
-        const auto regions = int64_t(n_);
-#pragma omp parallel for schedule(static) if (regions > kParallelScanThreshold)
-        for (int64_t i = 0; i < regions; ++i) {
-            const auto k = uint32_t(i);
+        for (uint32_t k = 0; k < n_; ++k) {
             if (!used_pairs_[k]) continue;
             for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
                 BvhNode node = nodes_[2 * k + j];

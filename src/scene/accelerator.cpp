@@ -297,21 +297,13 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     // enough nodes and leaf tests to pay for that (docs/performance.md, "Occlusion order").
     constexpr double kFarFirstMaxWork = 0.75;
     constexpr size_t kOcclusionSampleRays = 256;
-    constexpr int64_t kParallelOcclusionRays = 128;  // fewer: a parallel region costs more than it saves
     const std::vector<Ray> rays = occlusion_sample_rays(blocks_, kOcclusionSampleRays);
-    const auto count = int64_t(rays.size());
     uint64_t work[2] = {0, 0};
     for (int far = 0; far < 2; ++far) {
         wide8_.occlusion_far_first = far != 0;
-        // Integer sums: the same total, so the same choice, for any thread count.
-        uint64_t sum = 0;
-#pragma omp parallel for schedule(static) reduction(+ : sum) if (count >= kParallelOcclusionRays)
-        for (int64_t i = 0; i < count; ++i) {
-            TraversalCounters c;
-            occluded_counted(rays[size_t(i)], c);
-            sum += c.nodes_visited + c.prims_tested;
-        }
-        work[far] = sum;
+        TraversalCounters c;
+        for (const Ray& r : rays) occluded_counted(r, c);
+        work[far] = c.nodes_visited + c.prims_tested;
     }
     wide8_.occlusion_far_first = double(work[1]) < kFarFirstMaxWork * double(work[0]);
 }
