@@ -296,7 +296,8 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     // Farthest first sorts the hit children, which slot order does not: it must save
     // enough nodes and leaf tests to pay for that (docs/performance.md, "Occlusion order").
     constexpr double kFarFirstMaxWork = 0.75;
-    const std::vector<Ray> rays = occlusion_sample_rays(blocks_, 512);
+    constexpr size_t kOcclusionSampleRays = 256;
+    const std::vector<Ray> rays = occlusion_sample_rays(blocks_, kOcclusionSampleRays);
     uint64_t work[2] = {0, 0};
     for (int far = 0; far < 2; ++far) {
         wide8_.occlusion_far_first = far != 0;
