@@ -140,8 +140,9 @@ void add_embree_json(nlohmann::ordered_json& j, double count, const PassTimes& t
 /// The occlusion pass with the shadow cache (OcclusionCache), apart from the plain
 /// traversal's figures: "cached" ones, and how many answers differ from the plain pass
 /// (none should).
-void add_cached_json(nlohmann::ordered_json& j, double count, const PassTimes& cached, const PassTimes& theirs,
-                     const RayAnswers& plain, const RayAnswers& with_cache, bool embree) {
+void add_cached_json(nlohmann::ordered_json& j, double count, const PassTimes& cached,
+                     const PassTimes& theirs, const RayAnswers& plain, const RayAnswers& with_cache,
+                     bool embree) {
     j["cached_mrays_s"] = count / median(cached.wall) * 1e-6;
     j["cached_mrays_cpu_s"] = count / median(cached.cpu) * 1e-6;
     size_t differ = 0;

@@ -13,11 +13,11 @@ namespace sahara {
 
 /// A direction towards a light and what arrives along it.
 struct LightSample {
-    Vec3 wi;             ///< unit direction from the shading point
-    float distance = 0;  ///< to the sampled point (kInfinity: directional, envmap)
-    Rgb li{0.0f};        ///< radiance (area, envmap) or irradiance at normal incidence (delta)
-    float pdf = 0;       ///< selection probability times solid-angle density (delta: selection only)
-    bool delta = false;  ///< point or directional light: no MIS
+    Vec3 wi;               ///< unit direction from the shading point
+    float distance = 0;    ///< to the sampled point (kInfinity: directional, envmap)
+    Rgb li{0.0f};          ///< radiance (area, envmap) or irradiance at normal incidence (delta)
+    float pdf = 0;         ///< selection probability times solid-angle density (delta: selection only)
+    bool delta = false;    ///< point or directional light: no MIS
     uint32_t emitter = 0;  ///< which of Scene::emitters (its shadow cache: shadow_cache)
 };
 

@@ -19,7 +19,8 @@ namespace {
 TriangleMesh box_mesh(Vec3 lo, Vec3 hi) {
     TriangleMesh m;
     m.name = "box";
-    for (int k = 0; k < 8; ++k) m.positions.push_back({k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
+    for (int k = 0; k < 8; ++k)
+        m.positions.push_back({k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z});
     m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
                  2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
     return m;
@@ -31,9 +32,9 @@ TriangleMesh box_mesh(Vec3 lo, Vec3 hi) {
 SceneDesc room() {
     SceneDesc d;
     d.materials.push_back(MaterialDesc{});
-    d.meshes.push_back(box_mesh({0, 0, -0.2f}, {10, 8, 0}));    // floor
-    d.meshes.push_back(box_mesh({0, 0, 3}, {10, 8, 3.2f}));     // ceiling
-    d.meshes.push_back(box_mesh({-0.2f, 0, 0}, {0, 8, 3}));     // walls x = 0, x = 10, y = 0
+    d.meshes.push_back(box_mesh({0, 0, -0.2f}, {10, 8, 0}));  // floor
+    d.meshes.push_back(box_mesh({0, 0, 3}, {10, 8, 3.2f}));   // ceiling
+    d.meshes.push_back(box_mesh({-0.2f, 0, 0}, {0, 8, 3}));   // walls x = 0, x = 10, y = 0
     d.meshes.push_back(box_mesh({10, 0, 0}, {10.2f, 8, 3}));
     d.meshes.push_back(box_mesh({0, -0.2f, 0}, {10, 0, 3}));
     // Wall y = 8 around a window x in [3, 6], z in [1, 2.5].
@@ -44,7 +45,8 @@ SceneDesc room() {
     for (int j = 0; j < 20; ++j)
         for (int i = 0; i < 25; ++i) {
             const Vec3 lo{0.2f + 0.4f * float(i), 0.2f + 0.38f * float(j), 0.0f};
-            d.meshes.push_back(box_mesh(lo, lo + Vec3(0.1f, 0.1f, 0.1f + 0.05f * float((i * 7 + j * 3) % 5))));
+            d.meshes.push_back(
+                box_mesh(lo, lo + Vec3(0.1f, 0.1f, 0.1f + 0.05f * float((i * 7 + j * 3) % 5))));
         }
     return d;
 }
