@@ -22,8 +22,9 @@ enum class LeafResult : uint8_t {
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
 /// pushed farthest first. Any-hit rays visit children in slot order instead, or
-/// farthest entry first where the tree says so (BvhWide::occlusion_far_first). kAvx: 8-wide box tests in AVX
-/// (caller compiled for AVX2); kAvx512: 8-wide nodes take the AVX-512 step (intersect_bvh8_compress_avx512).
+/// farthest entry first where the tree says so (BvhWide::occlusion_far_first).
+/// kAvx: 8-wide box tests in AVX (caller compiled for AVX2); kAvx512: 8-wide nodes
+/// take the AVX-512 step (intersect_bvh8_compress_avx512).
 /// kPairNodes (8-wide; closest hit on the AVX2 and AVX-512 steps, any hit on the AVX2
 /// step): until the first hit, the inner node on top of the stack is tested in the same
 /// step as `cur`, and the hit children of both go to the stack together

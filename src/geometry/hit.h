@@ -41,8 +41,8 @@ static_assert(sizeof(Hit) == 20);
 /// the block goes through the same leaf test (cut-outs and one-sided triangles
 /// included), and any primitive that blocks the ray makes it occluded.
 struct OcclusionCache {
-    const void* owner =
-        nullptr;         ///< the Accelerator (scene/accelerator.h) that filled it; another ignores it
+    /// The Accelerator (scene/accelerator.h) that filled it; another one ignores it.
+    const void* owner = nullptr;
     uint32_t block = 0;  ///< the occluder's leaf block (wide8 layout)
 };
 

@@ -6,30 +6,10 @@
 #include <array>
 #include <bit>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
-
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
+#include <utility>
 
 namespace sahara::python {
-
-void* allocate_sort_buffer(size_t bytes) {
-    constexpr size_t kHugePage = size_t(2) << 20;
-    // Cache-line aligned at least (SortedRay asks for 32 bytes, more than malloc's 16).
-    const size_t align = bytes < 2 * kHugePage ? size_t(64) : kHugePage;
-    const size_t rounded = (std::max<size_t>(bytes, 1) + align - 1) / align * align;
-    void* p = std::aligned_alloc(align, rounded);
-    if (!p) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    // Advice only: without huge pages the buffer still works.
-    if (align == kHugePage) madvise(p, rounded, MADV_HUGEPAGE);
-#endif
-    return p;
-}
-
-void free_sort_buffer(void* p) noexcept { std::free(p); }
 
 namespace {
 

@@ -5,12 +5,9 @@
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
 #include <cstdint>
-#include <limits>
-#include <memory>
-#include <new>
-#include <utility>
 #include <vector>
 
+#include "accel/bvh.h"
 #include "accel/packet.h"
 #include "geometry/hit.h"
 #include "math/bounds.h"
@@ -22,39 +19,13 @@ namespace sahara::python {
 /// sparse for neighbours to share much, and the sort would cost more than it saves.
 inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 
-/// Allocates `bytes` for a sort buffer: buffers of several MB on 2 MB pages where the
-/// system offers them (Linux's transparent huge pages), so that the bucket pass, which
-/// writes to a thousand places at once, does not miss the TLB on each write, and a
-/// buffer's first touch takes one page fault per 2 MB instead of one per 4 kB.
-void* allocate_sort_buffer(size_t bytes);
-void free_sort_buffer(void* p) noexcept;
-
-/// An allocator whose value-initialisation leaves the memory as it is: the sort's
-/// buffers (tens of MB for a million rays) are written in full by parallel loops,
-/// which then also take their first-touch page faults in parallel instead of one
-/// thread zeroing them first.
+/// A vector whose resize() leaves new elements unwritten, on 2 MB pages when large
+/// (accel/bvh.h's FillLaterAllocator): the sort's buffers (tens of MB for a million
+/// rays) are written in full by parallel loops, which then take their first touch in
+/// parallel instead of one thread zeroing them first, and the bucket pass, which writes
+/// to a thousand places at once, does not miss the TLB on each write.
 template <class T>
-struct UninitializedAllocator {
-    using value_type = T;
-    UninitializedAllocator() = default;
-    template <class U>
-    UninitializedAllocator(const UninitializedAllocator<U>&) {}
-    T* allocate(size_t n) {
-        static_assert(alignof(T) <= 64, "allocate_sort_buffer aligns to a cache line");
-        if (n > std::numeric_limits<size_t>::max() / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(allocate_sort_buffer(n * sizeof(T)));
-    }
-    void deallocate(T* p, size_t) noexcept { free_sort_buffer(p); }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-        if constexpr (sizeof...(Args) > 0) ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-    friend bool operator==(const UninitializedAllocator&, const UninitializedAllocator&) { return true; }
-};
-
-/// A vector whose resize() leaves new elements unwritten (T must be an implicit-lifetime type).
-template <class T>
-using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
+using UninitializedVector = std::vector<T, FillLaterAllocator<T, 64>>;
 
 /// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
 /// over the sorted copies loads two rays per line.

@@ -84,14 +84,15 @@ void Scene::intersect_packet(RayPacket& packet, HitPacket& hits) const {
 
 bool Scene::occluded(const Ray& ray) const {
     count_ray(RayKind::shadow);
-    if (accel_ && accel_->occluded(ray)) return true;
-    if (instances_ && instances_->occluded(ray)) return true;
-    return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
+    return (accel_ && accel_->occluded(ray)) || occluded_outside_tree(ray);
 }
 
 bool Scene::occluded(const Ray& ray, OcclusionCache& cache) const {
     count_ray(RayKind::shadow);
-    if (accel_ && accel_->occluded(ray, cache)) return true;
+    return (accel_ && accel_->occluded(ray, cache)) || occluded_outside_tree(ray);
+}
+
+bool Scene::occluded_outside_tree(const Ray& ray) const {
     if (instances_ && instances_->occluded(ray)) return true;
     return std::any_of(planes.begin(), planes.end(), [&](const Plane& pl) { return pl.occluded(ray); });
 }

@@ -181,6 +181,8 @@ class Scene {
 
    private:
     void collect_instanced_emitters(std::vector<float>& power);
+    /// occluded()'s part beyond the flat tree: instances and planes.
+    bool occluded_outside_tree(const Ray& ray) const;
     std::vector<uint32_t> instance_emitter_base_;                ///< per instance; empty if none emits
     std::vector<std::vector<uint32_t>> prototype_emitter_slot_;  ///< per prototype, per triangle
     std::unique_ptr<Accelerator> accel_;
