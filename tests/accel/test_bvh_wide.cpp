@@ -498,3 +498,42 @@ TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused
     CHECK_THROWS_AS(make_bvh_wide<8>(bvh), std::invalid_argument);
     CHECK_THROWS_AS(make_bvh_wide<8>(bvh, WideCollapse{kMaxWideLeafCount + 1, 1.0}), std::invalid_argument);
 }
+
+TEST_CASE("wide BVH: octant orders rank the children of each node and opposite octants reverse them") {
+    // Distinct boxes on a jittered grid: no two child centres coincide, so every split inside a
+    // node has a side farther along each direction.
+    std::vector<Bounds3> boxes;
+    std::vector<Vec3> centers;
+    for (int k = 0; k < 600; ++k) {
+        const Vec3 c{float(k % 10) + 0.01f * float(k % 7), float(k / 10 % 6) + 0.02f * float(k % 5),
+                     float(k / 60) + 0.03f * float(k % 3)};
+        boxes.push_back(Bounds3{c - Vec3(0.2f, 0.2f, 0.2f), c + Vec3(0.2f, 0.2f, 0.2f)});
+        centers.push_back(c);
+    }
+    BvhBuildParams params;
+    params.max_leaf_size = 2;
+    const Bvh bvh = build_bvh(BvhBuildInput{boxes, centers}, BvhBuilder::binned, params);
+    const Bvh8 tree = make_bvh_wide<8>(bvh);
+    REQUIRE(tree.nodes.size() > 10);
+    int wrong = 0;
+    for (const Bvh8Node& n : tree.nodes) {
+        int children = 0;
+        while (children < 8 && n.has_child(children)) ++children;
+        for (int o = 0; o < 8; ++o) {
+            uint32_t seen = 0;
+            std::vector<int> order, opposite;
+            for (int p = 0; p < 8; ++p) {
+                const int slot = int(n.octant_order[o] >> (4 * p) & 15);
+                seen |= 1u << slot;
+                // Children first, then the empty slots.
+                wrong += int((p < children) != n.has_child(slot));
+                if (p < children) order.push_back(slot);
+                if (p < children) opposite.push_back(int(n.octant_order[7 - o] >> (4 * p) & 15));
+            }
+            wrong += int(seen != 0xFFu);
+            std::reverse(opposite.begin(), opposite.end());
+            wrong += int(order != opposite);
+        }
+    }
+    CHECK(wrong == 0);
+}
