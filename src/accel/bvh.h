@@ -211,6 +211,10 @@ struct BvhWorkload {
 BvhBuilder choose_bvh_builder(const BvhWorkload& workload);
 inline constexpr double kAutoMinLargestShare = 0.5;
 inline constexpr double kAutoMinRaysPerPrimitive = 100.0;
+/// Whether a scene of this many primitives and this largest_share (BvhWorkload) is
+/// treated as an interior: at least 1,000 primitives and largest_share >=
+/// kAutoMinLargestShare (what makes the automatic builder pick reinsert).
+bool looks_like_interior(size_t primitives, double largest_share);
 /// The largest_share of these boxes (BvhWorkload).
 double largest_box_area_share(std::span<const Bounds3> boxes);
 

@@ -207,9 +207,13 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
 /// primitives make largest_share high, but a tree that small traces no faster rebuilt.
 constexpr size_t kAutoMinPrimitives = 1000;
 
+bool looks_like_interior(size_t primitives, double largest_share) {
+    return primitives >= kAutoMinPrimitives && largest_share >= kAutoMinLargestShare;
+}
+
 BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
     const bool long_render = w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives);
-    const bool uneven = w.primitives >= kAutoMinPrimitives && w.largest_share >= kAutoMinLargestShare;
+    const bool uneven = looks_like_interior(w.primitives, w.largest_share);
     return long_render && uneven ? BvhBuilder::reinsert : BvhBuilder::binned;
 }
 

@@ -116,6 +116,12 @@ size_t l2_cache_bytes() {
     return bytes > 0 ? size_t(bytes) : size_t(1) << 20;
 }
 
+/// Whether the primitives look like an interior (looks_like_interior); measured only
+/// for trees larger than the L2 cache, where node pairing asks.
+bool interior_like(const PrimitiveList& prims) {
+    return looks_like_interior(prims.size(), largest_box_area_share(prims.box_span()));
+}
+
 /// The flat loop: one root leaf over every primitive.
 Bvh single_leaf_bvh(const PrimitiveList& prims) {
     Bvh bvh;
@@ -191,6 +197,10 @@ void check_accelerator_capacity(size_t total, size_t largest_kind, BvhLayout lay
                          " that a wide BVH's leaf references reach (the pairs layout has none)");
 }
 
+bool automatic_node_pairing(size_t tree_bytes, size_t cache_bytes, bool interior) {
+    return tree_bytes > cache_bytes && !interior;
+}
+
 Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
     : spheres_(scene.spheres),
       boxes_(scene.boxes),
@@ -237,7 +247,8 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
     if (layout_ == BvhLayout::wide8 && options.node_pairing != NodePairing::never) {
         if (options.node_pairing == NodePairing::always)
             pair_rays_ = PairRays::all;
-        else if (bytes() > l2_cache_bytes())
+        else if (bytes() > l2_cache_bytes() &&  // the interior test only where it matters
+                 automatic_node_pairing(bytes(), l2_cache_bytes(), interior_like(prims)))
             pair_rays_ = PairRays::inside;
     }
     if (layout_ == BvhLayout::wide8 && uses_tree_) choose_occlusion_order(options.occlusion_order);

@@ -49,10 +49,19 @@ inline constexpr uint32_t kFlatLoopMaxPrims = 0;
 /// one they visit (traverse_wide): closest-hit rays on the AVX-512 and AVX2 paths,
 /// occlusion rays on the AVX2 path.
 enum class NodePairing : uint8_t {
-    automatic,  ///< wide8 trees larger than the L2 cache, for rays from inside the scene's bounds
-    always,     ///< every ray that can pair, from anywhere, whatever the tree's size (tests)
+    /// wide8 trees larger than the L2 cache, for rays from inside the scene's bounds,
+    /// except on interiors (looks_like_interior in accel/bvh.h)
+    automatic,
+    always,  ///< every ray that can pair, from anywhere, whatever the tree's size (tests)
     never,
 };
+
+/// NodePairing::automatic's rule: pair when the tree is larger than the L2 cache
+/// (cache_bytes), except on interiors (looks_like_interior in accel/bvh.h). Their rays
+/// mostly start in a room and hit within it: the stack entry a paired step tests
+/// would mostly have been culled by that near hit, and the part of the tree they
+/// touch stays cached.
+bool automatic_node_pairing(size_t tree_bytes, size_t cache_bytes, bool interior);
 
 /// In which order occlusion rays on a wide8 tree visit the children a node test hits
 /// (BvhWide::occlusion_far_first).
@@ -90,7 +99,9 @@ struct AcceleratorOptions {
     /// Node pairing pays only where node fetches miss the L2 cache, whose latency it
     /// overlaps; on trees that fit in L2 it gains nothing. Camera rays from outside the
     /// bounds usually hit in the first subtree they enter, so the paired node would never
-    /// have been visited: automatic pairing leaves them out.
+    /// have been visited: automatic pairing leaves them out. Nor does it pair on
+    /// interiors, whose rays mostly hit near their origin (see docs/performance.md,
+    /// "Generated interiors").
     NodePairing node_pairing = NodePairing::automatic;
     OcclusionOrder occlusion_order = OcclusionOrder::automatic;
     /// Keep the binary tree after the block layout has collapsed it (bvh(), for

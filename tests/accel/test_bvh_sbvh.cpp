@@ -211,3 +211,20 @@ TEST_CASE("the automatic builder picks reinsert only for long renders of scenes 
     opt.expected_rays = 0;
     CHECK(Accelerator(scene, opt).builder() == BvhBuilder::binned);
 }
+
+TEST_CASE("automatic node pairing leaves out interiors and trees that fit in the cache") {
+    CHECK(looks_like_interior(1000, kAutoMinLargestShare));
+    CHECK_FALSE(looks_like_interior(999, 1.0));  // too small to matter
+    CHECK_FALSE(looks_like_interior(100000, 0.9 * kAutoMinLargestShare));
+    CHECK(automatic_node_pairing(2u << 20, 1u << 20, false));
+    CHECK_FALSE(automatic_node_pairing(2u << 20, 1u << 20, true));   // an interior
+    CHECK_FALSE(automatic_node_pairing(1u << 20, 1u << 20, false));  // fits in the cache
+    // A room's tree never pairs automatically, whatever the cache; asked for, it does.
+    const TriangleMesh room = make_room(3, 0);  // without planks: the walls hold most box area
+    REQUIRE(looks_like_interior(room.triangle_count(), largest_box_area_share(boxes_of(room).boxes)));
+    const Scene scene = scene_from_mesh(room);
+    AcceleratorOptions opt;
+    CHECK_FALSE(Accelerator(scene, opt).pairs_nodes());
+    opt.node_pairing = NodePairing::always;
+    CHECK(Accelerator(scene, opt).pairs_nodes());
+}
