@@ -159,6 +159,10 @@ struct BvhBuildParams {
     /// costs as much as a full one), so the SAH counts ceil(n / size) * size.
     uint32_t leaf_block_size = 1;
     uint32_t bin_count = 16;  ///< binned builder: centroid bins per axis (at most 8 for ranges of up to 64)
+    /// Binned builder: ranges of at most this many primitives (at most 16) are split by an
+    /// exact SAH sweep over their centroid orders instead of bins (a better split for
+    /// the same work; longer ranges cost more swept than binned); 0: bins everywhere.
+    uint32_t sweep_max_prims = 8;
     /// Subtrees with more primitives than this are built as OpenMP tasks.
     uint32_t parallel_threshold = 4096;
     /// Reinsertion: inner nodes removed and reinserted per round (the most inefficient ones), as a

@@ -3,7 +3,8 @@
 /// axes in one pass and partitions in a second one; its children's boxes come
 /// from the bins and their centroid bounds from the partition, so there is no
 /// separate bounds pass. Primitives are 48-byte records (box, id, centroid)
-/// moved in place, read sequentially.
+/// moved in place, read sequentially. Ranges of up to params.sweep_max_prims
+/// are split by an exact SAH sweep instead (bvh_small_sweep.h).
 ///
 /// Parallelism: ranges above kParallelScanThreshold are binned and partitioned
 /// as kScanChunks OpenMP tasks (stable partition into the other of two buffers), the
@@ -12,6 +13,7 @@
 /// (compacted at the end), so the tree is the same for any thread count.
 #include "accel/bvh_binned.h"
 #include "accel/bvh_bins.h"
+#include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
 
 #include <algorithm>
@@ -124,6 +126,7 @@ class BinnedBuild {
         const bool may_be_leaf = n <= params_.max_leaf_size;
         if (depth >= kBvhMedianSplitDepth) return !may_be_leaf && median_split(r, left, right);
         if (may_be_leaf && params_.intersection_cost > 0.0f && leaf_is_certain(r)) return false;
+        if (n <= params_.sweep_max_prims) return sweep_split(r, may_be_leaf, left, right);
         const uint32_t bins = binned_bin_count(n, params_.bin_count);
         const BinMap map(r.centroids, bins);
         Split best;
@@ -155,6 +158,24 @@ class BinnedBuild {
         }
         left.box = best.left;
         right.box = best.right;
+        return true;
+    }
+
+    /// split() of a short range by the exact SAH sweep (bvh_small_sweep.h).
+    bool sweep_split(const Range& r, bool may_be_leaf, Range& left, Range& right) {
+        PrimRef* refs = &r.refs[r.begin];
+        const uint32_t n = r.end - r.begin;
+        const binned::SmallSweep sweep(refs, n);
+        const binned::SweepSplit s = sweep.best({params_.intersection_cost, params_.leaf_block_size});
+        if (s.axis < 0) return !may_be_leaf && median_split(r, left, right);
+        Split bound;
+        bound.cost = s.cost;
+        if (may_be_leaf && is_leaf_cheaper(r, n, bound)) return false;
+        Box4 lbox, rbox, lcent, rcent;
+        sweep.apply(refs, s, lbox, rbox, lcent, rcent);
+        const uint32_t mid = r.begin + s.left_count;
+        left = Range{r.begin, mid, lbox.bounds(), lcent.bounds(), r.refs};
+        right = Range{mid, r.end, rbox.bounds(), rcent.bounds(), r.refs};
         return true;
     }
 

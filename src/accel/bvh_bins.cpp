@@ -6,12 +6,6 @@ namespace sahara::binned {
 
 namespace {
 
-/// Primitive count rounded up to whole leaf blocks (what a leaf of n actually tests).
-float blocked(uint32_t n, uint32_t b) {
-    if ((b & (b - 1)) == 0) return float((n + b - 1) & ~(b - 1));
-    return float((n + b - 1) / b * b);
-}
-
 /// Bit b set where count[b] != 0, for b < nb (count has kMaxBins entries).
 uint64_t nonzero_mask(const uint32_t* count, uint32_t nb) {
     uint64_t bits = 0;
@@ -58,8 +52,9 @@ BinSplit sparse_search(const Bins& bins, const BinMap& map, const SplitCosts& co
         for (uint32_t j = 1; j < m; ++j) {
             acc.extend(box[used[j - 1]]);
             cnt += count[used[j - 1]];
-            const float cost = costs.intersection_cost * (acc.area() * blocked(cnt, block) +
-                                                          right_area[j] * blocked(right_count[j], block));
+            const float cost =
+                costs.intersection_cost * (acc.area() * blocked_count(cnt, block) +
+                                           right_area[j] * blocked_count(right_count[j], block));
             if (cost < best.cost) {
                 best.cost = cost;
                 best.left_count = cnt;

@@ -59,6 +59,24 @@ struct Box4 {
     }
 };
 
+/// Surface areas of four boxes (lane 3 of each ignored), Box4::area's operations in the
+/// same order but four at a time; an empty box has area 0 as there, and a NaN extent
+/// counts as 0.
+inline __m128 areas4(const __m128* lo, const __m128* hi) {
+    const __m128 zero = _mm_setzero_ps();
+    __m128 e0 = _mm_max_ps(_mm_sub_ps(hi[0], lo[0]), zero), e1 = _mm_max_ps(_mm_sub_ps(hi[1], lo[1]), zero);
+    __m128 e2 = _mm_max_ps(_mm_sub_ps(hi[2], lo[2]), zero), e3 = _mm_max_ps(_mm_sub_ps(hi[3], lo[3]), zero);
+    _MM_TRANSPOSE4_PS(e0, e1, e2, e3);  // e0: x extents, e1: y, e2: z
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, e1), _mm_mul_ps(e1, e2)), _mm_mul_ps(e2, e0));
+    return _mm_add_ps(sum, sum);
+}
+
+/// Primitive count rounded up to whole leaf blocks of b (what a leaf of n actually tests).
+inline float blocked_count(uint32_t n, uint32_t b) {
+    if ((b & (b - 1)) == 0) return float((n + b - 1) & ~(b - 1));
+    return float((n + b - 1) / b * b);
+}
+
 /// The bins of the three axes of one range (or of one chunk of it).
 struct Bins {
     Box4 box[3][kMaxBins];

@@ -13,6 +13,7 @@
 #include "accel/bvh.h"
 #include "accel/bvh_binned.h"
 #include "accel/bvh_sbvh.h"
+#include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
 
 namespace sahara {
@@ -182,6 +183,7 @@ Bvh build_bvh(const BvhBuildInput& input, BvhBuilder builder, const BvhBuildPara
     p.bin_count = std::clamp(p.bin_count, 2u, 64u);
     p.max_leaf_size = std::max(p.max_leaf_size, 1u);
     p.leaf_block_size = std::max(p.leaf_block_size, 1u);
+    p.sweep_max_prims = std::min(p.sweep_max_prims, binned::kSweepMaxPrims);
     Bvh bvh;
     if (builder == BvhBuilder::binned) {
         build_binned_bvh(input, p, bvh);
