@@ -113,17 +113,15 @@ void cell_scales(const Bounds3& box, float (&scale)[3]) {
 /// The top kRadixBits of a key's code: the bucket of the first, global pass.
 size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBits)); }
 
-/// The sort's working arrays. The first pass moves each ray's key and its copy to
-/// the key's top bucket (reading the batch in order, so without scattered reads);
-/// each bucket, about a thousand rays per million that stay in the cache, is then
-/// sorted on its own by the remaining bits, its ray copies permuted in place (in
-/// TraceOrder::rays) through a per-thread buffer. Once the copies are bucketed,
-/// `keys` is free: each bucket's counting passes use its slots as scratch.
+/// The sort's working arrays besides TraceOrder's. The first pass moves each ray's
+/// key and its copy to the key's top bucket (reading the batch in order, so without
+/// scattered reads); each bucket, about a thousand rays per million that stay in the
+/// cache, then has its keys sorted on their own by the remaining bits. The copies are
+/// not moved again: the tracer reads them through the sorted keys' slots.
 struct SortScratch {
-    UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
-    UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
-    std::vector<size_t> counts;                    ///< per chunk and top bucket, then each chunk's slots
-    std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
+    UninitializedVector<uint64_t> keys;  ///< code << 32 | batch index; then each bucket's sort scratch
+    std::vector<size_t> counts;          ///< per chunk and top bucket, then each chunk's slots
+    std::vector<size_t> bucket_start;    ///< kBuckets + 1 entries
 };
 
 /// Keys of rays [lo, hi) and their counts per top bucket.
@@ -158,8 +156,8 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, si
     for (size_t i = lo; i < hi; ++i) {
         const uint64_t key = s.keys[i];
         const size_t slot = count[top_bucket(key)]++;
-        s.bucketed[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
-        s.index[slot] = uint32_t(key);
+        out.keys[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
+        out.index[slot] = uint32_t(key);
         out.slot_of[i] = uint32_t(slot);
         SortedRay& r = out.rays[slot];
         if (f32) {
@@ -173,35 +171,21 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, si
     }
 }
 
-/// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
-/// through `tmp`) and writes its part of the order and slots; its ray copies are
-/// put in that order through `held`.
-void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, UninitializedVector<SortedRay>& held,
-                 TraceOrder& out) {
-    uint64_t* keys = s.bucketed.data() + lo;
-    const size_t n = hi - lo;
-    if (n > 1) {
-        uint32_t count[2][kBuckets] = {};
-        for (size_t i = 0; i < n; ++i) {
-            ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
-            ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
-        }
-        for (auto& c : count) {
-            uint32_t next = 0;
-            for (uint32_t& x : c) next += std::exchange(x, next);
-        }
-        for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
-        for (size_t i = 0; i < n; ++i)
-            keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
+/// Sorts one top bucket's keys [lo, hi) by the code's lower bits (two stable counting
+/// passes through `tmp`).
+void sort_bucket(uint64_t* keys, size_t n, uint64_t* tmp) {
+    if (n < 2) return;
+    uint32_t count[2][kBuckets] = {};
+    for (size_t i = 0; i < n; ++i) {
+        ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
+        ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
     }
-    if (held.size() < n) held.resize(n);
-    std::copy(out.rays.begin() + ptrdiff_t(lo), out.rays.begin() + ptrdiff_t(hi), held.begin());
-    for (size_t k = lo; k < hi; ++k) {
-        const auto slot = uint32_t(s.bucketed[k]);
-        out.order[k] = s.index[slot];
-        out.slot[k] = slot;
-        out.rays[k] = held[slot - lo];
+    for (auto& c : count) {
+        uint32_t next = 0;
+        for (uint32_t& x : c) next += std::exchange(x, next);
     }
+    for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
+    for (size_t i = 0; i < n; ++i) keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
 }
 
 }  // namespace
@@ -214,13 +198,13 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     float scale[3];
     cell_scales(box, scale);
     SortScratch s;
-    s.keys.resize(n), s.bucketed.resize(n), s.index.resize(n);
+    s.keys.resize(n);
     // More chunks than threads, taken dynamically: a thread the system holds back
     // (a shared machine) then delays the passes by one chunk, not by half the batch.
     const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
     s.counts.assign(chunks * kBuckets, 0);
     s.bucket_start.resize(kBuckets + 1);
-    out.order.resize(n), out.slot.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+    out.keys.resize(n), out.index.resize(n), out.slot_of.resize(n), out.rays.resize(n);
     const auto chunk_count = int64_t(chunks);
 #pragma omp parallel num_threads(threads)
     {
@@ -234,11 +218,11 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
         for (int64_t c = 0; c < chunk_count; ++c)
             bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
                          &s.counts[size_t(c) * kBuckets], out);
-        UninitializedVector<SortedRay> held;
 #pragma omp for schedule(dynamic, 4)
-        for (size_t bucket = 0; bucket < kBuckets; ++bucket)
-            sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
-                        s.keys.data() + s.bucket_start[bucket], held, out);
+        for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
+            const size_t lo = s.bucket_start[bucket], hi = s.bucket_start[bucket + 1];
+            sort_bucket(out.keys.data() + lo, hi - lo, s.keys.data() + lo);
+        }
     }
 }
 

@@ -51,30 +51,33 @@ struct SortedHit {
 };
 
 /// The rays a query traces, in the order it traces them: the batch itself, or the
-/// batch sorted (sort_rays) into contiguous copies, position k holding the batch's
-/// ray order[k]. The sort moves each ray first to a slot of its top bucket and then
-/// sorts each bucket in the cache; results go back the same way (by slot, then
-/// slot_of each batch index), so neither direction reads or writes one cache line
-/// per ray at random.
+/// batch sorted (sort_rays). The sort copies each ray once, to a slot of its top
+/// bucket (contiguous per bucket), and then sorts each bucket's keys in the cache;
+/// position k traces the ray in slot slot(k), which lies in the same bucket as the
+/// slots around it, so the tracer reads one bucket's copies (a few tens of kB) at a
+/// time. Results go back the same way (by slot, then slot_of each batch index), so
+/// neither direction reads or writes one cache line per ray at random.
 struct TraceOrder {
     const RayBatch& batch;
-    UninitializedVector<uint32_t> order;    ///< empty: the batch's own order
-    UninitializedVector<uint32_t> slot;     ///< with `order`: the bucketed slot of position k
-    UninitializedVector<uint32_t> slot_of;  ///< with `order`: the bucketed slot of each batch index
-    UninitializedVector<SortedRay> rays;    ///< with `order`: the rays in that order
-    /// Nearest hits by bucketed slot (with `order` only): a bucket's hits are written
-    /// while its rays are traced, then read back in batch order as one sequential
-    /// stream per bucket.
+    /// With a sorted order: code << 32 | slot, in traced order (empty: the batch's own order).
+    UninitializedVector<uint64_t> keys;
+    UninitializedVector<uint32_t> index;    ///< with `keys`: the batch index of each slot
+    UninitializedVector<uint32_t> slot_of;  ///< with `keys`: the slot of each batch index
+    UninitializedVector<SortedRay> rays;    ///< with `keys`: the ray copies by slot
+    /// Nearest hits by slot (with `keys` only): a bucket's hits are written while its
+    /// rays are traced, then read back in batch order as one sequential stream per bucket.
     UninitializedVector<SortedHit> hits;
 
-    bool sorted() const { return !order.empty(); }
+    bool sorted() const { return !keys.empty(); }
     size_t size() const { return batch.size(); }
-    Ray ray(size_t k) const { return sorted() ? rays[k].ray() : batch.ray(k); }
+    /// The slot of position k (sorted orders only).
+    uint32_t slot(size_t k) const { return uint32_t(keys[k]); }
+    Ray ray(size_t k) const { return sorted() ? rays[slot(k)].ray() : batch.ray(k); }
     /// The batch index of position k (where its result goes).
-    size_t index(size_t k) const { return sorted() ? size_t(order[k]) : k; }
+    size_t index_of(size_t k) const { return sorted() ? size_t(index[slot(k)]) : k; }
 };
 
-/// Sorts the batch's rays into `out` (order, slot, slot_of, rays) by a Morton code of the
+/// Sorts the batch's rays into `out` (keys, index, slot_of, rays) by a Morton code of the
 /// points where each ray enters and leaves `box` (the mesh's bounds; 5 bits per
 /// coordinate, 30 in all), ties in batch order. Leaves `out` unsorted below
 /// kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).
