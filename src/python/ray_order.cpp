@@ -116,10 +116,10 @@ size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBi
 /// The sort's working arrays besides TraceOrder's. The first pass moves each ray's
 /// key and its copy to the key's top bucket (reading the batch in order, so without
 /// scattered reads); each bucket, about a thousand rays per million that stay in the
-/// cache, then has its keys sorted on their own by the remaining bits. The copies are
-/// not moved again: the tracer reads them through the sorted keys' slots.
+/// cache, then has its keys sorted on their own by the remaining bits (TraceOrder's
+/// `scratch` holding the batch-order keys first, then each bucket's sort scratch). The
+/// copies are not moved again: the tracer reads them through the sorted keys' slots.
 struct SortScratch {
-    UninitializedVector<uint64_t> keys;  ///< code << 32 | batch index; then each bucket's sort scratch
     std::vector<size_t> counts;          ///< per chunk and top bucket, then each chunk's slots
     std::vector<size_t> bucket_start;    ///< kBuckets + 1 entries
 };
@@ -149,12 +149,11 @@ void place_buckets(SortScratch& s, size_t chunks) {
 
 /// Moves rays [lo, hi) to their top buckets: key (low half now the bucketed slot),
 /// batch index and ray copy; records each ray's slot.
-void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count,
-                  TraceOrder& out) {
+void bucket_range(const RayBatch& rays, size_t lo, size_t hi, size_t* count, TraceOrder& out) {
     // float32 rows are copied as they are; other layouts go through the converting reader.
     const bool f32 = lo < hi && rays.f32_row(lo) != nullptr;
     for (size_t i = lo; i < hi; ++i) {
-        const uint64_t key = s.keys[i];
+        const uint64_t key = out.scratch[i];
         const size_t slot = count[top_bucket(key)]++;
         out.keys[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
         out.index[slot] = uint32_t(key);
@@ -198,32 +197,39 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     float scale[3];
     cell_scales(box, scale);
     SortScratch s;
-    s.keys.resize(n);
     // More chunks than threads, taken dynamically: a thread the system holds back
     // (a shared machine) then delays the passes by one chunk, not by half the batch.
     const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
     s.counts.assign(chunks * kBuckets, 0);
     s.bucket_start.resize(kBuckets + 1);
-    out.keys.resize(n), out.index.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+    for (auto* v : {&out.keys, &out.scratch}) resize_unwritten(*v, n);
+    for (auto* v : {&out.index, &out.slot_of}) resize_unwritten(*v, n);
+    resize_unwritten(out.rays, n);
     const auto chunk_count = int64_t(chunks);
 #pragma omp parallel num_threads(threads)
     {
 #pragma omp for schedule(dynamic, 1)
         for (int64_t c = 0; c < chunk_count; ++c)
-            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, s.keys.data(),
+            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, out.scratch.data(),
                       &s.counts[size_t(c) * kBuckets]);
 #pragma omp single
         place_buckets(s, chunks);
 #pragma omp for schedule(dynamic, 1)
         for (int64_t c = 0; c < chunk_count; ++c)
-            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
+            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks,
                          &s.counts[size_t(c) * kBuckets], out);
 #pragma omp for schedule(dynamic, 4)
         for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
             const size_t lo = s.bucket_start[bucket], hi = s.bucket_start[bucket + 1];
-            sort_bucket(out.keys.data() + lo, hi - lo, s.keys.data() + lo);
+            sort_bucket(out.keys.data() + lo, hi - lo, out.scratch.data() + lo);
         }
     }
+}
+
+size_t SortBuffers::bytes() const {
+    return keys.capacity() * sizeof(uint64_t) + scratch.capacity() * sizeof(uint64_t) +
+           index.capacity() * sizeof(uint32_t) + slot_of.capacity() * sizeof(uint32_t) +
+           rays.capacity() * sizeof(SortedRay) + hits.capacity() * sizeof(SortedHit);
 }
 
 bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset) {

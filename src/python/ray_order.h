@@ -5,6 +5,7 @@
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -26,6 +27,14 @@ inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 /// to a thousand places at once, does not miss the TLB on each write.
 template <class T>
 using UninitializedVector = std::vector<T, FillLaterAllocator<T, 64>>;
+
+/// Sizes `v` to n unwritten elements, its old ones dropped: storage with room is kept,
+/// and storage without is replaced with nothing copied.
+template <class T>
+void resize_unwritten(UninitializedVector<T>& v, size_t n) {
+    v.clear();
+    v.resize(n);
+}
 
 /// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
 /// over the sorted copies loads two rays per line.
@@ -50,6 +59,25 @@ struct SortedHit {
     float u, v;
 };
 
+/// The arrays of a sorted order (TraceOrder), which a caster keeps for its next batch
+/// (CastMesh::trace_order): reused, they are neither allocated nor cleared by the
+/// kernel again, which otherwise zero-fills tens of MB per million rays.
+struct SortBuffers {
+    /// code << 32 | slot, in traced order (empty: the batch's own order).
+    UninitializedVector<uint64_t> keys;
+    /// code << 32 | batch index in batch order, then each bucket's sort scratch.
+    UninitializedVector<uint64_t> scratch;
+    UninitializedVector<uint32_t> index;    ///< the batch index of each slot
+    UninitializedVector<uint32_t> slot_of;  ///< the slot of each batch index
+    UninitializedVector<SortedRay> rays;    ///< the ray copies by slot
+    /// Nearest hits by slot: a bucket's hits are written while its rays are traced,
+    /// then read back in batch order as one sequential stream per bucket.
+    UninitializedVector<SortedHit> hits;
+
+    /// Bytes held (capacities).
+    size_t bytes() const;
+};
+
 /// The rays a query traces, in the order it traces them: the batch itself, or the
 /// batch sorted (sort_rays). The sort copies each ray once, to a slot of its top
 /// bucket (contiguous per bucket), and then sorts each bucket's keys in the cache;
@@ -57,16 +85,13 @@ struct SortedHit {
 /// slots around it, so the tracer reads one bucket's copies (a few tens of kB) at a
 /// time. Results go back the same way (by slot, then slot_of each batch index), so
 /// neither direction reads or writes one cache line per ray at random.
-struct TraceOrder {
+struct TraceOrder : SortBuffers {
+    /// The batch in its own order, with `reuse`'s storage for a sort.
+    TraceOrder(const RayBatch& rays, SortBuffers&& reuse) : SortBuffers(std::move(reuse)), batch(rays) {
+        keys.clear();
+    }
+
     const RayBatch& batch;
-    /// With a sorted order: code << 32 | slot, in traced order (empty: the batch's own order).
-    UninitializedVector<uint64_t> keys;
-    UninitializedVector<uint32_t> index;    ///< with `keys`: the batch index of each slot
-    UninitializedVector<uint32_t> slot_of;  ///< with `keys`: the slot of each batch index
-    UninitializedVector<SortedRay> rays;    ///< with `keys`: the ray copies by slot
-    /// Nearest hits by slot (with `keys` only): a bucket's hits are written while its
-    /// rays are traced, then read back in batch order as one sequential stream per bucket.
-    UninitializedVector<SortedHit> hits;
 
     bool sorted() const { return !keys.empty(); }
     size_t size() const { return batch.size(); }

@@ -100,13 +100,25 @@ float CastMesh::packet_max_offset() const {
 }
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
-    TraceOrder out{rays, {}, {}, {}, {}, {}};
+    SortBuffers reuse;
+    {
+        const std::lock_guard lock(spare_mutex_);
+        reuse = std::move(spare_);
+    }
+    TraceOrder out(rays, std::move(reuse));
     if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
     sort_rays(accel_->bounds(), threads, out);
-    if (out.sorted()) out.hits.resize(out.keys.size());
+    if (out.sorted()) resize_unwritten(out.hits, out.keys.size());
     return out;
+}
+
+void CastMesh::recycle(TraceOrder&& order) const {
+    const size_t bytes = order.bytes();
+    if (bytes > kMaxKeptSortBytes) return;
+    const std::lock_guard lock(spare_mutex_);
+    if (bytes > spare_.bytes()) spare_ = std::move(static_cast<SortBuffers&>(order));
 }
 
 void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const {

@@ -4,6 +4,7 @@
 /// released, OpenMP over the rays.
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "geometry/hit.h"
@@ -16,6 +17,10 @@ class Accelerator;
 }
 
 namespace sahara::python {
+
+/// The most a caster keeps of its sort buffers between batches: those of about 1.8
+/// million rays (72 bytes per ray); larger batches allocate theirs each time.
+inline constexpr size_t kMaxKeptSortBytes = size_t(128) << 20;
 
 /// Nearest-hit results, one entry per ray (caller-owned storage).
 struct NearestHits {
@@ -56,8 +61,12 @@ class CastMesh {
 
     /// The order to trace a batch in: its own when it is short or its runs are already
     /// coherent (a camera's rays), otherwise sorted (ray_order), which keeps neighbouring
-    /// rays on the same nodes. OpenMP on `threads` (0: all).
+    /// rays on the same nodes, in the buffers the last batch left (recycle). OpenMP on
+    /// `threads` (0: all).
     TraceOrder trace_order(const RayBatch& rays, int threads) const;
+    /// Keeps the buffers of a finished order for the next batch, up to kMaxKeptSortBytes
+    /// (the larger of two concurrent batches' buffers wins).
+    void recycle(TraceOrder&& order) const;
     /// Positions [slice.first, slice.last) of `rays`; results go to each ray's batch index.
     /// With a sorted order the hits wait in rays.hits until write_sorted_hits.
     void nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out) const;
@@ -91,6 +100,10 @@ class CastMesh {
     std::vector<uint32_t> indices_;
     std::unique_ptr<Accelerator> accel_;
     int threads_ = 0;
+    /// Sort buffers between batches (trace_order, recycle); casts run concurrently
+    /// from Python threads, each taking the buffers or, when another has them, new ones.
+    mutable std::mutex spare_mutex_;
+    mutable SortBuffers spare_;
 };
 
 }  // namespace sahara::python

@@ -138,6 +138,7 @@ py::dict cast_rays(const CastMesh& mesh, const py::handle& rays_in, const py::ha
     {
         py::gil_scoped_release release;
         mesh.write_sorted_hits(order, n, out);
+        mesh.recycle(std::move(order));
     }
     py::dict d;
     d["t_hit"] = t;
@@ -153,8 +154,9 @@ py::array_t<bool> occluded(const CastMesh& mesh, const py::handle& rays_in, cons
     const RayBatch rays(rays_in, tmin, tmax);
     auto out = result_array<bool>(rays);
     bool* p = out.mutable_data();
-    const TraceOrder order = trace_order(mesh, rays, n);
+    TraceOrder order = trace_order(mesh, rays, n);
     cast_interruptibly(rays.size(), n, [&](RaySlice slice) { mesh.occluded(order, slice, p); });
+    mesh.recycle(std::move(order));
     return out;
 }
 

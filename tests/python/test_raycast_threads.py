@@ -102,6 +102,23 @@ def test_sorted_tracing_of_awkward_rays_matches_tracing_in_batch_order():
                                       np.isfinite(reference["t_hit"]))
 
 
+def test_batches_of_changing_sizes_on_one_caster_match_batch_order():
+    # A caster keeps its sort buffers for the next batch: later batches, larger or
+    # smaller, and occlusion queries in between, must not see what an earlier one left.
+    v, f = icosphere(6)
+    caster = sahara.RayCaster(v, f)
+    for count, seed in ((60_000, 21), (20_000, 22), (90_000, 23), (30_000, 24)):
+        rays, tmin, tmax = awkward_rays(count, seed)
+        step = 5000
+        parts = [caster.cast_rays(rays[i:i + step], tmin=tmin[i:i + step], tmax=tmax[i:i + step])
+                 for i in range(0, count, step)]
+        whole = caster.cast_rays(rays, tmin=tmin, tmax=tmax)
+        for key in whole:
+            np.testing.assert_array_equal(whole[key], np.concatenate([p[key] for p in parts]),
+                                          err_msg=f"{key}, {count} rays")
+        np.testing.assert_array_equal(caster.occluded(rays, tmin=tmin, tmax=tmax), np.isfinite(whole["t_hit"]))
+
+
 def test_threads_property_and_from_file(tmp_path, sphere):
     v, f = sphere
     assert sahara.RayCaster(v, f).threads is None
