@@ -161,11 +161,12 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, size_t* count, Tra
         SortedRay& r = out.rays[slot];
         if (f32) {
             const float* row = rays.f32_row(i);
-            r.origin = Vec3(row[0], row[1], row[2]), r.dir = Vec3(row[3], row[4], row[5]);
+            for (int k = 0; k < 3; ++k) r.origin[k] = row[k], r.dir[k] = row[3 + k];
             r.tmin = rays.tmin(i), r.tmax = rays.tmax(i);
         } else {
             const Ray full = rays.ray(i);
-            r = SortedRay{full.origin, full.tmin, full.dir, full.tmax};
+            r = SortedRay{{full.origin.x, full.origin.y, full.origin.z}, full.tmin,
+                          {full.dir.x, full.dir.y, full.dir.z}, full.tmax};
         }
     }
 }

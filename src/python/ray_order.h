@@ -5,6 +5,7 @@
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -38,18 +39,23 @@ void resize_unwritten(UninitializedVector<T>& v, size_t n) {
 
 /// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
 /// over the sorted copies loads two rays per line.
+/// Plain floats, not Vec3: Vec3 zero-initialises, and sizing the buffer of a million
+/// copies would then write 32 MB of zeros on one thread before every sort.
 struct alignas(32) SortedRay {
-    Vec3 origin;
+    float origin[3];
     float tmin;
-    Vec3 dir;
+    float dir[3];
     float tmax;
     Ray ray() const {
         Ray r;
-        r.origin = origin, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
+        r.origin = Vec3(origin[0], origin[1], origin[2]), r.dir = Vec3(dir[0], dir[1], dir[2]);
+        r.tmin = tmin, r.tmax = tmax;
         return r;
     }
 };
 static_assert(sizeof(SortedRay) == 32);
+static_assert(std::is_trivially_default_constructible_v<SortedRay>);
+
 
 /// A nearest hit as it waits in sorted order for the write-back (Hit without its
 /// instance field: 16 bytes, four per cache line).
@@ -58,6 +64,7 @@ struct SortedHit {
     uint32_t prim;
     float u, v;
 };
+static_assert(std::is_trivially_default_constructible_v<SortedHit>);
 
 /// The arrays of a sorted order (TraceOrder), which a caster keeps for its next batch
 /// (CastMesh::trace_order): reused, they are neither allocated nor cleared by the
