@@ -2,6 +2,7 @@
 /// The C++ side of sahara.RayCaster: one triangle mesh, its wide8 BVH (the
 /// renderer's Accelerator) and the batch queries the bindings run with the GIL
 /// released, OpenMP over the rays.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -83,6 +84,10 @@ class CastMesh {
     /// Threads of the queries that do not name their own (0: all).
     int threads() const { return threads_; }
     void set_threads(int threads) { threads_ = threads; }
+    /// Rays per second and thread of the last batch (0: none yet), which sizes the next
+    /// batch's first slice between signal checks.
+    double slice_rate() const { return slice_rate_.load(std::memory_order_relaxed); }
+    void set_slice_rate(double rate) const { slice_rate_.store(rate, std::memory_order_relaxed); }
 
    private:
     Vec3 unit_normal(uint32_t triangle) const;
@@ -104,6 +109,7 @@ class CastMesh {
     /// from Python threads, each taking the buffers or, when another has them, new ones.
     mutable std::mutex spare_mutex_;
     mutable SortBuffers spare_;
+    mutable std::atomic<double> slice_rate_{0.0};
 };
 
 }  // namespace sahara::python
