@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -160,13 +161,14 @@ void bucket_range(const RayBatch& rays, size_t lo, size_t hi, size_t* count, Tra
         out.slot_of[i] = uint32_t(slot);
         SortedRay& r = out.rays[slot];
         if (f32) {
-            const float* row = rays.f32_row(i);
-            for (int k = 0; k < 3; ++k) r.origin[k] = row[k], r.dir[k] = row[3 + k];
+            std::memcpy(&r, rays.f32_row(i), 6 * sizeof(float));  // origin and direction
             r.tmin = rays.tmin(i), r.tmax = rays.tmax(i);
         } else {
             const Ray full = rays.ray(i);
-            r = SortedRay{{full.origin.x, full.origin.y, full.origin.z}, full.tmin,
-                          {full.dir.x, full.dir.y, full.dir.z}, full.tmax};
+            r = SortedRay{{full.origin.x, full.origin.y, full.origin.z},
+                          {full.dir.x, full.dir.y, full.dir.z},
+                          full.tmin,
+                          full.tmax};
         }
     }
 }

@@ -4,6 +4,7 @@
 /// walk mostly the same nodes and leaves, which stay in the cache, and coherent
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 #include <utility>
@@ -40,11 +41,12 @@ void resize_unwritten(UninitializedVector<T>& v, size_t n) {
 /// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
 /// over the sorted copies loads two rays per line.
 /// Plain floats, not Vec3: Vec3 zero-initialises, and sizing the buffer of a million
-/// copies would then write 32 MB of zeros on one thread before every sort.
+/// copies would then write 32 MB of zeros on one thread before every sort. Origin and
+/// direction in a row, as in a float32 batch row and in Ray, so each copies as a block.
 struct alignas(32) SortedRay {
     float origin[3];
-    float tmin;
     float dir[3];
+    float tmin;
     float tmax;
     Ray ray() const {
         Ray r;
@@ -54,7 +56,7 @@ struct alignas(32) SortedRay {
     }
 };
 static_assert(sizeof(SortedRay) == 32);
-static_assert(std::is_trivially_default_constructible_v<SortedRay>);
+static_assert(std::is_trivially_default_constructible_v<SortedRay> && offsetof(SortedRay, dir) == 12);
 
 
 /// A nearest hit as it waits in sorted order for the write-back (Hit without its

@@ -225,7 +225,9 @@ t is measured in units of |direction|) and optional tmin/tmax (a number or one
 value per ray; defaults 0 and inf; hits need tmin < t < tmax). Queries run
 with the GIL released on `threads` OpenMP threads (None or 0: all; the BVH build
 too); cast_rays and occluded take their own threads= and stop with
-KeyboardInterrupt on Ctrl-C.)doc")
+KeyboardInterrupt on Ctrl-C. Large incoherent batches are traced in a sorted
+order whose buffers (72 bytes per ray) the caster keeps for its next batch, up to
+128 MB.)doc")
         .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"), py::kw_only(),
              py::arg("threads") = py::none())
         .def_static("from_file", &mesh_from_file, py::arg("path"), py::kw_only(),
