@@ -121,8 +121,8 @@ size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBi
 /// `scratch` holding the batch-order keys first, then each bucket's sort scratch). The
 /// copies are not moved again: the tracer reads them through the sorted keys' slots.
 struct SortScratch {
-    std::vector<size_t> counts;          ///< per chunk and top bucket, then each chunk's slots
-    std::vector<size_t> bucket_start;    ///< kBuckets + 1 entries
+    std::vector<size_t> counts;        ///< per chunk and top bucket, then each chunk's slots
+    std::vector<size_t> bucket_start;  ///< kBuckets + 1 entries
 };
 
 /// Keys of rays [lo, hi) and their counts per top bucket.
@@ -213,8 +213,8 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     {
 #pragma omp for schedule(dynamic, 1)
         for (int64_t c = 0; c < chunk_count; ++c)
-            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, out.scratch.data(),
-                      &s.counts[size_t(c) * kBuckets]);
+            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale,
+                      out.scratch.data(), &s.counts[size_t(c) * kBuckets]);
 #pragma omp single
         place_buckets(s, chunks);
 #pragma omp for schedule(dynamic, 1)

@@ -58,7 +58,6 @@ struct alignas(32) SortedRay {
 static_assert(sizeof(SortedRay) == 32);
 static_assert(std::is_trivially_default_constructible_v<SortedRay> && offsetof(SortedRay, dir) == 12);
 
-
 /// A nearest hit as it waits in sorted order for the write-back (Hit without its
 /// instance field: 16 bytes, four per cache line).
 struct SortedHit {
