@@ -119,6 +119,22 @@ def test_batches_of_changing_sizes_on_one_caster_match_batch_order():
         np.testing.assert_array_equal(caster.occluded(rays, tmin=tmin, tmax=tmax), np.isfinite(whole["t_hit"]))
 
 
+def test_concurrent_casts_on_one_caster_match_casts_one_after_another():
+    # Casts from several Python threads share the caster's kept sort buffers: each
+    # must get buffers of its own.
+    import concurrent.futures
+    v, f = icosphere(6)
+    caster = sahara.RayCaster(v, f, threads=1)
+    batches = [awkward_rays(40_000 + 10_000 * i, seed=30 + i) for i in range(4)]
+    expected = [caster.cast_rays(r, tmin=lo, tmax=hi) for r, lo, hi in batches]
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        for _ in range(2):
+            got = list(pool.map(lambda b: caster.cast_rays(b[0], tmin=b[1], tmax=b[2]), batches))
+            for g, e in zip(got, expected):
+                for key in e:
+                    np.testing.assert_array_equal(g[key], e[key], err_msg=key)
+
+
 def test_threads_property_and_from_file(tmp_path, sphere):
     v, f = sphere
     assert sahara.RayCaster(v, f).threads is None
