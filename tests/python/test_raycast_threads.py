@@ -135,6 +135,32 @@ def test_concurrent_casts_on_one_caster_match_casts_one_after_another():
                     np.testing.assert_array_equal(g[key], e[key], err_msg=key)
 
 
+def test_sorted_casts_on_the_sse2_path_match(tmp_path):
+    # The sort key has a baseline and an AVX2 build (SAHARA_SIMD picks the path, the
+    # traversal's too): the hits must not depend on it.
+    rays, tmin, tmax = awkward_rays(40_000, seed=41)
+    np.savez(tmp_path / "rays.npz", rays=rays, tmin=tmin, tmax=tmax)
+    child = textwrap.dedent(f"""
+        import sys
+        import numpy as np
+        sys.path.insert(0, {os.path.dirname(__file__)!r})
+        import sahara
+        from raycast_meshes import icosphere
+        v, f = icosphere(6)
+        a = np.load({str(tmp_path / "rays.npz")!r})
+        r = sahara.RayCaster(v, f).cast_rays(a["rays"], tmin=a["tmin"], tmax=a["tmax"])
+        np.savez({str(tmp_path / "hits.npz")!r}, **r)
+    """)
+    subprocess.run([sys.executable, "-c", child], check=True, timeout=300,
+                   env=dict(os.environ, SAHARA_SIMD="sse2"))
+    got = np.load(tmp_path / "hits.npz")
+    v, f = icosphere(6)
+    expected = sahara.RayCaster(v, f).cast_rays(rays, tmin=tmin, tmax=tmax)
+    assert 0.1 < np.isfinite(expected["t_hit"]).mean() < 0.9
+    for key in expected:
+        np.testing.assert_array_equal(got[key], expected[key], err_msg=key)
+
+
 def test_threads_property_and_from_file(tmp_path, sphere):
     v, f = sphere
     assert sahara.RayCaster(v, f).threads is None
