@@ -6,8 +6,11 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <utility>
+
+#include "accel/simd_path.h"
 
 namespace sahara::python {
 
@@ -29,7 +32,7 @@ constexpr int kChunksPerThread = 8;
 
 /// The cell of x in [lo, lo + kCells / scale); everything below goes to cell 0, NaN to
 /// cell 0 or the last (maxss and minss pass NaN through their first operand).
-uint32_t cell(float x, float lo, float scale) {
+[[gnu::always_inline]] inline uint32_t cell(float x, float lo, float scale) {
     const float f = (x - lo) * scale;
     return uint32_t(int(std::min(float(kCells - 1), std::max(f, 0.0f))));  // int: one cvttss2si
 }
@@ -66,8 +69,8 @@ constexpr int kKeyBlock = 16;
 /// is, so they visit the same nodes; keys of origin and direction leave random rays'
 /// neighbours far apart inside the box. Rays that miss the box share key 0 (any key is
 /// correct: it only orders the work).
-void segment_keys(const RayBatch& rays, size_t first, int count, const Bounds3& box, const float (&scale)[3],
-                  uint64_t* keys) {
+[[gnu::always_inline]] inline void segment_keys(const RayBatch& rays, size_t first, int count,
+                                                const Bounds3& box, const float (&scale)[3], uint64_t* keys) {
     float org[3][kKeyBlock] = {}, dir[3][kKeyBlock] = {}, enter[kKeyBlock] = {}, leave[kKeyBlock] = {};
     for (int i = 0; i < count; ++i) {
         const size_t j = first + size_t(i);
@@ -113,25 +116,36 @@ void cell_scales(const Bounds3& box, float (&scale)[3]) {
 /// The top kRadixBits of a key's code: the bucket of the first, global pass.
 size_t top_bucket(uint64_t key) { return size_t(key >> (32 + kKeyBits - kRadixBits)); }
 
-/// The sort's working arrays. The first pass moves each ray's key and its copy to
-/// the key's top bucket (reading the batch in order, so without scattered reads);
-/// each bucket, about a thousand rays per million that stay in the cache, is then
-/// sorted on its own by the remaining bits, its ray copies permuted in place (in
-/// TraceOrder::rays) through a per-thread buffer. Once the copies are bucketed,
-/// `keys` is free: each bucket's counting passes use its slots as scratch.
+/// The sort's working arrays besides TraceOrder's. The first pass moves each ray's
+/// key and its copy to the key's top bucket (reading the batch in order, so without
+/// scattered reads); each bucket, about a thousand rays per million that stay in the
+/// cache, then has its keys sorted on their own by the remaining bits (TraceOrder's
+/// `scratch` holding the batch-order keys first, then each bucket's sort scratch). The
+/// copies are not moved again: the tracer reads them through the sorted keys' slots.
 struct SortScratch {
-    UninitializedVector<uint64_t> keys, bucketed;  ///< code << 32 | batch index, then | bucketed slot
-    UninitializedVector<uint32_t> index;           ///< batch index of each bucketed slot
-    std::vector<size_t> counts;                    ///< per chunk and top bucket, then each chunk's slots
-    std::vector<size_t> bucket_start;              ///< kBuckets + 1 entries
+    std::vector<size_t> counts;        ///< per chunk and top bucket, then each chunk's slots
+    std::vector<size_t> bucket_start;  ///< kBuckets + 1 entries
 };
 
 /// Keys of rays [lo, hi) and their counts per top bucket.
-void key_range(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& box, const float (&scale)[3],
-               uint64_t* keys, size_t* count) {
+[[gnu::always_inline]] inline void key_range_body(const RayBatch& rays, size_t lo, size_t hi,
+                                                  const Bounds3& box, const float (&scale)[3], uint64_t* keys,
+                                                  size_t* count) {
     for (size_t first = lo; first < hi; first += kKeyBlock)
         segment_keys(rays, first, int(std::min<size_t>(kKeyBlock, hi - first)), box, scale, &keys[first]);
     for (size_t i = lo; i < hi; ++i) ++count[top_bucket(keys[i])];
+}
+
+/// key_range_body for the baseline and, 8 lanes per step, for AVX2 (the key's arithmetic
+/// is the same IEEE operations either way, with no contraction into FMA).
+void key_range_sse2(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& box, const float (&scale)[3],
+                    uint64_t* keys, size_t* count) {
+    key_range_body(rays, lo, hi, box, scale, keys, count);
+}
+__attribute__((target("avx2"))) void key_range_avx2(const RayBatch& rays, size_t lo, size_t hi,
+                                                    const Bounds3& box, const float (&scale)[3],
+                                                    uint64_t* keys, size_t* count) {
+    key_range_body(rays, lo, hi, box, scale, keys, count);
 }
 
 /// Bucket by bucket, chunk by chunk: each chunk's first slot in each bucket (the
@@ -151,57 +165,44 @@ void place_buckets(SortScratch& s, size_t chunks) {
 
 /// Moves rays [lo, hi) to their top buckets: key (low half now the bucketed slot),
 /// batch index and ray copy; records each ray's slot.
-void bucket_range(const RayBatch& rays, size_t lo, size_t hi, SortScratch& s, size_t* count,
-                  TraceOrder& out) {
+void bucket_range(const RayBatch& rays, size_t lo, size_t hi, size_t* count, TraceOrder& out) {
     // float32 rows are copied as they are; other layouts go through the converting reader.
     const bool f32 = lo < hi && rays.f32_row(lo) != nullptr;
     for (size_t i = lo; i < hi; ++i) {
-        const uint64_t key = s.keys[i];
+        const uint64_t key = out.scratch[i];
         const size_t slot = count[top_bucket(key)]++;
-        s.bucketed[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
-        s.index[slot] = uint32_t(key);
+        out.keys[slot] = (key & ~uint64_t(0xFFFFFFFFu)) | uint64_t(slot);
+        out.index[slot] = uint32_t(key);
         out.slot_of[i] = uint32_t(slot);
         SortedRay& r = out.rays[slot];
         if (f32) {
-            const float* row = rays.f32_row(i);
-            r.origin = Vec3(row[0], row[1], row[2]), r.dir = Vec3(row[3], row[4], row[5]);
+            std::memcpy(&r, rays.f32_row(i), 6 * sizeof(float));  // origin and direction
             r.tmin = rays.tmin(i), r.tmax = rays.tmax(i);
         } else {
             const Ray full = rays.ray(i);
-            r = SortedRay{full.origin, full.tmin, full.dir, full.tmax};
+            r = SortedRay{{full.origin.x, full.origin.y, full.origin.z},
+                          {full.dir.x, full.dir.y, full.dir.z},
+                          full.tmin,
+                          full.tmax};
         }
     }
 }
 
-/// Sorts one top bucket [lo, hi) by the code's lower bits (two stable counting passes
-/// through `tmp`) and writes its part of the order and slots; its ray copies are
-/// put in that order through `held`.
-void sort_bucket(SortScratch& s, size_t lo, size_t hi, uint64_t* tmp, UninitializedVector<SortedRay>& held,
-                 TraceOrder& out) {
-    uint64_t* keys = s.bucketed.data() + lo;
-    const size_t n = hi - lo;
-    if (n > 1) {
-        uint32_t count[2][kBuckets] = {};
-        for (size_t i = 0; i < n; ++i) {
-            ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
-            ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
-        }
-        for (auto& c : count) {
-            uint32_t next = 0;
-            for (uint32_t& x : c) next += std::exchange(x, next);
-        }
-        for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
-        for (size_t i = 0; i < n; ++i)
-            keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
+/// Sorts one top bucket's keys [lo, hi) by the code's lower bits (two stable counting
+/// passes through `tmp`).
+void sort_bucket(uint64_t* keys, size_t n, uint64_t* tmp) {
+    if (n < 2) return;
+    uint32_t count[2][kBuckets] = {};
+    for (size_t i = 0; i < n; ++i) {
+        ++count[0][(keys[i] >> 32) & (kBuckets - 1)];
+        ++count[1][(keys[i] >> (32 + kRadixBits)) & (kBuckets - 1)];
     }
-    if (held.size() < n) held.resize(n);
-    std::copy(out.rays.begin() + ptrdiff_t(lo), out.rays.begin() + ptrdiff_t(hi), held.begin());
-    for (size_t k = lo; k < hi; ++k) {
-        const auto slot = uint32_t(s.bucketed[k]);
-        out.order[k] = s.index[slot];
-        out.slot[k] = slot;
-        out.rays[k] = held[slot - lo];
+    for (auto& c : count) {
+        uint32_t next = 0;
+        for (uint32_t& x : c) next += std::exchange(x, next);
     }
+    for (size_t i = 0; i < n; ++i) tmp[count[0][(keys[i] >> 32) & (kBuckets - 1)]++] = keys[i];
+    for (size_t i = 0; i < n; ++i) keys[count[1][(tmp[i] >> (32 + kRadixBits)) & (kBuckets - 1)]++] = tmp[i];
 }
 
 }  // namespace
@@ -214,32 +215,41 @@ void sort_rays(const Bounds3& box, int threads, TraceOrder& out) {
     float scale[3];
     cell_scales(box, scale);
     SortScratch s;
-    s.keys.resize(n), s.bucketed.resize(n), s.index.resize(n);
+    const bool avx2 = active_simd_path() != SimdPath::sse2;
     // More chunks than threads, taken dynamically: a thread the system holds back
     // (a shared machine) then delays the passes by one chunk, not by half the batch.
     const size_t chunks = std::min(n, size_t(kChunksPerThread) * size_t(threads));
     s.counts.assign(chunks * kBuckets, 0);
     s.bucket_start.resize(kBuckets + 1);
-    out.order.resize(n), out.slot.resize(n), out.slot_of.resize(n), out.rays.resize(n);
+    for (auto* v : {&out.keys, &out.scratch}) resize_unwritten(*v, n);
+    for (auto* v : {&out.index, &out.slot_of}) resize_unwritten(*v, n);
+    resize_unwritten(out.rays, n);
     const auto chunk_count = int64_t(chunks);
 #pragma omp parallel num_threads(threads)
     {
 #pragma omp for schedule(dynamic, 1)
         for (int64_t c = 0; c < chunk_count; ++c)
-            key_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, box, scale, s.keys.data(),
-                      &s.counts[size_t(c) * kBuckets]);
+            (avx2 ? key_range_avx2 : key_range_sse2)(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks,
+                                                     box, scale, out.scratch.data(),
+                                                     &s.counts[size_t(c) * kBuckets]);
 #pragma omp single
         place_buckets(s, chunks);
 #pragma omp for schedule(dynamic, 1)
         for (int64_t c = 0; c < chunk_count; ++c)
-            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks, s,
+            bucket_range(rays, n * size_t(c) / chunks, n * size_t(c + 1) / chunks,
                          &s.counts[size_t(c) * kBuckets], out);
-        UninitializedVector<SortedRay> held;
 #pragma omp for schedule(dynamic, 4)
-        for (size_t bucket = 0; bucket < kBuckets; ++bucket)
-            sort_bucket(s, s.bucket_start[bucket], s.bucket_start[bucket + 1],
-                        s.keys.data() + s.bucket_start[bucket], held, out);
+        for (size_t bucket = 0; bucket < kBuckets; ++bucket) {
+            const size_t lo = s.bucket_start[bucket], hi = s.bucket_start[bucket + 1];
+            sort_bucket(out.keys.data() + lo, hi - lo, out.scratch.data() + lo);
+        }
     }
+}
+
+size_t SortBuffers::bytes() const {
+    return keys.capacity() * sizeof(uint64_t) + scratch.capacity() * sizeof(uint64_t) +
+           index.capacity() * sizeof(uint32_t) + slot_of.capacity() * sizeof(uint32_t) +
+           rays.capacity() * sizeof(SortedRay) + hits.capacity() * sizeof(SortedHit);
 }
 
 bool runs_are_coherent(const RayBatch& rays, float max_chord, float max_offset) {

@@ -4,7 +4,10 @@
 /// walk mostly the same nodes and leaves, which stay in the cache, and coherent
 /// runs (a camera's rays) can go through the packet traversal. Results are still
 /// written at each ray's own index.
+#include <cstddef>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -27,20 +30,33 @@ inline constexpr size_t kMinSortedRays = size_t(1) << 14;
 template <class T>
 using UninitializedVector = std::vector<T, FillLaterAllocator<T, 64>>;
 
+/// Sizes `v` to n unwritten elements, its old ones dropped: storage with room is kept,
+/// and storage without is replaced with nothing copied.
+template <class T>
+void resize_unwritten(UninitializedVector<T>& v, size_t n) {
+    v.clear();
+    v.resize(n);
+}
+
 /// A ray as the sorted traversal reads it: half a cache line, so a sequential walk
 /// over the sorted copies loads two rays per line.
+/// Plain floats, not Vec3: Vec3 zero-initialises, and sizing the buffer of a million
+/// copies would then write 32 MB of zeros on one thread before every sort. Origin and
+/// direction in a row, as in a float32 batch row and in Ray, so each copies as a block.
 struct alignas(32) SortedRay {
-    Vec3 origin;
+    float origin[3];
+    float dir[3];
     float tmin;
-    Vec3 dir;
     float tmax;
     Ray ray() const {
         Ray r;
-        r.origin = origin, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
+        r.origin = Vec3(origin[0], origin[1], origin[2]), r.dir = Vec3(dir[0], dir[1], dir[2]);
+        r.tmin = tmin, r.tmax = tmax;
         return r;
     }
 };
 static_assert(sizeof(SortedRay) == 32);
+static_assert(std::is_trivially_default_constructible_v<SortedRay> && offsetof(SortedRay, dir) == 12);
 
 /// A nearest hit as it waits in sorted order for the write-back (Hit without its
 /// instance field: 16 bytes, four per cache line).
@@ -49,32 +65,52 @@ struct SortedHit {
     uint32_t prim;
     float u, v;
 };
+static_assert(std::is_trivially_default_constructible_v<SortedHit>);
 
-/// The rays a query traces, in the order it traces them: the batch itself, or the
-/// batch sorted (sort_rays) into contiguous copies, position k holding the batch's
-/// ray order[k]. The sort moves each ray first to a slot of its top bucket and then
-/// sorts each bucket in the cache; results go back the same way (by slot, then
-/// slot_of each batch index), so neither direction reads or writes one cache line
-/// per ray at random.
-struct TraceOrder {
-    const RayBatch& batch;
-    UninitializedVector<uint32_t> order;    ///< empty: the batch's own order
-    UninitializedVector<uint32_t> slot;     ///< with `order`: the bucketed slot of position k
-    UninitializedVector<uint32_t> slot_of;  ///< with `order`: the bucketed slot of each batch index
-    UninitializedVector<SortedRay> rays;    ///< with `order`: the rays in that order
-    /// Nearest hits by bucketed slot (with `order` only): a bucket's hits are written
-    /// while its rays are traced, then read back in batch order as one sequential
-    /// stream per bucket.
+/// The arrays of a sorted order (TraceOrder), which a caster keeps for its next batch
+/// (CastMesh::trace_order): reused, they are neither allocated nor cleared by the
+/// kernel again, which otherwise zero-fills tens of MB per million rays.
+struct SortBuffers {
+    /// code << 32 | slot, in traced order (empty: the batch's own order).
+    UninitializedVector<uint64_t> keys;
+    /// code << 32 | batch index in batch order, then each bucket's sort scratch.
+    UninitializedVector<uint64_t> scratch;
+    UninitializedVector<uint32_t> index;    ///< the batch index of each slot
+    UninitializedVector<uint32_t> slot_of;  ///< the slot of each batch index
+    UninitializedVector<SortedRay> rays;    ///< the ray copies by slot
+    /// Nearest hits by slot: a bucket's hits are written while its rays are traced,
+    /// then read back in batch order as one sequential stream per bucket.
     UninitializedVector<SortedHit> hits;
 
-    bool sorted() const { return !order.empty(); }
-    size_t size() const { return batch.size(); }
-    Ray ray(size_t k) const { return sorted() ? rays[k].ray() : batch.ray(k); }
-    /// The batch index of position k (where its result goes).
-    size_t index(size_t k) const { return sorted() ? size_t(order[k]) : k; }
+    /// Bytes held (capacities).
+    size_t bytes() const;
 };
 
-/// Sorts the batch's rays into `out` (order, slot, slot_of, rays) by a Morton code of the
+/// The rays a query traces, in the order it traces them: the batch itself, or the
+/// batch sorted (sort_rays). The sort copies each ray once, to a slot of its top
+/// bucket (contiguous per bucket), and then sorts each bucket's keys in the cache;
+/// position k traces the ray in slot slot(k), which lies in the same bucket as the
+/// slots around it, so the tracer reads one bucket's copies (a few tens of kB) at a
+/// time. Results go back the same way (by slot, then slot_of each batch index), so
+/// neither direction reads or writes one cache line per ray at random.
+struct TraceOrder : SortBuffers {
+    /// The batch in its own order, with `reuse`'s storage for a sort.
+    TraceOrder(const RayBatch& rays, SortBuffers&& reuse) : SortBuffers(std::move(reuse)), batch(rays) {
+        keys.clear();
+    }
+
+    const RayBatch& batch;
+
+    bool sorted() const { return !keys.empty(); }
+    size_t size() const { return batch.size(); }
+    /// The slot of position k (sorted orders only).
+    uint32_t slot(size_t k) const { return uint32_t(keys[k]); }
+    Ray ray(size_t k) const { return sorted() ? rays[slot(k)].ray() : batch.ray(k); }
+    /// The batch index of position k (where its result goes).
+    size_t index_of(size_t k) const { return sorted() ? size_t(index[slot(k)]) : k; }
+};
+
+/// Sorts the batch's rays into `out` (keys, index, slot_of, rays) by a Morton code of the
 /// points where each ray enters and leaves `box` (the mesh's bounds; 5 bits per
 /// coordinate, 30 in all), ties in batch order. Leaves `out` unsorted below
 /// kMinSortedRays or at 2^32 rays and more. OpenMP on `threads` (0: all).

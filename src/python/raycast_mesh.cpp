@@ -100,18 +100,30 @@ float CastMesh::packet_max_offset() const {
 }
 
 TraceOrder CastMesh::trace_order(const RayBatch& rays, int threads) const {
-    TraceOrder out{rays, {}, {}, {}, {}, {}};
+    SortBuffers reuse;
+    {
+        const std::lock_guard lock(spare_mutex_);
+        reuse = std::move(spare_);
+    }
+    TraceOrder out(rays, std::move(reuse));
     if (!accel_ || accel_->bytes() < kMinSortedBvhBytes || rays.size() < kMinSortedRays ||
         runs_are_coherent(rays, kPacketMaxChord, packet_max_offset()))
         return out;
     sort_rays(accel_->bounds(), threads, out);
-    if (out.sorted()) out.hits.resize(out.order.size());
+    if (out.sorted()) resize_unwritten(out.hits, out.keys.size());
     return out;
+}
+
+void CastMesh::recycle(TraceOrder&& order) const {
+    const size_t bytes = order.bytes();
+    if (bytes > kMaxKeptSortBytes) return;
+    const std::lock_guard lock(spare_mutex_);
+    if (bytes > spare_.bytes()) spare_ = std::move(static_cast<SortBuffers&>(order));
 }
 
 void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const NearestHits& out) const {
     if (!rays.sorted()) return;
-    const auto n = int64_t(rays.order.size());
+    const auto n = int64_t(rays.keys.size());
     const int team = threads > 0 ? threads : omp_get_max_threads();
     const uint32_t* slot_of = rays.slot_of.data();
     const SortedHit* hits = rays.hits.data();
@@ -140,14 +152,19 @@ void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
     const int threads = team_size(slice);
     const int64_t item = work_item(slice, threads, 1);
     const SortedRay* in = rays.rays.data();
-    const uint32_t* slot = rays.slot.data();
+    const uint64_t* keys = rays.keys.data();
     SortedHit* hits = rays.hits.data();
+    // The copies of a bucket are read in its sorted order, at random within the bucket's
+    // few tens of kB: asked for a few rays ahead, as the hardware prefetcher cannot guess.
+    constexpr int64_t kRaysAhead = 8;
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
     for (int64_t k = first; k < last; ++k) {
-        Ray r = in[k].ray();
+        if (k + kRaysAhead < last) __builtin_prefetch(&in[uint32_t(keys[k + kRaysAhead])]);
+        const uint32_t slot = uint32_t(keys[k]);
+        Ray r = in[slot].ray();
         Hit h;
         if (accel_) accel_->intersect(r, h);
-        hits[slot[k]] = SortedHit{h.t, h.prim, h.u, h.v};
+        hits[slot] = SortedHit{h.t, h.prim, h.u, h.v};
     }
 }
 
@@ -189,7 +206,7 @@ void CastMesh::occluded(const TraceOrder& rays, RaySlice slice, bool* out) const
     const int64_t item = work_item(slice, threads, 1);
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
     for (int64_t k = first; k < last; ++k) {
-        out[rays.index(size_t(k))] = accel_ && accel_->occluded(rays.ray(size_t(k)));
+        out[rays.index_of(size_t(k))] = accel_ && accel_->occluded(rays.ray(size_t(k)));
     }
 }
 

@@ -2,8 +2,10 @@
 /// The C++ side of sahara.RayCaster: one triangle mesh, its wide8 BVH (the
 /// renderer's Accelerator) and the batch queries the bindings run with the GIL
 /// released, OpenMP over the rays.
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "geometry/hit.h"
@@ -16,6 +18,10 @@ class Accelerator;
 }
 
 namespace sahara::python {
+
+/// The most a caster keeps of its sort buffers between batches: those of about 1.8
+/// million rays (72 bytes per ray); larger batches allocate theirs each time.
+inline constexpr size_t kMaxKeptSortBytes = size_t(128) << 20;
 
 /// Nearest-hit results, one entry per ray (caller-owned storage).
 struct NearestHits {
@@ -56,8 +62,12 @@ class CastMesh {
 
     /// The order to trace a batch in: its own when it is short or its runs are already
     /// coherent (a camera's rays), otherwise sorted (ray_order), which keeps neighbouring
-    /// rays on the same nodes. OpenMP on `threads` (0: all).
+    /// rays on the same nodes, in the buffers the last batch left (recycle). OpenMP on
+    /// `threads` (0: all).
     TraceOrder trace_order(const RayBatch& rays, int threads) const;
+    /// Keeps the buffers of a finished order for the next batch, up to kMaxKeptSortBytes
+    /// (the larger of two concurrent batches' buffers wins).
+    void recycle(TraceOrder&& order) const;
     /// Positions [slice.first, slice.last) of `rays`; results go to each ray's batch index.
     /// With a sorted order the hits wait in rays.hits until write_sorted_hits.
     void nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out) const;
@@ -74,6 +84,10 @@ class CastMesh {
     /// Threads of the queries that do not name their own (0: all).
     int threads() const { return threads_; }
     void set_threads(int threads) { threads_ = threads; }
+    /// Rays per second and thread of the last batch (0: none yet), which sizes the next
+    /// batch's first slice between signal checks.
+    double slice_rate() const { return slice_rate_.load(std::memory_order_relaxed); }
+    void set_slice_rate(double rate) const { slice_rate_.store(rate, std::memory_order_relaxed); }
 
    private:
     Vec3 unit_normal(uint32_t triangle) const;
@@ -91,6 +105,11 @@ class CastMesh {
     std::vector<uint32_t> indices_;
     std::unique_ptr<Accelerator> accel_;
     int threads_ = 0;
+    /// Sort buffers between batches (trace_order, recycle); casts run concurrently
+    /// from Python threads, each taking the buffers or, when another has them, new ones.
+    mutable std::mutex spare_mutex_;
+    mutable SortBuffers spare_;
+    mutable std::atomic<double> slice_rate_{0.0};
 };
 
 }  // namespace sahara::python

@@ -41,8 +41,12 @@ py::array read_only_view(const T* data, size_t rows, const py::object& owner) {
 /// How long one slice of a cast should take: between slices the calling thread runs
 /// Python's signal handlers, so Ctrl-C waits about this long. Each slice's size follows
 /// the rays per second of the one before (rays cost from nanoseconds to milliseconds,
-/// depending on the mesh), starting small and growing at most fourfold per slice.
+/// depending on the mesh), growing at most fourfold per slice. The first takes a quarter
+/// of that time at the rate of the caster's last batch (small on its first batch):
+/// batches differ, and one with rays a hundred times slower than the last then still
+/// checks for Ctrl-C within seconds.
 constexpr double kSliceSeconds = 0.1;
+constexpr double kFirstSliceFraction = 0.25;
 constexpr size_t kFirstSliceRays = 4096;
 constexpr size_t kMinSliceRays = 256;
 
@@ -69,11 +73,18 @@ class ThreadsInScope {
 
 /// Runs `cast(slice)` over the batch slice by slice with the GIL released; between slices
 /// this thread runs Python's signal handlers, so Ctrl-C (or any exception a handler
-/// raises) stops the cast after the current slice.
+/// raises) stops the cast after the current slice. Every slice is a parallel region
+/// whose end all threads wait for (a thread the system holds back stalls the others),
+/// so a long cast should take few: the first slice is sized by the rate per thread of
+/// the caster's last batch (CastMesh::slice_rate), which this cast then updates with the
+/// rate of its longest slice.
 template <class Cast>
-void cast_interruptibly(size_t count, int threads, const Cast& cast) {
+void cast_interruptibly(const CastMesh& mesh, size_t count, int threads, const Cast& cast) {
     using Clock = std::chrono::steady_clock;
-    size_t step = kFirstSliceRays;
+    const int team = threads > 0 ? threads : omp_get_max_threads();
+    size_t step =
+        std::max(kFirstSliceRays, size_t(mesh.slice_rate() * team * kSliceSeconds * kFirstSliceFraction));
+    double longest = 0.0, rate_of_longest = 0.0;
     for (size_t first = 0; first < count;) {
         const RaySlice slice{first, std::min(count, first + step), threads};
         const auto start = Clock::now();
@@ -84,9 +95,11 @@ void cast_interruptibly(size_t count, int threads, const Cast& cast) {
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();
         const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
         const double rate = double(slice.last - first) / std::max(seconds, 1e-6);
+        if (seconds > longest) longest = seconds, rate_of_longest = rate;
         step = std::clamp(size_t(rate * kSliceSeconds), kMinSliceRays, 4 * step);
         first = slice.last;
     }
+    if (longest > 0.0) mesh.set_slice_rate(rate_of_longest / team);
 }
 
 TraceOrder trace_order(const CastMesh& mesh, const RayBatch& rays, int threads) {
@@ -134,10 +147,11 @@ py::dict cast_rays(const CastMesh& mesh, const py::handle& rays_in, const py::ha
     auto normal = result_array<float>(rays, {3});
     const NearestHits out{t.mutable_data(), prim.mutable_data(), uv.mutable_data(), normal.mutable_data()};
     TraceOrder order = trace_order(mesh, rays, n);
-    cast_interruptibly(rays.size(), n, [&](RaySlice slice) { mesh.nearest(order, slice, out); });
+    cast_interruptibly(mesh, rays.size(), n, [&](RaySlice slice) { mesh.nearest(order, slice, out); });
     {
         py::gil_scoped_release release;
         mesh.write_sorted_hits(order, n, out);
+        mesh.recycle(std::move(order));
     }
     py::dict d;
     d["t_hit"] = t;
@@ -153,8 +167,9 @@ py::array_t<bool> occluded(const CastMesh& mesh, const py::handle& rays_in, cons
     const RayBatch rays(rays_in, tmin, tmax);
     auto out = result_array<bool>(rays);
     bool* p = out.mutable_data();
-    const TraceOrder order = trace_order(mesh, rays, n);
-    cast_interruptibly(rays.size(), n, [&](RaySlice slice) { mesh.occluded(order, slice, p); });
+    TraceOrder order = trace_order(mesh, rays, n);
+    cast_interruptibly(mesh, rays.size(), n, [&](RaySlice slice) { mesh.occluded(order, slice, p); });
+    mesh.recycle(std::move(order));
     return out;
 }
 
@@ -210,7 +225,9 @@ t is measured in units of |direction|) and optional tmin/tmax (a number or one
 value per ray; defaults 0 and inf; hits need tmin < t < tmax). Queries run
 with the GIL released on `threads` OpenMP threads (None or 0: all; the BVH build
 too); cast_rays and occluded take their own threads= and stop with
-KeyboardInterrupt on Ctrl-C.)doc")
+KeyboardInterrupt on Ctrl-C. Large incoherent batches are traced in a sorted
+order whose buffers (72 bytes per ray) the caster keeps for its next batch, up to
+128 MB.)doc")
         .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"), py::kw_only(),
              py::arg("threads") = py::none())
         .def_static("from_file", &mesh_from_file, py::arg("path"), py::kw_only(),

@@ -102,6 +102,65 @@ def test_sorted_tracing_of_awkward_rays_matches_tracing_in_batch_order():
                                       np.isfinite(reference["t_hit"]))
 
 
+def test_batches_of_changing_sizes_on_one_caster_match_batch_order():
+    # A caster keeps its sort buffers for the next batch: later batches, larger or
+    # smaller, and occlusion queries in between, must not see what an earlier one left.
+    v, f = icosphere(6)
+    caster = sahara.RayCaster(v, f)
+    for count, seed in ((60_000, 21), (20_000, 22), (90_000, 23), (30_000, 24)):
+        rays, tmin, tmax = awkward_rays(count, seed)
+        step = 5000
+        parts = [caster.cast_rays(rays[i:i + step], tmin=tmin[i:i + step], tmax=tmax[i:i + step])
+                 for i in range(0, count, step)]
+        whole = caster.cast_rays(rays, tmin=tmin, tmax=tmax)
+        for key in whole:
+            np.testing.assert_array_equal(whole[key], np.concatenate([p[key] for p in parts]),
+                                          err_msg=f"{key}, {count} rays")
+        np.testing.assert_array_equal(caster.occluded(rays, tmin=tmin, tmax=tmax), np.isfinite(whole["t_hit"]))
+
+
+def test_concurrent_casts_on_one_caster_match_casts_one_after_another():
+    # Casts from several Python threads share the caster's kept sort buffers: each
+    # must get buffers of its own.
+    import concurrent.futures
+    v, f = icosphere(6)
+    caster = sahara.RayCaster(v, f, threads=1)
+    batches = [awkward_rays(40_000 + 10_000 * i, seed=30 + i) for i in range(4)]
+    expected = [caster.cast_rays(r, tmin=lo, tmax=hi) for r, lo, hi in batches]
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        for _ in range(2):
+            got = list(pool.map(lambda b: caster.cast_rays(b[0], tmin=b[1], tmax=b[2]), batches))
+            for g, e in zip(got, expected):
+                for key in e:
+                    np.testing.assert_array_equal(g[key], e[key], err_msg=key)
+
+
+def test_sorted_casts_on_the_sse2_path_match(tmp_path):
+    # The sort key has a baseline and an AVX2 build (SAHARA_SIMD picks the path, the
+    # traversal's too): the hits must not depend on it.
+    rays, tmin, tmax = awkward_rays(40_000, seed=41)
+    np.savez(tmp_path / "rays.npz", rays=rays, tmin=tmin, tmax=tmax)
+    child = textwrap.dedent(f"""
+        import sys
+        import numpy as np
+        sys.path.insert(0, {os.path.dirname(__file__)!r})
+        import sahara
+        from raycast_meshes import icosphere
+        v, f = icosphere(6)
+        a = np.load({str(tmp_path / "rays.npz")!r})
+        r = sahara.RayCaster(v, f).cast_rays(a["rays"], tmin=a["tmin"], tmax=a["tmax"])
+        np.savez({str(tmp_path / "hits.npz")!r}, **r)
+    """)
+    subprocess.run([sys.executable, "-c", child], check=True, timeout=300,
+                   env=dict(os.environ, SAHARA_SIMD="sse2"))
+    got = np.load(tmp_path / "hits.npz")
+    v, f = icosphere(6)
+    expected = sahara.RayCaster(v, f).cast_rays(rays, tmin=tmin, tmax=tmax)
+    assert 0.1 < np.isfinite(expected["t_hit"]).mean() < 0.9
+    for key in expected:
+        np.testing.assert_array_equal(got[key], expected[key], err_msg=key)
+
+
 def test_threads_property_and_from_file(tmp_path, sphere):
     v, f = sphere
     assert sahara.RayCaster(v, f).threads is None
