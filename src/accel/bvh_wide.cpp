@@ -1,7 +1,6 @@
 #include "accel/bvh_wide.h"
 
 #include <array>
-#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -59,56 +58,7 @@ class CollapsePlan {
         return n;
     }
 
-    /// BvhWideNode::octant_order of the wide node for binary inner node `inner`, its
-    /// children in the slots `children` gives them, for direction octant `octant`.
-    uint32_t octant_order(uint32_t inner, int octant) const {
-        static_assert(N <= 8, "4-bit slots, eight per word");
-        int order[N], n = 0;
-        order_pair(bvh_.nodes[inner].index, plan_[inner].left_slots[N], N, 0, octant, order, n);
-        uint32_t word = 0;
-        for (int p = 0; p < N; ++p) word |= uint32_t(p < n ? order[p] : p) << (4 * p);
-        return word;
-    }
-
    private:
-    /// Slots emit(x, k) fills.
-    int emitted(uint32_t x, int k) const {
-        const BvhNode& node = bvh_.nodes[x];
-        if (node.is_leaf() || !plan_[x].open[k]) return 1;
-        const int j = plan_[x].left_slots[k];
-        return emitted(node.index, j) + emitted(node.index + 1, k - j);
-    }
-    /// Appends to order[n..] the slots of binary siblings `first` (j slots from `base`)
-    /// and first + 1 (the k - j after), the one farther along the octant's direction first.
-    void order_pair(uint32_t first, int j, int k, int base, int octant, int* order, int& n) const {
-        const BvhNode& l = bvh_.nodes[first];
-        const BvhNode& r = bvh_.nodes[first + 1];
-        int axis = 0;
-        float sep = -1.0f, d = 0.0f;
-        for (int a = 0; a < 3; ++a) {
-            const float da =
-                (r.bounds[2 * a] + r.bounds[2 * a + 1]) - (l.bounds[2 * a] + l.bounds[2 * a + 1]);
-            if (std::fabs(da) > sep) sep = std::fabs(da), axis = a, d = da;
-        }
-        const bool right_first = ((octant >> axis) & 1) ? d < 0.0f : d > 0.0f;
-        const int left_slots = emitted(first, j);
-        if (right_first) {
-            order_sub(first + 1, k - j, base + left_slots, octant, order, n);
-            order_sub(first, j, base, octant, order, n);
-        } else {
-            order_sub(first, j, base, octant, order, n);
-            order_sub(first + 1, k - j, base + left_slots, octant, order, n);
-        }
-    }
-    void order_sub(uint32_t x, int k, int base, int octant, int* order, int& n) const {
-        const BvhNode& node = bvh_.nodes[x];
-        if (node.is_leaf() || !plan_[x].open[k]) {
-            order[n++] = base;
-            return;
-        }
-        order_pair(node.index, plan_[x].left_slots[k], k, base, octant, order, n);
-    }
-
     using Costs = std::array<double, N + 1>;  ///< [k]: least cost of a subtree in k slots
     struct Choice {
         std::array<uint8_t, N + 1> left_slots;  ///< [k]: slots of the left child when opened
@@ -289,7 +239,6 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
         const int n = plan.children(it.node, kids);
         BvhWideNode<N> p = empty_node<N>();
         for (int c = 0; c < n; ++c) set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
-        for (int o = 0; o < 8; ++o) p.octant_order[o] = plan.octant_order(it.node, o);
         out.nodes.push_back(p);
         for (int c = n - 1; c >= 0; --c)
             if (!kids[c].count) stack.push_back({kids[c].node, index, c});

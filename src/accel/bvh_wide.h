@@ -31,19 +31,11 @@ inline uint32_t ref_first(uint32_t ref) { return ref >> kLeafCountBits; }
 
 /// One N-wide node; child c is empty (child[c] == kNoNode), inner (child = the node's
 /// byte offset) or a leaf (child = wide_leaf_ref(first, count)). The alignment pads it
-/// to whole cache lines (the last one: child links and visiting orders).
+/// to whole cache lines (the last one half used).
 template <int N>
 struct alignas(64) BvhWideNode {
     float lo_x[N], hi_x[N], lo_y[N], hi_y[N], lo_z[N], hi_z[N];  ///< 24 N bytes of child bounds
     uint32_t child[N];
-    /// Any-hit visiting orders, in the padding of the child line: for a ray in direction
-    /// octant o (bit a set: negative along axis a), word o holds the slot of the p-th child
-    /// to visit in bits [4 p, 4 p + 4), empty slots last. At each binary split the collapse
-    /// merged into this node, the half farther along the direction goes first (the axis
-    /// that separates the halves' centres most): close to farthest entry first, which suits
-    /// rays stopped by an enclosure's far shell (BvhWide::occlusion_far_first), with no
-    /// sort in the node step (intersect_bvh8_ordered_avx512).
-    uint32_t octant_order[8];
 
     static constexpr int kWidth = N;
     bool has_child(int c) const { return child[c] != kNoNode; }
@@ -65,9 +57,8 @@ struct BvhWide {
     std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>>
         nodes;  ///< nodes[0]: the root's children
     bool empty = true;
-    /// Any-hit traversal visits the hit children farthest first, not in slot order
-    /// (traverse_wide; the AVX-512 step by BvhWideNode::octant_order, the others by entry
-    /// distance). Rays that leave a surface inside an enclosure (a room) are mostly
+    /// Any-hit traversal visits the hit children farthest entry first, not in slot order
+    /// (traverse_wide). Rays that leave a surface inside an enclosure (a room) are mostly
     /// stopped by the far shell, not by what lies around their origin; set per tree by
     /// whoever knows which order suits it (Accelerator: OcclusionOrder).
     bool occlusion_far_first = false;

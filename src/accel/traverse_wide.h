@@ -22,9 +22,7 @@ enum class LeafResult : uint8_t {
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
 /// pushed farthest first. Any-hit rays visit children in slot order instead, or
-/// farthest first where the tree says so (BvhWide::occlusion_far_first): the AVX-512
-/// step in the node's order for the ray's octant (BvhWideNode::octant_order), the
-/// others by entry distance.
+/// farthest entry first where the tree says so (BvhWide::occlusion_far_first).
 /// kAvx: 8-wide box tests in AVX (caller compiled for AVX2); kAvx512: 8-wide nodes
 /// take the AVX-512 step (intersect_bvh8_compress_avx512).
 /// kPairNodes (8-wide; closest hit on the AVX2 and AVX-512 steps, any hit on the AVX2
@@ -119,9 +117,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     auto far_key = [](float t) __attribute__((always_inline)) {
         return std::bit_cast<float>(0x7F7FFFFFu - std::bit_cast<uint32_t>(t));
     };
-    size_t order_off = 0;
-    if constexpr (kAvx512 && N == 8 && kAnyHit)
-        if (far_first) order_off = octant_order_offset(ray);
     // Pops the nearest pending entry that can still hold a closer hit into `cur`.
     auto pop = [&]() __attribute__((always_inline)) {
         for (;;) {
@@ -158,13 +153,26 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                 if constexpr (!std::is_same_v<Counters, NoTraversalCounters>)
                     for (int c = 0; c < N; ++c) counters.on_nodes(n.has_child(c) ? 1 : 0);
                 if constexpr (kAvx512 && N == 8 && kAnyHit) {
-                    // Far first takes the node's precomputed order for the ray's direction
-                    // (BvhWideNode::octant_order), not a sort by entry distance.
-                    const Bvh8HitChildren h =
-                        far_first ? intersect_bvh8_ordered_avx512(n, rw.avx, ray.tmin, tmax_far, order_off,
-                                                                  reinterpret_cast<uint64_t*>(&stack[top]))
-                                  : intersect_bvh8_entries_avx512(n, rw.avx, ray.tmin, tmax_far,
-                                                                  reinterpret_cast<uint64_t*>(&stack[top]));
+                    if (far_first) {
+                        alignas(32) uint32_t ref[N];
+                        alignas(32) float t[N];
+                        const Bvh8HitChildren h =
+                            intersect_bvh8_compress_avx512(n, rw.avx, ray.tmin, tmax_far, ref, t);
+                        if (!h.mask) {
+                            if (!pop()) return found;
+                            continue;
+                        }
+                        cur = Entry{h.ref0, far_key(h.t0)};
+                        const int hits = __builtin_popcount(h.mask), base = top;
+                        for (int i = 1; i < hits; ++i) {
+                            Entry in{ref[i], far_key(t[i])};
+                            nearer_first(cur, in);
+                            push_sorted(base, in);
+                        }
+                        continue;
+                    }
+                    const Bvh8HitChildren h = intersect_bvh8_entries_avx512(
+                        n, rw.avx, ray.tmin, tmax_far, reinterpret_cast<uint64_t*>(&stack[top]));
                     if (h.mask) {
                         // The first hit child is visited next, the others stay pushed (the
                         // last one on top); no branch on the number of hits.

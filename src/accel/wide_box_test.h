@@ -248,47 +248,6 @@ intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin
     return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), 0.0f};
 }
 
-/// Byte offset in a Bvh8Node of the any-hit visiting order for ray `r`
-/// (BvhWideNode::octant_order): its direction's octant.
-inline size_t octant_order_offset(const BvhRay& r) {
-    return offsetof(Bvh8Node, octant_order) +
-           sizeof(uint32_t) * size_t(r.neg[0] | r.neg[1] << 1 | r.neg[2] << 2);
-}
-
-/// The AVX-512 node step of an any-hit ray in the node's order for the ray's direction
-/// (`order_off`, octant_order_offset): as intersect_bvh8_entries_avx512, but the children
-/// are ranked by that order, not by slot; the first hit in it comes back in registers,
-/// the others are written to entries[0..8) last first, so that the second in the order
-/// ends on top of the stack. Only the hit compare waits for the permutation (the order is
-/// read beside the planes); no sort, no branch on the number of hits.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
-intersect_bvh8_ordered_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
-                              size_t order_off, uint64_t* entries) {
-    __m256i entry, neg_exit;
-    bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
-    uint32_t word;
-    std::memcpy(&word, reinterpret_cast<const char*>(&n) + order_off, sizeof(word));
-    // Lane p: the slot ranked p (vpermd reads the low three bits only).
-    const __m256i order =
-        _mm256_srlv_epi32(_mm256_set1_epi32(int(word)), _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28));
-    const __m256i a = _mm256_permutexvar_epi32(order, _mm256_add_epi32(entry, _mm256_set1_epi32(0x7FFFFFFF)));
-    const __m256i b = _mm256_permutexvar_epi32(order, _mm256_sub_epi32(neg_exit, _mm256_set1_epi32(1)));
-    __mmask8 k;  // the hit compare of bvh8_hits_avx512, in ranked lanes
-    asm("vpcmpud $2, %[b], %[a], %[k]" : [k] "=Yk"(k) : [a] "v"(a), [b] "v"(b));
-    const __m256i ranked =
-        _mm256_permutexvar_epi32(order, _mm256_load_si256(reinterpret_cast<const __m256i*>(n.child)));
-    const __m256i ch = _mm256_maskz_compress_epi32(k, ranked);
-    // Entry j takes hit number hits - 1 - j (indices below 0 fill entries past the hits).
-    const __m256i last = _mm256_set1_epi32(__builtin_popcount(unsigned(k)) - 1);
-    _mm256_storeu_si256(
-        reinterpret_cast<__m256i*>(entries),
-        _mm256_permutexvar_epi32(_mm256_sub_epi32(last, _mm256_setr_epi32(0, 0, 1, 1, 2, 2, 3, 3)), ch));
-    _mm256_storeu_si256(
-        reinterpret_cast<__m256i*>(entries + 4),
-        _mm256_permutexvar_epi32(_mm256_sub_epi32(last, _mm256_setr_epi32(4, 4, 5, 5, 6, 6, 7, 7)), ch));
-    return {unsigned(k), uint32_t(_mm256_cvtsi256_si32(ch)), 0.0f};
-}
-
 /// Box constants of one ray for an N-wide node: AVX for an 8-wide node when
 /// kAvx (the caller is compiled for AVX2), SSE otherwise.
 template <int N, bool kAvx>

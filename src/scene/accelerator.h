@@ -68,7 +68,7 @@ bool automatic_node_pairing(size_t tree_bytes, size_t cache_bytes, bool interior
 enum class OcclusionOrder : uint8_t {
     automatic,  ///< farthest first when it saves work on sample rays (Accelerator::choose_occlusion_order)
     slot,       ///< slot order: no sorting, best where an occluder is as likely near as far
-    far_first,  ///< farthest first (BvhWide::occlusion_far_first): interiors, where the shell stops most rays
+    far_first,  ///< farthest entry distance first: interiors, where the room's shell stops most rays
 };
 
 /// Build choices for an Accelerator.

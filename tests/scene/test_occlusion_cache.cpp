@@ -130,36 +130,3 @@ TEST_CASE("occlusion order: automatic picks farthest first in a room and slot or
     const Accelerator ground_accel(build_scene(d));
     CHECK_FALSE(ground_accel.occlusion_far_first());
 }
-
-TEST_CASE("occlusion order: rays in every direction octant get brute-force answers in both orders") {
-    // The ordered node step reads one visiting order per octant (BvhWideNode::octant_order).
-    SimdGuard guard;
-    const Scene scene = build_scene(room());
-    std::vector<Ray> rays;
-    for (int o = 0; o < 8; ++o) {
-        const Vec3 d = normalize(Vec3(o & 1 ? -0.3f : 0.3f, o & 2 ? -1.0f : 1.0f, o & 4 ? -0.45f : 0.45f));
-        for (int j = 0; j < 12; ++j)
-            for (int i = 0; i < 15; ++i)
-                rays.push_back(Ray{
-                    {0.15f + 0.65f * float(i), 0.15f + 0.65f * float(j), 0.05f + 0.2f * float(j % 12)}, d});
-    }
-    for (OcclusionOrder order : {OcclusionOrder::slot, OcclusionOrder::far_first}) {
-        AcceleratorOptions o;
-        o.occlusion_order = order;
-        const Accelerator accel(scene, o);
-        for (SimdPath path : runnable_simd_paths()) {
-            force_simd_path(path);
-            int wrong = 0, occluded = 0;
-            for (const Ray& r : rays) {
-                Ray b = r;
-                Hit h;
-                const bool want = accel.intersect_brute_force(b, h);
-                wrong += int(accel.occluded(r) != want);
-                occluded += int(want);
-            }
-            INFO(std::string(simd_path_name(path)), " far first ", order == OcclusionOrder::far_first);
-            CHECK(wrong == 0);
-            CHECK(occluded > int(rays.size()) / 2);
-        }
-    }
-}
