@@ -220,14 +220,18 @@ BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
 }
 
 double largest_box_area_share(std::span<const Bounds3> boxes) {
-    std::vector<double> areas(boxes.size());
+    // Areas are floats already; keeping them as floats halves the selection's memory,
+    // and the pass runs on every thread, since it sits in front of the build.
+    const auto n = int64_t(boxes.size());
+    std::vector<float> areas(boxes.size());
     double total = 0;
-    for (size_t i = 0; i < boxes.size(); ++i) total += areas[i] = double(boxes[i].surface_area());
+#pragma omp parallel for reduction(+ : total) schedule(static) if (n >= 65536)
+    for (int64_t i = 0; i < n; ++i) total += double(areas[size_t(i)] = boxes[size_t(i)].surface_area());
     if (!(total > 0)) return 0.0;
     const size_t k = std::max<size_t>(1, boxes.size() / 100);
     std::nth_element(areas.begin(), areas.begin() + std::ptrdiff_t(k - 1), areas.end(), std::greater<>());
     double top = 0;
-    for (size_t i = 0; i < k; ++i) top += areas[i];
+    for (size_t i = 0; i < k; ++i) top += double(areas[i]);
     return top / total;
 }
 
