@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -99,14 +101,15 @@ PrimitiveList collect_primitives(const Scene& scene) {
     return list;
 }
 
-/// BvhBuilder::automatic resolved for these primitives (see choose_bvh_builder).
-BvhBuilder resolve_builder(const PrimitiveList& prims, const AcceleratorOptions& options) {
+/// BvhBuilder::automatic resolved for `primitives` (see choose_bvh_builder);
+/// largest_share() is asked only for a long render.
+BvhBuilder resolve_builder(size_t primitives, const AcceleratorOptions& options,
+                           const std::function<double()>& largest_share) {
     if (options.builder != BvhBuilder::automatic) return options.builder;
     BvhWorkload w;
-    w.primitives = prims.size();
+    w.primitives = primitives;
     w.expected_rays = options.expected_rays;
-    if (w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives))
-        w.largest_share = largest_box_area_share(prims.box_span());
+    if (w.expected_rays >= kAutoMinRaysPerPrimitive * double(w.primitives)) w.largest_share = largest_share();
     return choose_bvh_builder(w);
 }
 
@@ -114,12 +117,6 @@ BvhBuilder resolve_builder(const PrimitiveList& prims, const AcceleratorOptions&
 size_t l2_cache_bytes() {
     const long bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
     return bytes > 0 ? size_t(bytes) : size_t(1) << 20;
-}
-
-/// Whether the primitives look like an interior (looks_like_interior); measured only
-/// for trees larger than the L2 cache, where node pairing asks.
-bool interior_like(const PrimitiveList& prims) {
-    return looks_like_interior(prims.size(), largest_box_area_share(prims.box_span()));
 }
 
 /// The flat loop: one root leaf over every primitive.
@@ -225,7 +222,13 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
     const BvhBuildParams params = options.build_params();
     const BvhBuildInput input{prims.box_span(), prims.center_span(), scene.triangles.positions,
                               scene.triangles.indices};
-    builder_ = resolve_builder(prims, options);
+    // One pass over every box, which the builder choice and node pairing may both ask for.
+    std::optional<double> share;
+    const std::function<double()> largest_share = [&] {
+        if (!share) share = largest_box_area_share(prims.box_span());
+        return *share;
+    };
+    builder_ = resolve_builder(prims.size(), options, largest_share);
     bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
     // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
     // straight from the scene into the layout's leaf storage.
@@ -248,7 +251,8 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
         if (options.node_pairing == NodePairing::always)
             pair_rays_ = PairRays::all;
         else if (bytes() > l2_cache_bytes() &&  // the interior test only where it matters
-                 automatic_node_pairing(bytes(), l2_cache_bytes(), interior_like(prims)))
+                 automatic_node_pairing(bytes(), l2_cache_bytes(),
+                                        looks_like_interior(prims.size(), largest_share())))
             pair_rays_ = PairRays::inside;
     }
     if (layout_ == BvhLayout::wide8 && uses_tree_) choose_occlusion_order(options.occlusion_order);
