@@ -56,7 +56,10 @@ void check_output_path(const fs::path& file) {
     if (dir.empty()) dir = ".";
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
-        throw input_error(name, "", "output directory '" + dir.string() + "' does not exist");
+        throw input_error(name, "", "output directory '" + dir.string() +
+                                        (fs::exists(dir, ec) ? "' is not a directory" : "' does not exist"));
+    // Checked now, not when the finished image cannot be renamed onto it.
+    if (fs::is_directory(file, ec)) throw input_error(name, "", "is a directory, not an image file name");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");
     if (file_kind(file) != FileKind::pfm)
         image_codec(name);  // a missing codec fails here, not after the render
@@ -151,8 +154,9 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
     std::error_code ec;
     fs::rename(tmp, file, ec);
     if (ec) {
+        const std::string why = ec.message();  // before remove() overwrites ec
         fs::remove(tmp, ec);
-        throw input_error(name, "", "cannot move the finished image into place: " + ec.message());
+        throw input_error(name, "", "cannot move the finished image into place: " + why);
     }
 }
 

@@ -313,8 +313,9 @@ void write_via_temporary(const std::string& file, Write&& write) {
     }
     fs::rename(tmp, file, ec);
     if (ec) {
+        const std::string why = ec.message();  // before remove() overwrites ec
         fs::remove(tmp, ec);
-        throw input_error(file, "", "cannot move the finished plot into place: " + ec.message());
+        throw input_error(file, "", "cannot move the finished plot into place: " + why);
     }
 }
 
