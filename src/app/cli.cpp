@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -94,7 +95,14 @@ int run_cli(int argc, char** argv) {
         const std::string first = app.remaining().empty() ? args[0] : app.remaining()[0];
         return usage_error("", (first[0] == '-' ? "unknown option '" : "unknown command '") + first + "'");
     }
-    return dispatch(cmd, chosen[0]->remaining());
+    try {
+        return dispatch(cmd, chosen[0]->remaining());
+    } catch (const std::bad_alloc&) {
+        // A film of 32768 x 32768 pixels alone needs 36 GiB: a size the format
+        // allows can still be more than the machine has.
+        std::fputs("sahara: error: out of memory (a smaller image or scene needs less)\n", stderr);
+        return 2;
+    }
 }
 
 }  // namespace sahara

@@ -17,6 +17,7 @@
 
 #include "app/cmd_info.h"
 #include "cli_test_util.h"
+#include "sanitizer_build.h"
 #include "scene/accelerator.h"
 #include "app/render_args.h"
 #include "geometry/sphere.h"
@@ -113,6 +114,18 @@ TEST_CASE("cli: a missing output directory exits 2 and writes nothing") {
     const CliRun r = run_sahara("render" + kSmall + "--spp 1 -o " + out, dir);
     CHECK(r.code == 2);
     CHECK(r.err.find("does not exist") != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+}
+
+TEST_CASE("cli: an image too large for the memory exits 2 with a message and writes nothing") {
+    // ASan reserves terabytes of address space at start: no address-space limit there.
+    if (sahara::test::kSanitized) return;
+    TempDir dir("oom");
+    const std::string out = dir / "big.png";
+    // 32768 x 32768 is in range, but its film needs 36 GiB: more than the 4 GiB allowed here.
+    const CliRun r = run_sahara("render --size 32768 --spp 1 -o " + out, dir, "ulimit -v 4000000;");
+    CHECK(r.code == 2);
+    CHECK(r.err.find("out of memory") != std::string::npos);
     CHECK_FALSE(fs::exists(out));
 }
 
