@@ -19,6 +19,7 @@
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
 #include "io/obj_material.h"
+#include "io/obj_text.h"
 
 namespace sahara {
 
@@ -41,7 +42,9 @@ std::filesystem::path portable_path(std::string name) {
 
 /// Opens the .mtl files named by `mtllib` relative to the .obj (with Windows
 /// separators tolerated); a missing one is a warning. Remembers the folder of
-/// the first one read: MTL texture paths are relative to it.
+/// the first one read: MTL texture paths are relative to it. Reports every
+/// file as not loaded: tinyobjloader stops at the first file of an `mtllib`
+/// line that loads, and all of them are wanted (each is read once).
 class MtlFileReader : public tinyobj::MaterialReader {
    public:
     explicit MtlFileReader(const std::filesystem::path& obj_file)
@@ -50,6 +53,7 @@ class MtlFileReader : public tinyobj::MaterialReader {
     bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* names, std::string* warn, std::string* err) override {
         const std::filesystem::path path = obj_file_.parent_path() / portable_path(name);
+        if (std::find(files_.begin(), files_.end(), path) != files_.end()) return false;
         std::optional<std::string> text;
         try {
             text = read_file(path);
@@ -63,9 +67,9 @@ class MtlFileReader : public tinyobj::MaterialReader {
         if (!found_) dir_ = path.parent_path();
         found_ = true;
         files_.push_back(path);
-        std::istringstream in(*text);
+        std::istringstream in(obj::prepare_mtl_text(*text));
         tinyobj::LoadMtl(names, materials, &in, warn, err);
-        return true;
+        return false;
     }
 
     const std::filesystem::path& texture_dir() const { return dir_; }
@@ -281,7 +285,7 @@ Vec3d far_model_centre(const std::vector<tinyobj::real_t>& v) {
 /// tinyobjloader's warnings, one line each; a missing .mtl is reported by MtlFileReader, and
 /// without materials (the BVH tools) unknown usemtl names are expected.
 void log_obj_warnings(const std::string& file, const std::string& warn, bool materials) {
-    std::istringstream warnings(warn);
+    std::istringstream warnings(obj::decode_material_name(warn));
     for (std::string line; std::getline(warnings, line);) {
         if (line.empty() || line.find("Failed to load material file") != std::string::npos) continue;
         if (!materials && line.find("not found in .mtl") != std::string::npos) continue;
@@ -299,8 +303,11 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
                      const ObjReadOptions& options) {
     const std::string text = read_file(file);
     obj::check_encoding(file.string(), text);
-    obj::check_obj_numbers(file.string(), text);
-    std::istringstream stream(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text);  // UTF-8 BOM
+    const std::string prepared =
+        obj::prepare_obj_text(text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text,  // UTF-8 BOM
+                              file.parent_path());
+    obj::check_obj_numbers(file.string(), prepared);
+    std::istringstream stream(prepared);
     MtlFileReader mtl_reader(file);
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
@@ -312,6 +319,7 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
                           /*default_vcols_fallback=*/false))
         throw input_error(file.string(), "", "malformed OBJ: " + first_line(err));
     log_obj_warnings(file.string(), warn, options.materials);
+    for (tinyobj::material_t& m : materials) m.name = obj::decode_material_name(m.name);
 
     LoadedModel model;
     obj::MtlKeys keys;

@@ -1,0 +1,72 @@
+// OBJ text tinyobjloader alone reads wrongly: several files on one mtllib line,
+// names with spaces, and line continuations.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "io/model_loader.h"
+
+using namespace sahara;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+    fs::path dir = fs::temp_directory_path() / ("sahara_obj_text_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
+
+/// The material names the model's triangles use.
+std::set<std::string> used_materials(const LoadedModel& m) {
+    std::set<std::string> names;
+    for (const TriangleMesh& mesh : m.meshes) {
+        if (mesh.material_ids.empty()) names.insert(m.materials.at(mesh.material).name);
+        for (uint32_t id : mesh.material_ids) names.insert(m.materials.at(id).name);
+    }
+    return names;
+}
+
+const std::string kTwoTriangles = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
+
+}  // namespace
+
+TEST_CASE("every file of an mtllib line with several files is read") {
+    const fs::path dir = scratch("multi");
+    write(dir / "a.mtl", "newmtl red\nKd 1 0 0\n");
+    write(dir / "b.mtl", "newmtl green\nKd 0 1 0\n");
+    write(dir / "m.obj", "mtllib a.mtl b.mtl\n" + kTwoTriangles +
+                             "usemtl red\nf 1 2 3\nusemtl green\nf 2 4 3\n");
+    const LoadedModel m = load_obj(dir / "m.obj");
+    CHECK(used_materials(m) == std::set<std::string>{"red", "green"});
+    // Named again on a later line, a file is not read twice.
+    write(dir / "twice.obj", "mtllib a.mtl\nmtllib a.mtl b.mtl\n" + kTwoTriangles +
+                                 "usemtl red\nf 1 2 3\nusemtl green\nf 2 4 3\n");
+    CHECK(load_obj(dir / "twice.obj").materials.size() == 2);
+}
+
+TEST_CASE("material and library names with spaces are kept whole") {
+    const fs::path dir = scratch("spaces");
+    write(dir / "my mats.mtl", "newmtl red paint\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n");
+    write(dir / "m.obj", "mtllib my mats.mtl\n" + kTwoTriangles +
+                             "usemtl red paint\nf 1 2 3\nusemtl green\nf 2 4 3\n");
+    const LoadedModel m = load_obj(dir / "m.obj");
+    CHECK(used_materials(m) == std::set<std::string>{"red paint", "green"});
+    for (const MaterialDesc& mat : m.materials)
+        if (mat.name == "red paint") CHECK(mat.albedo.color == Rgb(1, 0, 0));
+}
+
+TEST_CASE("OBJ line continuations join lines") {
+    const fs::path dir = scratch("continue");
+    write(dir / "m.obj", "# a comment ending in \\\nv 0 0 \\\r\n2\nv 1 0 2\nv 0 1 2\nf 1 \\\n 2 3\n");
+    const LoadedModel m = load_obj(dir / "m.obj");
+    REQUIRE(m.meshes.size() == 1);
+    CHECK(m.meshes[0].indices.size() == 3);
+    for (const Vec3& p : m.meshes[0].positions) CHECK(p.z == 2.0f);
+}
