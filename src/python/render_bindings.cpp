@@ -246,6 +246,7 @@ py::tuple render_scene(PyScene& ps, const RenderKwargs& k) {
 size_t write_array(const py::object& path_like, const py::object& array, float exposure,
                    const std::string& tonemap) {
     const std::string path = py::str(py::module_::import("os").attr("fspath")(path_like));
+    check_output_path(path);  // the CLI's formats and messages, before any work
     const Tonemap curve = tonemap_arg(tonemap);
     if (!std::isfinite(exposure) || exposure < -64 || exposure > 64)
         throw py::value_error("exposure: expected a number in [-64, 64] (stops)");
@@ -255,8 +256,9 @@ size_t write_array(const py::object& path_like, const py::object& array, float e
     if (kind != 'f' && kind != 'i' && kind != 'u')
         throw py::type_error("array: expected a float or integer array, got dtype " +
                              std::string(py::str(any.dtype())));
-    if (any.ndim() != 3 || any.shape(2) != 3 || any.shape(0) < 1 || any.shape(1) < 1)
-        throw py::value_error("array: expected an H x W x 3 array, got shape " +
+    if (any.ndim() != 3 || any.shape(2) != 3 || any.shape(0) < 1 || any.shape(1) < 1 ||
+        any.shape(0) > 32768 || any.shape(1) > 32768)
+        throw py::value_error("array: expected an H x W x 3 array, H and W in 1..32768, got shape " +
                               std::string(py::str(any.attr("shape"))));
     const auto pixels = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(any);
     const int height = int(pixels.shape(0)), width = int(pixels.shape(1));

@@ -120,3 +120,22 @@ def test_bad_image_paths(tmp_path):
         sahara.read_image(tmp_path / "missing.exr")
     with pytest.raises(ValueError, match="tonemap"):
         sahara.write_image(tmp_path / "x.png", img, tonemap="sepia")
+
+
+@pytest.mark.parametrize("name, pattern", [
+    ("x.bmp", "unsupported output format"),   # OpenImageIO could write it; the CLI refuses it too
+    ("x", "unsupported output format"),
+    ("sub.png", "is a directory"),
+    ("", "unsupported output format"),
+])
+def test_image_paths_the_command_line_refuses(tmp_path, name, pattern):
+    (tmp_path / "sub.png").mkdir()
+    with pytest.raises(sahara.InputError, match=pattern):
+        sahara.write_image(tmp_path / name if name else "", np.zeros((2, 2, 3), np.float32))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sub.png"]
+
+
+def test_an_image_larger_than_the_command_line_allows_is_refused_before_any_work(tmp_path):
+    huge = np.broadcast_to(np.float32(0), (40000, 2, 3))  # no memory behind it
+    with pytest.raises(ValueError, match="1..32768"):
+        sahara.write_image(tmp_path / "x.png", huge)
