@@ -18,7 +18,7 @@ constexpr int kLabelSize = 14;
 }  // namespace
 
 Rgb heat_color(float t) {
-    t = std::clamp(t, 0.0f, 1.0f);
+    t = t > 0.0f ? std::min(t, 1.0f) : 0.0f;  // NaN too: it would index outside the stops
     // Piecewise-linear ramp through perceptually ordered stops (linear RGB).
     static const Rgb stops[] = {{0.00f, 0.00f, 0.15f},
                                 {0.00f, 0.25f, 0.80f},
@@ -63,7 +63,8 @@ BvhCostImage render_bvh_cost(const Scene& scene, int width, int height, int thre
     // Columns bar_x0..bar_x1 and rows bar_y0..bar_y1, both ends included; the
     // last column repeats the colour of the one before it.
     for (int x = bar_x0; x <= std::min(bar_x1, width - 1); ++x) {
-        const Rgb c = heat_color(float(std::min(x, bar_x1 - 1) - bar_x0) / float(bar_x1 - bar_x0 - 1));
+        // An image under 18 pixels wide has a one-column bar: no 0/0 there.
+        const Rgb c = heat_color(float(std::min(x, bar_x1 - 1) - bar_x0) / float(std::max(1, bar_x1 - bar_x0 - 1)));
         for (int y = bar_y0; y <= bar_y1; ++y) set(x, y, c);
     }
     out.labels.push_back({"0", bar_x0, bar_y1 + 4, kLabelSize, false});

@@ -59,3 +59,16 @@ TEST_CASE("bvh-cost legend: the labels are drawn under the bar and the heat map 
     CHECK(dark_pixels(drawn, text_top - 2, drawn.height, 24, 40) == 0);
     CHECK(drawn.rgb != plain.rgb);
 }
+
+TEST_CASE("bvh-cost images of every small width have a legend and no crash") {
+    const Scene scene = build_scene(default_scene());
+    CHECK(heat_color(std::nanf("")) == heat_color(0.0f));
+    for (int width = 1; width <= 20; ++width) {
+        CAPTURE(width);
+        BvhCostImage img = render_bvh_cost(scene, width, 3, 1);
+        CHECK(img.width == width);
+        CHECK(img.rgb.size() == size_t(img.width) * size_t(img.height) * 3);
+        for (float v : img.rgb) REQUIRE(std::isfinite(v));
+        draw_bvh_cost_legend(img, "small.png");  // labels reaching past the edge are clipped
+    }
+}
