@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "base/error.h"
 #include "python/bindings.h"
 
 namespace py = pybind11;
@@ -29,10 +30,20 @@ Json convert(const py::handle& h, const std::string& what, const std::string& pa
         try {
             return h.cast<int64_t>();
         } catch (const py::cast_error&) {
-            throw py::value_error(where(what, path) + ": integer too large");
+        }
+        try {
+            return h.cast<uint64_t>();  // a seed may use all 64 bits
+        } catch (const py::cast_error&) {
+            throw py::value_error(where(what, path) + ": integer too large (" + std::string(py::str(h)) + ")");
         }
     }
-    if (py::isinstance<py::float_>(h)) return h.cast<double>();
+    if (py::isinstance<py::float_>(h)) {
+        // JSON has no NaN or infinity: the parser would see null and say so.
+        const double v = h.cast<double>();
+        if (!std::isfinite(v))
+            throw InputError(where(what, path) + ": expected a finite number, got " + std::string(py::repr(h)));
+        return v;
+    }
     if (py::isinstance<py::str>(h)) return h.cast<std::string>();
     if (py::isinstance<py::dict>(h)) {
         Json object = Json::object();

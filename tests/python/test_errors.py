@@ -44,6 +44,19 @@ def test_bad_scene_dicts(workshop, change, pattern):
         sahara.Scene(workshop)
 
 
+@pytest.mark.parametrize("value, shown", [(float("nan"), "nan"), (float("-inf"), "-inf"), (np.float32("inf"), "inf")])
+def test_a_non_finite_number_in_a_dict_is_named_as_such(workshop, value, shown):
+    workshop["objects"][0]["radius"] = value
+    with pytest.raises(sahara.InputError, match=r"objects\[0\]\.radius: expected a finite number, got " + shown):
+        sahara.Scene(workshop)
+
+
+@pytest.mark.parametrize("seed", [2 ** 64 - 1, np.uint64(2 ** 64 - 1)])
+def test_a_dict_seed_may_use_all_64_bits_as_in_a_file(workshop, seed):
+    workshop["render"] = {"seed": seed}
+    assert sahara.Scene(workshop).settings["seed"] == 2 ** 64 - 1
+
+
 def test_values_without_a_json_form_are_type_errors(workshop):
     workshop["objects"][0]["center"] = {1, 2, 3}
     with pytest.raises(TypeError, match=r"scene: objects\[0\]\.center: set"):
