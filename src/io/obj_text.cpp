@@ -1,5 +1,6 @@
 #include "io/obj_text.h"
 
+#include <algorithm>
 #include <string_view>
 
 namespace sahara::obj {
@@ -34,8 +35,35 @@ std::string encode_blanks(std::string_view name) {
     return out;
 }
 
+/// A data line (v, vt, vn, vp, f, l, p): a trailing `# comment` cut off, and in
+/// face corners an empty trailing slot (`1/2/`, `1//`) dropped; tinyobjloader
+/// refuses both.
+bool is_data_line(std::string_view t) {
+    const size_t end = t.find_first_of(" \t");
+    const std::string_view key = t.substr(0, end);
+    return end != std::string_view::npos &&
+           (key == "v" || key == "vt" || key == "vn" || key == "vp" || key == "f" || key == "l" || key == "p");
+}
+
+std::string clean_data_line(std::string_view t) {
+    if (const size_t hash = t.find('#'); hash != std::string_view::npos) t = trim(t.substr(0, hash));
+    if (t.front() != 'f' && t.front() != 'l') return std::string(t);
+    std::string out;
+    size_t pos = 0;
+    while (pos < t.size()) {  // word by word, blanks kept
+        const size_t end = std::min(t.find_first_of(" \t", pos), t.size());
+        std::string_view word = t.substr(pos, end - pos);
+        while (word.size() > 1 && word.back() == '/') word.remove_suffix(1);
+        out.append(word);
+        if (end < t.size()) out.push_back(t[end]);
+        pos = end + 1;
+    }
+    return out;
+}
+
 /// One logical line, rewritten where a name with spaces would be cut.
 std::string prepare_obj_line(std::string_view line, const std::filesystem::path& dir) {
+    if (is_data_line(trim(line))) return clean_data_line(trim(line));
     std::string_view rest;
     if (rest_after(line, "usemtl", rest) && rest.find_first_of(" \t") != std::string_view::npos)
         return "usemtl " + encode_blanks(rest);

@@ -13,6 +13,8 @@ namespace sahara::obj {
 /// the file's), `usemtl` names with spaces encoded as encode_material_name does,
 /// and an `mtllib` whose whole rest of line names a file in `dir` escaped as
 /// one file name (otherwise its words are separate files, as the format says).
+/// Data lines (v, vt, vn, f, ...) lose a trailing `# comment`, and face corners
+/// an empty last slot (`f 1/1/ 2/2/ 3/3/`).
 std::string prepare_obj_text(const std::string& text, const std::filesystem::path& dir);
 
 /// The MTL text with `newmtl` names encoded to match prepare_obj_text's `usemtl`.

@@ -70,3 +70,14 @@ TEST_CASE("OBJ line continuations join lines") {
     CHECK(m.meshes[0].indices.size() == 3);
     for (const Vec3& p : m.meshes[0].positions) CHECK(p.z == 2.0f);
 }
+
+TEST_CASE("OBJ data lines with a trailing comment or an empty last index slot load") {
+    const fs::path dir = scratch("trailing");
+    write(dir / "m.obj",
+          "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0#corner\nvt 0 0\nvt 1 0\nvt 0 1\n"
+          "f 1/1/ 2/2/ 3/3/ # a face\nf 1// 3// 2//\n");
+    const LoadedModel m = load_obj(dir / "m.obj");
+    REQUIRE(m.meshes.size() == 1);
+    CHECK(m.meshes[0].indices.size() == 6);
+    CHECK(m.meshes[0].uvs.size() == m.meshes[0].positions.size());
+}
