@@ -118,3 +118,17 @@ TEST_CASE("cli: --version reports a missing plugin and a narrowed SIMD path") {
     if (sahara::best_simd_path() != sahara::SimdPath::sse2)
         CHECK(r.out.find("(SAHARA_SIMD selects sse2)") != std::string::npos);
 }
+
+TEST_CASE("cli: output lost to a full disk is an error and not exit code 0") {
+    if (!fs::exists("/dev/full")) return;
+    TempDir dir("full");
+    const std::string err = dir / "stderr.txt";
+    for (const char* args : {"info --json", "--version"}) {
+        CAPTURE(args);
+        const std::string cmd = std::string(SAHARA_EXE) + " " + args + " >/dev/full 2>" + err;
+        const int status = std::system(cmd.c_str());
+        REQUIRE(WIFEXITED(status));
+        CHECK(WEXITSTATUS(status) == 2);
+        CHECK(read_text(err).find("cannot write to standard output") != std::string::npos);
+    }
+}
