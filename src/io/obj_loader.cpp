@@ -320,6 +320,8 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
         throw input_error(file.string(), "", "malformed OBJ: " + first_line(err));
     log_obj_warnings(file.string(), warn, options.materials);
     for (tinyobj::material_t& m : materials) m.name = obj::decode_material_name(m.name);
+    if (!attrib.colors.empty())  // said once, rather than rendering grey without a word
+        log_warning(file.string() + ": vertex colours (v x y z r g b) are not rendered");
 
     LoadedModel model;
     obj::MtlKeys keys;

@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 
+#include "base/log.h"
 #include "io/model_loader.h"
 
 using namespace sahara;
@@ -80,4 +81,14 @@ TEST_CASE("OBJ data lines with a trailing comment or an empty last index slot lo
     REQUIRE(m.meshes.size() == 1);
     CHECK(m.meshes[0].indices.size() == 6);
     CHECK(m.meshes[0].uvs.size() == m.meshes[0].positions.size());
+}
+
+TEST_CASE("OBJ vertex colours load the positions and are named as not rendered") {
+    const fs::path dir = scratch("colours");
+    write(dir / "m.obj", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n");
+    const int before = warning_count();
+    const LoadedModel m = load_obj(dir / "m.obj");
+    CHECK(warning_count() - before == 1);
+    REQUIRE(m.meshes.size() == 1);
+    CHECK(m.meshes[0].positions[1] == Vec3(1, 0, 0));
 }
