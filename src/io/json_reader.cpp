@@ -267,9 +267,12 @@ Vec3d JsonValue::vec3d(const NumberRange& range) const {
 }
 
 Vec3 JsonValue::nonzero_vec3() const {
-    Vec3 v = vec3();
-    if (v.x == 0 && v.y == 0 && v.z == 0) fail_expected("a non-zero vector [x, y, z]");
-    return v;
+    const Vec3d v = vec3d();
+    const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    if (largest == 0) fail_expected("a non-zero vector [x, y, z]");
+    // Scaled to at most 1 per component: every caller normalises, and the float
+    // square of 1e20 or 1e-20 would overflow or vanish there.
+    return Vec3(v / largest);
 }
 
 std::vector<JsonValue> JsonValue::array(size_t min_size, size_t max_size) const {

@@ -69,7 +69,8 @@ class JsonValue {
     /// [x, y, z] as vec3() checks it, in double precision (positions, which
     /// the parser moves to the local origin before rounding to float).
     Vec3d vec3d(const NumberRange& range = NumberRange::any()) const;
-    /// [x, y, z] with at least one non-zero component.
+    /// [x, y, z] with at least one non-zero component, as a direction: scaled
+    /// so that its largest component is +-1.
     Vec3 nonzero_vec3() const;
     /// An array; `min_size`..`max_size` elements.
     std::vector<JsonValue> array(size_t min_size = 0, size_t max_size = SIZE_MAX) const;

@@ -429,3 +429,23 @@ TEST_CASE("scene parser: workshop.json is the built-in default scene") {
     CHECK(f.render.spp == d.render.spp);
     CHECK(f.render.width == d.render.width);
 }
+
+TEST_CASE("scene parser: directions of any finite length give unit vectors") {
+    const SceneDesc s = parse_scene_json(
+        R"({"camera": {"position": [0, -5, 0], "look_at": [0, 0, 0], "up": [0, 0, 1e-30]},
+            "background": {"type": "gradient", "up": [1e30, 0, 0]},
+            "objects": [{"type": "plane", "normal": [0, 3e38, 3e38]},
+                        {"type": "cylinder", "axis": [1e-38, 0, 0]}],
+            "lights": [{"type": "directional", "direction": [1e30, 0, 1e30]}]})",
+        "dirs.json");
+    const auto unit = [](Vec3 v) { return std::abs(length(v) - 1.0f) < 1e-5f; };
+    CHECK(unit(s.camera.up));
+    CHECK(unit(s.background.up));
+    REQUIRE(s.planes.size() == 1);
+    CHECK(unit(s.planes[0].normal));
+    REQUIRE(s.quadrics.size() == 1);
+    CHECK(s.quadrics[0].axis == Vec3(1, 0, 0));
+    REQUIRE(s.lights.size() == 1);
+    CHECK(s.lights[0].direction.x == doctest::Approx(std::sqrt(0.5)));
+    CHECK(s.lights[0].direction.z == doctest::Approx(std::sqrt(0.5)));
+}
