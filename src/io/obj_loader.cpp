@@ -287,7 +287,10 @@ Vec3d far_model_centre(const std::vector<tinyobj::real_t>& v) {
 void log_obj_warnings(const std::string& file, const std::string& warn, bool materials) {
     std::istringstream warnings(obj::decode_material_name(warn));
     for (std::string line; std::getline(warnings, line);) {
-        if (line.empty() || line.find("Failed to load material file") != std::string::npos) continue;
+        // tinyobjloader ends its "Degenerated face found" with a stray "." line.
+        if (line.empty() || line == "." || line.find("Failed to load material file") != std::string::npos)
+            continue;
+        if (line == "Degenerated face found") line = "a face with fewer than 3 vertices is skipped";
         if (!materials && line.find("not found in .mtl") != std::string::npos) continue;
         log_warning(file + ": " + line);
     }

@@ -92,3 +92,13 @@ TEST_CASE("OBJ vertex colours load the positions and are named as not rendered")
     REQUIRE(m.meshes.size() == 1);
     CHECK(m.meshes[0].positions[1] == Vec3(1, 0, 0));
 }
+
+TEST_CASE("an OBJ face of two vertices is one warning") {
+    const fs::path dir = scratch("two");
+    write(dir / "m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n");
+    const int before = warning_count();
+    const LoadedModel m = load_obj(dir / "m.obj");
+    CHECK(warning_count() - before == 1);
+    REQUIRE(m.meshes.size() == 1);
+    CHECK(m.meshes[0].indices.size() == 3);
+}
