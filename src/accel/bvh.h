@@ -178,6 +178,14 @@ struct BvhBuildParams {
     /// Spatial splits are tried only where the best object split's children overlap by
     /// more than this fraction of the root's surface area (Stich et al.'s alpha).
     float sbvh_overlap_alpha = 1e-5f;
+    /// Reinsertion's collapse: a leaf holding a primitive whose box has at least this share
+    /// of the root box's surface area (a floor, a ceiling) counts its primitives
+    /// large_leaf_cost_factor times. The surface-area probability assumes rays from outside;
+    /// rays that start inside a room cross such a slab far more often than its area share
+    /// says, and a leaf of a whole slab (twelve triangles) makes every one of them test all
+    /// its faces (docs/performance.md, "Large primitives' leaves"). 0: off.
+    float large_leaf_area_share = 0.1f;
+    float large_leaf_cost_factor = 2.0f;
 };
 
 /// Inputs of a build: one box and one centre per primitive (same length).

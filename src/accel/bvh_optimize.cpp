@@ -12,7 +12,9 @@
 /// tree (a priority queue ordered by the induced cost of the ancestors).
 /// Rounds stop when the SAH cost stops falling. Finally each subtree becomes a
 /// leaf where that is cheaper than keeping it (bottom-up, exact for the given
-/// topology), and the tree is written out in the Bvh sibling-pair layout.
+/// topology), and the tree is written out in the Bvh sibling-pair layout. That
+/// last step weights up leaves that hold a primitive spanning much of the scene
+/// (BvhBuildParams::large_leaf_area_share), which rays from inside it cross often.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -242,6 +244,9 @@ class Collapser {
         count_.assign(tree.size(), 0);
         cost_.assign(tree.size(), 0.0);
         make_leaf_.assign(tree.size(), 0);
+        large_.assign(tree.size(), 0);
+        large_area_ = double(params.large_leaf_area_share) * area(tree.box(tree.root()));
+        large_factor_ = std::max(1.0, double(params.large_leaf_cost_factor));
         // Post-order by reversing a pre-order walk: children before parents.
         std::vector<uint32_t> order, stack{tree.root()};
         while (!stack.empty()) {
@@ -289,14 +294,16 @@ class Collapser {
         const double ci = double(params_.intersection_cost), ct = double(params_.traversal_cost);
         if (tree_.is_leaf(n)) {
             count_[n] = 1;
+            large_[n] = large_area_ > 0 && a >= large_area_;
             cost_[n] = ci * blocked(1) * a;
             make_leaf_[n] = 1;
             return;
         }
         const uint32_t c0 = tree_.child(n, 0), c1 = tree_.child(n, 1);
         count_[n] = count_[c0] + count_[c1];
+        large_[n] = large_[c0] | large_[c1];
         const double split = ct * a + cost_[c0] + cost_[c1];
-        const double leaf = ci * blocked(count_[n]) * a;
+        const double leaf = ci * (large_[n] ? large_factor_ : 1.0) * blocked(count_[n]) * a;
         make_leaf_[n] = count_[n] <= params_.max_leaf_size && leaf <= split;
         cost_[n] = make_leaf_[n] ? leaf : split;
     }
@@ -322,6 +329,9 @@ class Collapser {
     std::vector<uint32_t> count_;
     std::vector<double> cost_;
     std::vector<uint8_t> make_leaf_;
+    std::vector<uint8_t> large_;  ///< the subtree holds a primitive of large_area_ or more
+    double large_area_ = 0;
+    double large_factor_ = 1;
 };
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh_binned.h"
+#include "accel/bvh_stats.h"
 #include "mesh_fixtures.h"
 #include "scene/accelerator.h"
 #include "scene/mesh_scene.h"
@@ -85,6 +86,49 @@ double cheapest_binned_split(const Bvh& bvh, std::span<const Bounds3> prims, uin
     return best;
 }
 
+/// Adds the twelve triangles of the box [lo, hi].
+void add_box(TriangleMesh& m, const Vec3& lo, const Vec3& hi) {
+    const auto base = uint32_t(m.positions.size());
+    for (int i = 0; i < 8; ++i)
+        m.positions.push_back(Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+    const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : faces)
+        m.indices.insert(m.indices.end(), {base + f[0], base + f[1], base + f[2], base + f[0], base + f[2], base + f[3]});
+}
+
+/// An open-plan office: floor and ceiling slabs with a thickness reaching under the
+/// walls, four walls (boxes) and a grid of ceiling light panels.
+TriangleMesh make_slab_office() {
+    TriangleMesh m;
+    m.name = "slab office";
+    const float length = 30, width = 16, height = 3.2f, t = 0.3f;
+    add_box(m, Vec3(-t, -t, -t), Vec3(length + t, width + t, 0));                // floor slab
+    add_box(m, Vec3(-t, -t, height), Vec3(length + t, width + t, height + t));   // ceiling slab
+    add_box(m, Vec3(0, -t, 0), Vec3(length, 0, height));                         // walls
+    add_box(m, Vec3(0, width, 0), Vec3(length, width + t, height));
+    add_box(m, Vec3(-t, 0, 0), Vec3(0, width, height));
+    add_box(m, Vec3(length, 0, 0), Vec3(length + t, width, height));
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 6; ++j) {  // light panels under the ceiling
+            const float x = 1.2f + 2.4f * float(i), y = 1.2f + 2.4f * float(j);
+            add_box(m, Vec3(x - 0.6f, y - 0.3f, height - 0.05f), Vec3(x + 0.6f, y + 0.3f, height));
+        }
+    return m;
+}
+
+/// The most primitives in a leaf that holds a primitive whose box has at least `share`
+/// of the root box's surface area.
+uint32_t largest_leaf_with_large_primitive(const Bvh& bvh, std::span<const Bounds3> prims, float share) {
+    const float large = share * bvh.nodes[0].box().surface_area();
+    uint32_t most = 0;
+    for (const BvhNode& n : bvh.nodes) {
+        if (!n.is_leaf() || n.count == 0) continue;
+        for (uint32_t s = n.index; s < n.index + n.count; ++s)
+            if (prims[bvh.prim_indices[s]].surface_area() >= large) most = std::max(most, n.count);
+    }
+    return most;
+}
+
 }  // namespace
 
 TEST_CASE("binned build: a leaf is never more expensive than its cheapest binned split") {
@@ -144,6 +188,30 @@ TEST_CASE("the default acceleration structure keeps at most 64 bytes per triangl
         REQUIRE(acc.primitive_count() == m.triangle_count());
         CHECK(double(acc.bytes()) / double(acc.primitive_count()) <= 64.0);
     }
+}
+
+TEST_CASE("reinsertion keeps the slabs of a room out of large leaves") {
+    // A slab spanning the room collapsed into one leaf of its twelve triangles makes every
+    // ray from inside the room that reaches it test all twelve; reinsertion's collapse
+    // counts a leaf holding such a primitive twice (BvhBuildParams::large_leaf_cost_factor).
+    const TriangleMesh m = make_slab_office();
+    const std::vector<Bounds3> boxes = triangle_boxes(m);
+    std::vector<Vec3> centers;
+    for (const Bounds3& b : boxes) centers.push_back(b.center());
+    const BvhBuildParams params = AcceleratorOptions{}.build_params();
+    const float share = params.large_leaf_area_share;
+    REQUIRE(share > 0.0f);
+    const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::reinsert, params);
+    CHECK(validate_bvh(bvh, boxes) == "");
+    const uint32_t with_rule = largest_leaf_with_large_primitive(bvh, boxes, share);
+    BvhBuildParams plain = params;
+    plain.large_leaf_cost_factor = 1.0f;
+    const uint32_t without_rule =
+        largest_leaf_with_large_primitive(build_bvh({boxes, centers}, BvhBuilder::reinsert, plain), boxes, share);
+    INFO("with the rule ", with_rule, ", without ", without_rule);
+    CHECK(with_rule > 0);
+    CHECK(with_rule <= 4);
+    CHECK(without_rule > 4);  // the rule, not the room, keeps the leaves small
 }
 
 }  // namespace sahara
