@@ -77,8 +77,9 @@ inline float blocked_count(uint32_t n, uint32_t b) {
     return float((n + b - 1) / b * b);
 }
 
-/// The bins of the three axes of one range (or of one chunk of it).
-struct Bins {
+/// The bins of the three axes of one range (or of one chunk of it). Aligned so that
+/// each bin's box (lo and hi, 32 bytes) is one aligned AVX load.
+struct alignas(32) Bins {
     Box4 box[3][kMaxBins];
     uint32_t count[3][kMaxBins];
 
@@ -178,6 +179,11 @@ class SideTest {
     bool by_threshold_ = false;
     float threshold_ = 0.0f;
 };
+
+/// Clears the first map.count() bins of `out` and bins refs[begin, end) into them (the
+/// AVX2 kernel where the active SIMD path allows, else SSE2; the same bins bit for bit).
+/// Uses a thread's second set of bins for long ranges: not across a task scheduling point.
+void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out);
 
 /// A bin boundary and what it costs.
 struct BinSplit {
