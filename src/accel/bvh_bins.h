@@ -137,16 +137,29 @@ struct BinMap {
 /// the scale are finite, so there the test is one comparison against the smallest
 /// centroid of the right side, found by bisection over the floats between the bounds (a
 /// NaN centroid goes left either way: bin() clamps its integer conversion to 0). The
-/// bisection costs about as much as binning 50 centroids, so short ranges bin.
+/// bisection starts from a few floats around the boundary's computed position, so it
+/// costs about ten bin computations; shorter ranges than kThresholdMin bin instead.
 class SideTest {
    public:
+    static constexpr uint32_t kThresholdMin = 16;
+
     SideTest(const BinMap& map, int axis, uint32_t pos, float centroid_hi, uint32_t primitives)
         : map_(map), axis_(axis), pos_(pos) {
-        if (primitives < 64) return;
+        if (primitives < kThresholdMin) return;
         const float lo = map.lo_s[axis];
         const float extent = centroid_hi - lo;
         if (!(extent <= kMaxFloat && map.scale_s[axis] <= kMaxFloat) || !(lo >= -kMaxFloat)) return;
         uint32_t a = key(lo), b = key(centroid_hi);  // bin(a) < pos <= bin(b)
+        // Narrows [a, b] to a few floats around the boundary where the bins there confirm it
+        // (rounding moves the boundary by a few floats at most); else the full bisection.
+        const float guess = lo + float(pos) / map.scale_s[axis];
+        if (guess > lo && guess < centroid_hi) {
+            constexpr uint32_t kSlack = 4;
+            const uint32_t g = key(guess);
+            const uint32_t ga = g - std::min(kSlack, g - a), gb = g + std::min(kSlack, b - g);
+            if (map.bin_of(from_key(ga), axis) < pos) a = ga;
+            if (map.bin_of(from_key(gb), axis) >= pos) b = gb;
+        }
         while (b - a > 1) {
             const uint32_t mid = a + (b - a) / 2;
             (map.bin_of(from_key(mid), axis) >= pos ? b : a) = mid;
