@@ -333,7 +333,7 @@ class BinnedBuild {
             return;
         }
         used_pairs_[0] = 1;
-        std::vector<uint32_t> new_pair(n_);
+        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
         uint32_t pairs = 0;
         for (uint32_t k = 0; k < n_; ++k) {
             new_pair[k] = pairs;
