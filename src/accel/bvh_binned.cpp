@@ -24,11 +24,10 @@ namespace sahara {
 
 namespace {
 
-/// Ranges binned into two sets of bins (fill_bins): the merge costs a few hundred instructions.
-constexpr uint32_t kTwoBinSetsMin = 256;
 using binned::BinMap;
 using binned::Bins;
 using binned::Box4;
+using binned::fill_bins;
 using binned::kMaxBins;
 using binned::load_lo;
 using binned::PrimRef;
@@ -135,7 +134,6 @@ class BinnedBuild {
             if (n < bins) {
                 fill_few_bins(r.refs, r.begin, r.end, map, all);
             } else {
-                all.clear(bins);
                 fill_bins(r.refs, r.begin, r.end, map, all);
             }
             best = find_split(all, map);
@@ -144,10 +142,8 @@ class BinnedBuild {
             partition_serial(r, map, best, left, right);
         } else {
             std::vector<Bins> parts(kScanChunks);
-            for_chunks(r.begin, r.end, [&](uint32_t c, uint32_t b, uint32_t e) {
-                parts[c].clear(bins);
-                fill_bins(r.refs, b, e, map, parts[c]);
-            });
+            for_chunks(r.begin, r.end,
+                       [&](uint32_t c, uint32_t b, uint32_t e) { fill_bins(r.refs, b, e, map, parts[c]); });
             auto all = std::make_unique<Bins>();
             all->clear(bins);
             for (const Bins& p : parts) all->add(p, bins);
@@ -204,44 +200,6 @@ class BinnedBuild {
     bool is_leaf_cheaper(const Range& r, uint32_t n, const Split& s) const {
         const float area = r.box.surface_area();
         return params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + s.cost;
-    }
-
-    static void bin_one(const PrimRef& p, const BinMap& map, __m128i last, Bins& out) {
-        alignas(16) uint32_t k[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(k), map.bins(_mm_load_ps(p.c), last));
-        const __m128 lo = load_lo(p), hi = _mm_load_ps(p.hi);
-        for (int a = 0; a < 3; ++a) {
-            out.box[a][k[a]].extend(lo, hi);
-            ++out.count[a][k[a]];
-        }
-    }
-
-    /// A thread's second set of bins (not used across a task scheduling point). Out of line:
-    /// with -fPIC a thread_local access is a call, which GCC repeated for every primitive
-    /// of the loop, spilling its registers each time.
-    [[gnu::noinline]] static Bins& odd_bins() {
-        thread_local Bins bins;
-        return bins;
-    }
-
-    /// Long ranges bin alternate primitives into two sets, merged at the end: neighbours
-    /// often share a bin, and one set would chain each box update to the store before it.
-    static void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out) {
-        const __m128i last = _mm_set1_epi32(map.last);
-        if (end - begin < kTwoBinSetsMin) {
-            for (uint32_t i = begin; i < end; ++i) bin_one(refs[i], map, last, out);
-            return;
-        }
-        Bins& odd = odd_bins();
-        const uint32_t bins = map.count();
-        odd.clear(bins);
-        uint32_t i = begin;
-        for (; i + 1 < end; i += 2) {
-            bin_one(refs[i], map, last, out);
-            bin_one(refs[i + 1], map, last, odd);
-        }
-        if (i < end) bin_one(refs[i], map, last, out);
-        out.add(odd, bins);
     }
 
     /// fill_bins for fewer primitives than bins: clears all counts but only the boxes of
@@ -375,7 +333,7 @@ class BinnedBuild {
             return;
         }
         used_pairs_[0] = 1;
-        std::vector<uint32_t> new_pair(n_);
+        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
         uint32_t pairs = 0;
         for (uint32_t k = 0; k < n_; ++k) {
             new_pair[k] = pairs;

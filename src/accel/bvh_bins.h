@@ -77,8 +77,9 @@ inline float blocked_count(uint32_t n, uint32_t b) {
     return float((n + b - 1) / b * b);
 }
 
-/// The bins of the three axes of one range (or of one chunk of it).
-struct Bins {
+/// The bins of the three axes of one range (or of one chunk of it). Aligned so that
+/// each bin's box (lo and hi, 32 bytes) is one aligned AVX load.
+struct alignas(32) Bins {
     Box4 box[3][kMaxBins];
     uint32_t count[3][kMaxBins];
 
@@ -136,16 +137,29 @@ struct BinMap {
 /// the scale are finite, so there the test is one comparison against the smallest
 /// centroid of the right side, found by bisection over the floats between the bounds (a
 /// NaN centroid goes left either way: bin() clamps its integer conversion to 0). The
-/// bisection costs about as much as binning 50 centroids, so short ranges bin.
+/// bisection starts from a few floats around the boundary's computed position, so it
+/// costs about ten bin computations; shorter ranges than kThresholdMin bin instead.
 class SideTest {
    public:
+    static constexpr uint32_t kThresholdMin = 16;
+
     SideTest(const BinMap& map, int axis, uint32_t pos, float centroid_hi, uint32_t primitives)
         : map_(map), axis_(axis), pos_(pos) {
-        if (primitives < 64) return;
+        if (primitives < kThresholdMin) return;
         const float lo = map.lo_s[axis];
         const float extent = centroid_hi - lo;
         if (!(extent <= kMaxFloat && map.scale_s[axis] <= kMaxFloat) || !(lo >= -kMaxFloat)) return;
         uint32_t a = key(lo), b = key(centroid_hi);  // bin(a) < pos <= bin(b)
+        // Narrows [a, b] to a few floats around the boundary where the bins there confirm it
+        // (rounding moves the boundary by a few floats at most); else the full bisection.
+        const float guess = lo + float(pos) / map.scale_s[axis];
+        if (guess > lo && guess < centroid_hi) {
+            constexpr uint32_t kSlack = 4;
+            const uint32_t g = key(guess);
+            const uint32_t ga = g - std::min(kSlack, g - a), gb = g + std::min(kSlack, b - g);
+            if (map.bin_of(from_key(ga), axis) < pos) a = ga;
+            if (map.bin_of(from_key(gb), axis) >= pos) b = gb;
+        }
         while (b - a > 1) {
             const uint32_t mid = a + (b - a) / 2;
             (map.bin_of(from_key(mid), axis) >= pos ? b : a) = mid;
@@ -178,6 +192,11 @@ class SideTest {
     bool by_threshold_ = false;
     float threshold_ = 0.0f;
 };
+
+/// Clears the first map.count() bins of `out` and bins refs[begin, end) into them (the
+/// AVX2 kernel where the active SIMD path allows, else SSE2; the same bins bit for bit).
+/// Uses a thread's second set of bins for long ranges: not across a task scheduling point.
+void fill_bins(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map, Bins& out);
 
 /// A bin boundary and what it costs.
 struct BinSplit {

@@ -221,15 +221,17 @@ BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
 
 double largest_box_area_share(std::span<const Bounds3> boxes) {
     // Areas are floats already; keeping them as floats halves the selection's memory,
-    // and the pass runs on every thread, since it sits in front of the build.
+    // and the pass runs on every thread, since it sits in front of the build. The array
+    // is not zero-filled first: that was a serial pass (and its page faults) on one thread.
     const auto n = int64_t(boxes.size());
-    std::vector<float> areas(boxes.size());
+    const BuildArray<float> areas(boxes.size());
     double total = 0;
 #pragma omp parallel for reduction(+ : total) schedule(static) if (n >= 65536)
     for (int64_t i = 0; i < n; ++i) total += double(areas[size_t(i)] = boxes[size_t(i)].surface_area());
     if (!(total > 0)) return 0.0;
     const size_t k = std::max<size_t>(1, boxes.size() / 100);
-    std::nth_element(areas.begin(), areas.begin() + std::ptrdiff_t(k - 1), areas.end(), std::greater<>());
+    float* const a = areas.get();
+    std::nth_element(a, a + std::ptrdiff_t(k - 1), a + boxes.size(), std::greater<>());
     double top = 0;
     for (size_t i = 0; i < k; ++i) top += double(areas[i]);
     return top / total;

@@ -3,13 +3,17 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
+#include <random>
 #include <span>
 #include <vector>
 
 #include "accel/bvh.h"
 #include "accel/bvh_binned.h"
+#include "accel/bvh_bins.h"
 #include "accel/bvh_stats.h"
+#include "accel/simd_path.h"
 #include "mesh_fixtures.h"
 #include "scene/accelerator.h"
 #include "scene/mesh_scene.h"
@@ -177,6 +181,81 @@ TEST_CASE("binned build: every node's box is exactly the union of what it holds"
             CHECK(loose == 0);
         }
     }
+}
+
+TEST_CASE("binned build: the SSE2 and AVX2 binning kernels build the same tree bit for bit") {
+    // The AVX2 kernel keeps bin boxes as (lo, -hi); a wrong operand order or sign would
+    // change a box's signed zero or a NaN's side, and with it a split or a node's bounds.
+    struct Restore {
+        ~Restore() { clear_forced_simd_path(); }
+    } restore;
+    const std::vector<SimdPath> paths = runnable_simd_paths();
+    if (paths.size() < 2) MESSAGE("this CPU runs only the SSE2 kernel");
+    // Long ranges (two bin sets, parallel chunks above 32,768 primitives) and odd boxes.
+    for (const TriangleMesh& m :
+         {make_slivers(40000), make_icosphere(4), make_degenerate_mesh(), make_tiny_grid(40)}) {
+        const std::vector<Bounds3> boxes = triangle_boxes(m);
+        std::vector<Vec3> centers;
+        for (const Bounds3& b : boxes) centers.push_back(b.center());
+        BvhBuildParams p;
+        p.leaf_block_size = 4;
+        force_simd_path(SimdPath::sse2);
+        const Bvh reference = build_bvh({boxes, centers}, BvhBuilder::binned, p);
+        for (SimdPath path : paths) {
+            force_simd_path(path);
+            const Bvh bvh = build_bvh({boxes, centers}, BvhBuilder::binned, p);
+            INFO(m.name, " ", simd_path_name(path));
+            REQUIRE(bvh.nodes.size() == reference.nodes.size());
+            CHECK(bvh.prim_indices == reference.prim_indices);
+            CHECK(std::memcmp(bvh.nodes.data(), reference.nodes.data(), bvh.nodes.size() * sizeof(BvhNode)) ==
+                  0);
+        }
+    }
+}
+
+TEST_CASE("binned build: the partition's centroid threshold puts every centroid on its bin's side") {
+    // The threshold is searched from the boundary's computed position; one float off
+    // would move the centroids on the boundary to the other child.
+    std::mt19937 rng(7);
+    int checked = 0, wrong = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        const float scale = std::ldexp(1.0f, int(rng() % 40) - 20);
+        const float lo = (float(rng() % 2001) - 1000.0f) * scale * 0.01f;
+        const float extent = float(1 + rng() % 1000) * scale * 0.001f;
+        Bounds3 cents{{lo, lo, lo}, {lo + extent, lo + extent * 0.5f, lo + extent * 3.0f}};
+        const uint32_t bins = trial % 2 ? 16 : 8;
+        const binned::BinMap map(cents, bins);
+        // Centroids on the bounds, spread between them, and the floats around each boundary.
+        std::vector<binned::PrimRef> refs;
+        for (int axis = 0; axis < 3; ++axis) {
+            const float a = cents.lo[axis], b = cents.hi[axis];
+            std::vector<float> xs = {a, b};
+            for (int k = 0; k < 64; ++k) xs.push_back(a + (b - a) * float(rng() % 10001) * 1e-4f);
+            for (uint32_t pos = 1; pos < bins; ++pos) {
+                float x = a + float(pos) * (b - a) / float(bins);
+                for (int k = 0; k < 6; ++k) x = std::nextafter(x, -kInfinity);
+                for (int k = 0; k < 12; ++k, x = std::nextafter(x, kInfinity))
+                    if (x >= a && x <= b) xs.push_back(x);
+            }
+            for (float x : xs) {
+                binned::PrimRef r{};
+                r.c[0] = r.c[1] = r.c[2] = x;
+                refs.push_back(r);
+            }
+        }
+        for (int axis = 0; axis < 3; ++axis)
+            for (uint32_t pos = 1; pos < bins; ++pos) {
+                const binned::SideTest side(map, axis, pos, cents.hi[axis], 1000);
+                for (const binned::PrimRef& r : refs) {
+                    if (r.c[axis] < cents.lo[axis] || r.c[axis] > cents.hi[axis]) continue;
+                    ++checked;
+                    wrong += side.left(r) != (map.bin(r, axis) < pos);
+                }
+            }
+    }
+    INFO(wrong, " of ", checked);
+    REQUIRE(checked > 100000);
+    CHECK(wrong == 0);
 }
 
 TEST_CASE("the default acceleration structure keeps at most 64 bytes per triangle") {
