@@ -14,6 +14,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "io/files.h"
+#include "io/gltf_compressed.h"
 #include "io/gltf_detail.h"
 #include "io/mesh_utils.h"
 
@@ -28,7 +29,8 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_texture_transform",      "KHR_materials_emissive_strength",
     "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_volume",       "KHR_lights_punctual",
-    "KHR_mesh_quantization"};
+    "KHR_mesh_quantization",      "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression"};
 
 /// "major.minor" as two numbers; nothing if the text is not of that form.
 std::optional<std::pair<int, int>> version_numbers(const std::string& text) {
@@ -176,8 +178,12 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     src.file = file.string();
     src.dir = file.parent_path();
     const std::vector<unsigned char> bytes = read_file_bytes(file);
-    precheck(src.file, src.dir, json_part(src.file, bytes));
-    parse(src, bytes);
+    const JsonPart part = json_part(src.file, bytes);
+    precheck(src.file, src.dir, part);
+    const auto prepared = gltf::prepared_for_tinygltf(bytes, part.text, part.glb);
+    parse(src, prepared ? *prepared : bytes);
+    gltf::decode_meshopt_views(src);  // first: a Draco bitstream may sit in a meshopt bufferView
+    gltf::decode_draco_primitives(src);
     LoadedModel out;
     gltf::build_scene(src, world_from_model, shared, out);
     if (out.dropped_degenerate > 0)

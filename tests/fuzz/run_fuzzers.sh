@@ -12,7 +12,7 @@ flags="-std=c++20 -O1 -gline-tables-only -fno-omit-frame-pointer -DSAHARA_VERSIO
 # OBJ numbers are read in double, as in the CMake build (CMakeLists.txt gives the define
 # to the OBJ sources only; here it reaches every loader source, where only those two use it).
 flags="$flags -DTINYOBJLOADER_USE_DOUBLE"
-libs="-ltinyobjloader_double -ltinygltf -lOpenImageIO -lOpenImageIO_Util -ldl"
+libs="-ltinyobjloader_double -ltinygltf -ldraco -lmeshoptimizer -lOpenImageIO -lOpenImageIO_Util -ldl"
 # Every OBJ and glTF source by pattern, so a loader split into a new file is linked too.
 srcs="$(ls "$root"/src/io/obj_*.cpp "$root"/src/io/gltf_*.cpp | tr '\n' ' ')
       $root/src/io/model_loader.cpp $root/src/io/mesh_utils.cpp $root/src/io/image_bytes.cpp
