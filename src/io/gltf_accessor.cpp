@@ -10,6 +10,22 @@
 
 namespace sahara::gltf {
 
+/// Shared by the accessors and the compressed-data decoders (gltf_compressed.h).
+std::span<const unsigned char> buffer_view_bytes(const Source& src, int bv, const std::string& element) {
+    const tinygltf::Model& m = src.model;
+    if (bv < 0 || size_t(bv) >= m.bufferViews.size())
+        throw input_error(src.file, element, "bufferView " + std::to_string(bv) + " does not exist");
+    const tinygltf::BufferView& view = m.bufferViews[size_t(bv)];
+    const std::string view_name = "bufferViews[" + std::to_string(bv) + "]";
+    if (view.buffer < 0 || size_t(view.buffer) >= m.buffers.size())
+        throw input_error(src.file, view_name, "buffer " + std::to_string(view.buffer) + " does not exist");
+    const std::vector<unsigned char>& data = m.buffers[size_t(view.buffer)].data;
+    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+        throw input_error(src.file, view_name,
+                          "extends past the end of buffers[" + std::to_string(view.buffer) + "]");
+    return {data.data() + view.byteOffset, view.byteLength};
+}
+
 namespace {
 
 int component_size(int type) {
@@ -93,25 +109,17 @@ struct View {
 /// bytes from `offset` (with the view's stride unless `packed`) stay inside it.
 View view_for(const Source& src, int bv, size_t offset, size_t count, size_t elem_size, bool packed,
               const std::string& element) {
-    const tinygltf::Model& m = src.model;
-    if (bv < 0 || size_t(bv) >= m.bufferViews.size())
-        throw input_error(src.file, element, "bufferView " + std::to_string(bv) + " does not exist");
-    const tinygltf::BufferView& view = m.bufferViews[size_t(bv)];
+    const std::span<const unsigned char> bytes = buffer_view_bytes(src, bv, element);
+    const tinygltf::BufferView& view = src.model.bufferViews[size_t(bv)];
     const std::string view_name = "bufferViews[" + std::to_string(bv) + "]";
-    if (view.buffer < 0 || size_t(view.buffer) >= m.buffers.size())
-        throw input_error(src.file, view_name, "buffer " + std::to_string(view.buffer) + " does not exist");
-    const size_t buffer_size = m.buffers[size_t(view.buffer)].data.size();
-    if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
-        throw input_error(src.file, view_name,
-                          "extends past the end of buffers[" + std::to_string(view.buffer) + "]");
     const size_t stride = packed || view.byteStride == 0 ? elem_size : view.byteStride;
     if (stride < elem_size)
         throw input_error(src.file, element, "byteStride of " + view_name + " is smaller than an element");
     // count <= 2^32 and stride <= 252 keep this arithmetic far from overflow.
-    if (count > (size_t(1) << 32) || offset > view.byteLength ||
-        (count > 0 && (count - 1) * stride + elem_size > view.byteLength - offset))
+    if (count > (size_t(1) << 32) || offset > bytes.size() ||
+        (count > 0 && (count - 1) * stride + elem_size > bytes.size() - offset))
         throw input_error(src.file, element, "reads past the end of " + view_name);
-    return {m.buffers[size_t(view.buffer)].data.data() + view.byteOffset + offset, stride};
+    return {bytes.data() + offset, stride};
 }
 
 /// Sparse substitution: values[k] replaces element indices[k].

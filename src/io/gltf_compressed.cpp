@@ -50,11 +50,13 @@ bool give_draco_indices_a_view(nlohmann::json& doc) {
     for (const auto& mesh : doc["meshes"]) {
         if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
         for (const auto& prim : mesh["primitives"]) {
-            if (!has_extension(prim, kDraco) || !prim.contains("indices") || !prim["indices"].is_number_unsigned())
+            if (!has_extension(prim, kDraco) || !prim.contains("indices") ||
+                !prim["indices"].is_number_unsigned())
                 continue;
             const auto& ext = prim["extensions"][kDraco];
             const size_t indices = prim["indices"].get<size_t>();
-            if (!ext.is_object() || !ext.contains("bufferView") || indices >= doc["accessors"].size()) continue;
+            if (!ext.is_object() || !ext.contains("bufferView") || indices >= doc["accessors"].size())
+                continue;
             nlohmann::json& acc = doc["accessors"][indices];
             if (!acc.is_object() || acc.contains("bufferView")) continue;
             acc["bufferView"] = ext["bufferView"];
@@ -93,20 +95,6 @@ std::optional<std::vector<unsigned char>> prepared_for_tinygltf(const std::vecto
     const bool placeholders = give_fallbacks_placeholders(doc, glb);
     if (!give_draco_indices_a_view(doc) && !placeholders) return std::nullopt;
     return with_json(file_bytes, json, glb, doc.dump());
-}
-
-std::span<const unsigned char> buffer_view_bytes(const Source& src, int bv, const std::string& element) {
-    const tinygltf::Model& m = src.model;
-    if (bv < 0 || size_t(bv) >= m.bufferViews.size())
-        throw input_error(src.file, element, "bufferView " + std::to_string(bv) + " does not exist");
-    const tinygltf::BufferView& view = m.bufferViews[size_t(bv)];
-    const std::string view_name = "bufferViews[" + std::to_string(bv) + "]";
-    if (view.buffer < 0 || size_t(view.buffer) >= m.buffers.size())
-        throw input_error(src.file, view_name, "buffer " + std::to_string(view.buffer) + " does not exist");
-    const std::vector<unsigned char>& data = m.buffers[size_t(view.buffer)].data;
-    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
-        throw input_error(src.file, view_name, "extends past the end of buffers[" + std::to_string(view.buffer) + "]");
-    return {data.data() + view.byteOffset, view.byteLength};
 }
 
 int append_buffer_view(Source& src, int buffer, const std::vector<unsigned char>& bytes) {

@@ -25,9 +25,6 @@ void decode_meshopt_views(Source& src);
 /// Decodes each primitive's KHR_draco_mesh_compression bitstream into its accessors.
 void decode_draco_primitives(Source& src);
 
-/// The bytes of bufferViews[bv], checked to lie inside their buffer.
-std::span<const unsigned char> buffer_view_bytes(const Source& src, int bv, const std::string& element);
-
 /// Appends `bytes` (4-byte aligned) to buffers[buffer] as a new bufferView; returns its index.
 int append_buffer_view(Source& src, int buffer, const std::vector<unsigned char>& bytes);
 

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct Source {
     /// Encoded bytes of images given as data: URIs, captured while tinygltf parses.
     std::map<int, std::vector<unsigned char>> data_uri_images;
 };
+
+/// The bytes of bufferViews[bv], checked to lie inside their buffer.
+std::span<const unsigned char> buffer_view_bytes(const Source& src, int bv, const std::string& element);
 
 /// Reads accessor `index` (referenced from `user`, e.g. "meshes[0].primitives[1].attributes.POSITION")
 /// as `components` numbers per element. Normalized integers map to [0,1] / [-1,1]; other integers
