@@ -135,3 +135,20 @@ TEST_CASE("info: OBJ and MTL materials by what they use") {
         CHECK(contains(ignored, "Ps (sheen)"));
     }
 }
+
+TEST_CASE("info: an OBJ with vertex colours says its lambertian material uses them") {
+    TempDir dir("info_obj_colours");
+    gltf::write_text(dir.path / "m.mtl", "newmtl plain\nKd 0.5 0.5 0.5\n");
+    gltf::write_text(dir.path / "m.obj",
+                     "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nusemtl plain\nf 1 2 3\n");
+    const json j = scene_info(dir / "m.obj").to_json();
+    json m;
+    for (const auto& [label, v] : j["Materials"].items())
+        if (v.is_object() && v["name"] == "plain") m = v;
+    CHECK(m["type"] == "lambertian");
+    CHECK(m["vertex_colors"] == true);
+    TempDir run("info_obj_colours_text");
+    const CliRun r = run_sahara("info " + (dir.path / "m.obj").string(), run);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("lambertian; vertex colours") != std::string::npos);
+}
