@@ -151,4 +151,16 @@ TEST_CASE("info: an OBJ with vertex colours says its lambertian material uses th
     const CliRun r = run_sahara("info " + (dir.path / "m.obj").string(), run);
     CHECK(r.code == 0);
     CHECK(r.out.find("lambertian; vertex colours") != std::string::npos);
+
+    // A scene material given to the coloured mesh is tinted too, and says so.
+    gltf::write_text(
+        dir.path / "s.json",
+        R"({"format": "scene/1", "camera": {"position": [0, -3, 1], "look_at": [0, 0, 0]}, "materials": {"red": {"type": "metal", "albedo": [1, 0, 0]}},
+                         "objects": [{"type": "mesh", "file": "m.obj", "material": "red"}]})");
+    const json scene = scene_info(dir / "s.json").to_json();
+    json red;
+    for (const auto& [label, v] : scene["Materials"].items())
+        if (v.is_object() && v["name"] == "red") red = v;
+    CHECK(red["type"] == "metal");
+    CHECK(red["vertex_colors"] == true);
 }

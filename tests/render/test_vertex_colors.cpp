@@ -4,6 +4,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "io/model_loader.h"
 #include "render_test_util.h"
 
@@ -17,12 +19,14 @@ namespace {
 /// `v` line (none when empty), loaded as the scene's only mesh under a white
 /// sky with `material`.
 SceneDesc quad_scene(const std::string& colour, const MaterialDesc& material) {
+    // One file per test process: ctest runs test cases in parallel.
     const fs::path dir = fs::temp_directory_path() / "sahara_render_vertex_colours";
     fs::create_directories(dir);
-    const fs::path file = dir / "quad.obj";
+    const fs::path file = dir / ("quad_" + std::to_string(::getpid()) + ".obj");
     std::ofstream(file, std::ios::binary) << "v 0 0 0 " << colour << "\nv 1 0 0 " << colour << "\nv 1 1 0 "
                                           << colour << "\nv 0 1 0 " << colour << "\nf 1 2 3 4\n";
     LoadedModel model = load_obj(file);
+    fs::remove(file);
     SceneDesc d = empty_scene(Rgb(1.0f));
     d.materials = {material};
     for (TriangleMesh& mesh : model.meshes) {
