@@ -80,7 +80,7 @@ struct MaterialDesc {
     int metallic_roughness_texture = -1;  ///< G scales roughness, B scales metallic
     int normal_texture = -1;              ///< tangent-space normal map
     float normal_scale = 1.0f;
-    bool vertex_colors = false;     ///< base colour also times the mesh's COLOR_0
+    bool vertex_colors = false;     ///< used by a mesh with vertex colours (any type: they tint the albedo)
     float transmission = 0.0f;      ///< KHR_materials_transmission
     int transmission_texture = -1;  ///< R scales transmission
     /// KHR_materials_volume: light inside decays to attenuation_color after this distance.

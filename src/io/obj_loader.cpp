@@ -94,7 +94,8 @@ bool is_convex_quad(const std::vector<Vec3>& q) {
     return true;
 }
 
-/// Rejects NaN/Inf in v, vn and vt (1-based element numbers as in the file).
+/// Rejects NaN/Inf in v, vn and vt, and NaN/Inf/negative vertex colours
+/// (1-based element numbers as in the file).
 void validate_attributes(const std::string& file, const tinyobj::attrib_t& attrib) {
     const std::pair<const std::vector<tinyobj::real_t>*, const char*> lists[] = {
         {&attrib.vertices, "v"}, {&attrib.normals, "vn"}, {&attrib.texcoords, "vt"}};
@@ -105,6 +106,22 @@ void validate_attributes(const std::string& file, const tinyobj::attrib_t& attri
                 throw input_error(file, std::string(name) + " #" + std::to_string(i / stride + 1),
                                   "coordinate is not a finite number");
     }
+    for (size_t i = 0; i < attrib.colors.size(); ++i) {
+        const tinyobj::real_t c = attrib.colors[i];
+        if (!std::isfinite(float(c)) || c < 0)
+            throw input_error(file, "v #" + std::to_string(i / 3 + 1),
+                              c < 0 ? "colour is negative" : "colour is not a finite number");
+    }
+}
+
+/// OBJ vertex colours as linear RGB, in place. Writers store display colours
+/// (sRGB-encoded, from 8-bit values): 0-1, or 0-255 by some tools, which any
+/// component above 1 gives away.
+void decode_vertex_colors(const std::string& file, std::vector<tinyobj::real_t>& colors) {
+    const bool bytes = std::any_of(colors.begin(), colors.end(), [](tinyobj::real_t c) { return c > 1; });
+    if (bytes) log_info(file + ": vertex colours above 1, read as 0-255");
+    for (tinyobj::real_t& c : colors)
+        c = tinyobj::real_t(srgb_decode(std::min(float(bytes ? c / 255 : c), 1.0f)));
 }
 
 /// Identifies an output vertex: OBJ position/texcoord/normal indices. In a
@@ -224,6 +241,10 @@ class ObjShapeBuilder {
             }
             mesh_.normals.push_back(n);
         }
+        if (!attrib_.colors.empty()) {
+            const tinyobj::real_t* c = &attrib_.colors[3 * size_t(key.v)];
+            mesh_.colors.emplace_back(float(c[0]), float(c[1]), float(c[2]));
+        }
         return it->second;
     }
 
@@ -263,6 +284,10 @@ void build_obj_meshes(const std::string& file, const tinyobj::attrib_t& attrib,
             mesh.material = ids.front();
             mesh.material_ids.clear();
         }
+        if (!mesh.colors.empty())  // so that `sahara info` says the colours are used
+            for (uint32_t id :
+                 mesh.material_ids.empty() ? std::vector<uint32_t>{mesh.material} : mesh.material_ids)
+                model.materials[id].vertex_colors = true;
         model.meshes.push_back(std::move(mesh));
     }
 }
@@ -323,8 +348,6 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
         throw input_error(file.string(), "", "malformed OBJ: " + first_line(err));
     log_obj_warnings(file.string(), warn, options.materials);
     for (tinyobj::material_t& m : materials) m.name = obj::decode_material_name(m.name);
-    if (!attrib.colors.empty())  // said once, rather than rendering grey without a word
-        log_warning(file.string() + ": vertex colours (v x y z r g b) are not rendered");
 
     LoadedModel model;
     obj::MtlKeys keys;
@@ -334,6 +357,7 @@ LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_m
     for (const tinyobj::material_t& m : materials)
         model.materials.push_back(obj::convert_material(m, keys[m.name], textures));
     validate_attributes(file.string(), attrib);
+    decode_vertex_colors(file.string(), attrib.colors);
     // The file's digits were read in double (tinyobjloader's double build): subtract
     // the centre before they become float, and let the transform (double) add it back.
     const Vec3d centre = far_model_centre(attrib.vertices);

@@ -170,9 +170,11 @@ void check_obj_numbers(const std::string& file, const std::string& text) {
         if (kind < 0) return;
         ++counts[kind];
         for (size_t i = 1; i < w.size(); ++i) {
+            const bool colour = kind == 0 && w.size() == 7 && i >= 4;  // v x y z r g b
             if (has_non_finite_word(w[i]))
-                throw input_error(file, std::string(names[kind]) + " #" + std::to_string(counts[kind]),
-                                  "coordinate is not a finite number");
+                throw input_error(
+                    file, std::string(names[kind]) + " #" + std::to_string(counts[kind]),
+                    colour ? "colour is not a finite number" : "coordinate is not a finite number");
             checker.check(w[i], number);
         }
     });

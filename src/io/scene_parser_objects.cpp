@@ -455,6 +455,8 @@ void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uin
         if (material_override) {
             mesh.material_ids.clear();
             mesh.material = *material_override;
+            // The mesh's colours tint whatever material it gets: `sahara info` says so.
+            if (!mesh.colors.empty()) scene.materials[mesh.material].vertex_colors = true;
         } else {
             mesh.material += material_offset;
             for (uint32_t& id : mesh.material_ids) id += material_offset;

@@ -79,9 +79,11 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     if (!roles.empty()) parts.push_back("textures: " + join(roles, ", "));
     value["textures"] = textures;
     const bool pbr = m.type == MaterialType::pbr;
-    value["vertex_colors"] = pbr && m.vertex_colors;
+    // Every type but dielectric and emissive has an albedo that vertex colours tint.
+    const bool tinted = m.vertex_colors && m.type != MaterialType::dielectric && m.type != MaterialType::emissive;
+    value["vertex_colors"] = tinted;
     value["vertex_alpha"] = m.vertex_alpha;
-    if (pbr && m.vertex_colors)
+    if (tinted)
         parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
     value["emission"] = emits_light(m);
     if (emits_light(m) && m.type != MaterialType::emissive) parts.push_back("emission");

@@ -83,10 +83,10 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
             break;
         case MaterialType::lambertian:
             b.kind = BsdfKind::lambertian;
-            b.albedo = eval_color(m.albedo, textures, si.p, si.uv);
+            b.albedo = material_albedo(m, si, textures);
             break;
         case MaterialType::metal:
-            b.albedo = eval_color(m.albedo, textures, si.p, si.uv);
+            b.albedo = material_albedo(m, si, textures);
             b.alpha = m.roughness * m.roughness;  // perceptual roughness, as in glTF
             b.kind = b.alpha < kMinGgxAlpha ? BsdfKind::mirror : BsdfKind::ggx;
             break;

@@ -46,6 +46,12 @@ struct BsdfSample {
     float eta_scale = 1;    ///< radiance scale 1/eta^2 undone, for Russian roulette
 };
 
+/// Any material's colour at `si`: albedo factor x texture x interpolated vertex
+/// colour (1 without). The Lambertian reflectance, the metal's F0, pbr's base
+/// colour, and what the albedo image shows; every albedo is evaluated here so
+/// that vertex colours tint all material types alike.
+Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+
 /// The BSDF of material `m` at `si`.
 Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
 

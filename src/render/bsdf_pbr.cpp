@@ -134,7 +134,8 @@ Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
 
 }  // namespace
 
-Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si,
+// Declared in render/bsdf.h; here because it shares texcoord with the pbr inputs.
+Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
                    const std::vector<TextureDesc>& textures) {
     return eval_color(m.albedo, textures, si.p, texcoord(si, textures, m.albedo.texture)) * si.color;
 }
@@ -147,7 +148,7 @@ Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
                    const std::vector<TextureDesc>& textures) {
     b.kind = BsdfKind::pbr;
-    b.albedo = pbr_base_color(m, si, textures);
+    b.albedo = material_albedo(m, si, textures);
     float roughness = m.roughness, metallic = m.metallic, transmission = m.transmission;
     if (m.metallic_roughness_texture >= 0) {
         const Rgb c = sample_texture_rgb(textures[size_t(m.metallic_roughness_texture)],

@@ -28,9 +28,6 @@ namespace sahara {
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
                    const std::vector<TextureDesc>& textures);
 
-/// Base colour at si (factor x texture x vertex colour), what the albedo image shows.
-Rgb pbr_base_color(const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures);
 /// Emitted radiance (factor x texture x strength), from either side.
 Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
                  const std::vector<TextureDesc>& textures);

@@ -72,7 +72,7 @@ template <bool kLambertOnly>
 auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si,
                   const std::vector<TextureDesc>& textures) {
     if constexpr (kLambertOnly)
-        return LambertShading{eval_color(m.albedo, textures, si.p, si.uv), si.ns, si.ng};
+        return LambertShading{material_albedo(m, si, textures), si.ns, si.ng};
     else
         return make_bsdf(m, si, textures);
 }
@@ -315,10 +315,8 @@ Rgb inspect(const Scene& scene, Ray ray) {
             return Rgb(1.0f);
         case MaterialType::emissive:
             return eval_color(m.radiance, scene.textures, si.p, si.uv);
-        case MaterialType::pbr:
-            return pbr_base_color(m, si, scene.textures);
         default:
-            return eval_color(m.albedo, scene.textures, si.p, si.uv);
+            return material_albedo(m, si, scene.textures);
     }
 }
 

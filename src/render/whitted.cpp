@@ -87,13 +87,13 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
             radiance += whitted_pbr(scene, si, m, wo, ray.time, depth, max_depth, weight);
             break;
         case MaterialType::lambertian: {
-            const Rgb albedo = eval_color(m.albedo, scene.textures, si.p, si.uv);
+            const Rgb albedo = material_albedo(m, si, scene.textures);
             radiance += albedo * eval_background(scene.background, si.ns);  // ambient
             radiance += direct_lights(scene, si, albedo, ray.time);
             break;
         }
         case MaterialType::metal: {  // roughness ignored: a perfect mirror
-            const Rgb f = fresnel_schlick(eval_color(m.albedo, scene.textures, si.p, si.uv), dot(wo, si.ns));
+            const Rgb f = fresnel_schlick(material_albedo(m, si, scene.textures), dot(wo, si.ns));
             const Vec3 wr = reflect(wo, si.ns);
             if (dot(wr, si.ng) > 0)
                 radiance +=

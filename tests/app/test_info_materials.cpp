@@ -135,3 +135,32 @@ TEST_CASE("info: OBJ and MTL materials by what they use") {
         CHECK(contains(ignored, "Ps (sheen)"));
     }
 }
+
+TEST_CASE("info: an OBJ with vertex colours says its lambertian material uses them") {
+    TempDir dir("info_obj_colours");
+    gltf::write_text(dir.path / "m.mtl", "newmtl plain\nKd 0.5 0.5 0.5\n");
+    gltf::write_text(dir.path / "m.obj",
+                     "mtllib m.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nusemtl plain\nf 1 2 3\n");
+    const json j = scene_info(dir / "m.obj").to_json();
+    json m;
+    for (const auto& [label, v] : j["Materials"].items())
+        if (v.is_object() && v["name"] == "plain") m = v;
+    CHECK(m["type"] == "lambertian");
+    CHECK(m["vertex_colors"] == true);
+    TempDir run("info_obj_colours_text");
+    const CliRun r = run_sahara("info " + (dir.path / "m.obj").string(), run);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("lambertian; vertex colours") != std::string::npos);
+
+    // A scene material given to the coloured mesh is tinted too, and says so.
+    gltf::write_text(
+        dir.path / "s.json",
+        R"({"format": "scene/1", "camera": {"position": [0, -3, 1], "look_at": [0, 0, 0]}, "materials": {"red": {"type": "metal", "albedo": [1, 0, 0]}},
+                         "objects": [{"type": "mesh", "file": "m.obj", "material": "red"}]})");
+    const json scene = scene_info(dir / "s.json").to_json();
+    json red;
+    for (const auto& [label, v] : scene["Materials"].items())
+        if (v.is_object() && v["name"] == "red") red = v;
+    CHECK(red["type"] == "metal");
+    CHECK(red["vertex_colors"] == true);
+}

@@ -78,6 +78,16 @@ def test_scene_info_is_the_info_report(workshop):
     assert "Load" in info["Time"] and "Build" in info["Time"]
 
 
+def test_scene_info_names_obj_vertex_colours(tmp_path):
+    obj = tmp_path / "coloured.obj"
+    obj.write_text("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n")
+    scene = {"format": "scene/1", "camera": {"position": [0, -3, 1], "look_at": [0, 0, 0]},
+             "objects": [{"type": "mesh", "file": str(obj)}]}
+    materials = sahara.Scene(scene).info()["Materials"]
+    coloured = [m["type"] for m in materials.values() if isinstance(m, dict) and m["vertex_colors"]]
+    assert coloured == ["lambertian"]
+
+
 def test_bvh_stats_has_the_keys_of_sahara_bvh_json(workshop, sahara_exe, tmp_path):
     scene_file = tmp_path / "workshop.json"
     scene_file.write_text(json.dumps(workshop))
