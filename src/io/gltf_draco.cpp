@@ -76,8 +76,7 @@ class DracoPrimitive {
         for (const std::string& semantic : attrs.Keys()) {
             const tinygltf::Value& id = attrs.Get(semantic);
             if (!id.IsNumber() || id.GetNumberAsInt() < 0)
-                throw input_error(src_.file, element_ + ".attributes." + semantic,
-                                  "is not an attribute id");
+                throw input_error(src_.file, element_ + ".attributes." + semantic, "is not an attribute id");
             fill_attribute(semantic, uint32_t(id.GetNumberAsInt()));
         }
         fill_indices();
@@ -107,7 +106,8 @@ class DracoPrimitive {
             throw input_error(src_.file, element, "is not an attribute of the primitive");
         const draco::PointAttribute* attr = mesh_->GetAttributeByUniqueId(id);
         if (attr == nullptr)
-            throw input_error(src_.file, element, "attribute id " + std::to_string(id) + " is not in the Draco data");
+            throw input_error(src_.file, element,
+                              "attribute id " + std::to_string(id) + " is not in the Draco data");
         const int index = claim(it->second, element);
         it->second = index;
         const tinygltf::Accessor& acc = src_.model.accessors[size_t(index)];
@@ -203,7 +203,8 @@ void decode_draco_primitives(Source& src) {
             auto ext = prims[p].extensions.find(kDraco);
             if (ext == prims[p].extensions.end()) continue;
             // Points and lines are skipped by the reader; Draco allows neither.
-            if (prims[p].mode != TINYGLTF_MODE_TRIANGLES && prims[p].mode != TINYGLTF_MODE_TRIANGLE_STRIP) continue;
+            if (prims[p].mode != TINYGLTF_MODE_TRIANGLES && prims[p].mode != TINYGLTF_MODE_TRIANGLE_STRIP)
+                continue;
             const std::string element = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
                                         "].extensions." + kDraco;
             try {

@@ -49,16 +49,19 @@ Compressed parse(const Source& src, const tinygltf::Value& ext, const tinygltf::
     const auto fail = [&](const std::string& why) { throw input_error(src.file, element, why); };
     if (c.mode != "ATTRIBUTES" && c.mode != "TRIANGLES" && c.mode != "INDICES")
         fail("mode must be ATTRIBUTES, TRIANGLES or INDICES");
-    if (c.filter != "NONE" && c.filter != "OCTAHEDRAL" && c.filter != "QUATERNION" && c.filter != "EXPONENTIAL")
+    if (c.filter != "NONE" && c.filter != "OCTAHEDRAL" && c.filter != "QUATERNION" &&
+        c.filter != "EXPONENTIAL")
         fail("filter must be NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
     if (view.byteStride != 0 && view.byteStride != c.stride) fail("byteStride differs from the bufferView's");
     if (view.byteLength != c.stride * c.count) fail("the bufferView's byteLength is not byteStride x count");
     if (c.mode == "ATTRIBUTES" && (c.stride == 0 || c.stride % 4 != 0 || c.stride > 256))
         fail("byteStride of ATTRIBUTES must be a multiple of 4 up to 256");
-    if (c.mode != "ATTRIBUTES" && c.stride != 2 && c.stride != 4) fail("byteStride of indices must be 2 or 4");
+    if (c.mode != "ATTRIBUTES" && c.stride != 2 && c.stride != 4)
+        fail("byteStride of indices must be 2 or 4");
     if (c.mode != "ATTRIBUTES" && c.filter != "NONE") fail("indices take no filter");
     if (c.mode == "TRIANGLES" && c.count % 3 != 0) fail("count of TRIANGLES must be a multiple of 3");
-    if (c.filter == "OCTAHEDRAL" && c.stride != 4 && c.stride != 8) fail("OCTAHEDRAL needs byteStride 4 or 8");
+    if (c.filter == "OCTAHEDRAL" && c.stride != 4 && c.stride != 8)
+        fail("OCTAHEDRAL needs byteStride 4 or 8");
     if (c.filter == "QUATERNION" && c.stride != 8) fail("QUATERNION needs byteStride 8");
     // The codecs spend at least 2 bits per 16 decoded bytes: a larger claim is not
     // backed by the data and must not make a small file allocate gigabytes.
@@ -71,7 +74,8 @@ std::vector<unsigned char> decode(const Source& src, const Compressed& c, const 
     std::vector<unsigned char> out(c.stride * c.count);
     if (c.count == 0) return out;
     if (c.buffer < 0 || size_t(c.buffer) >= src.model.buffers.size())
-        throw input_error(src.file, element + ".buffer", "buffer " + std::to_string(c.buffer) + " does not exist");
+        throw input_error(src.file, element + ".buffer",
+                          "buffer " + std::to_string(c.buffer) + " does not exist");
     const std::vector<unsigned char>& data = src.model.buffers[size_t(c.buffer)].data;
     if (c.offset > data.size() || c.length > data.size() - c.offset)
         throw input_error(src.file, element,
@@ -85,7 +89,8 @@ std::vector<unsigned char> decode(const Source& src, const Compressed& c, const 
     else
         status = meshopt_decodeIndexSequence(out.data(), c.count, c.stride, in, c.length);
     if (status != 0)
-        throw input_error(src.file, element, "corrupt meshopt data (decoder status " + std::to_string(status) + ")");
+        throw input_error(src.file, element,
+                          "corrupt meshopt data (decoder status " + std::to_string(status) + ")");
     if (c.filter == "OCTAHEDRAL") meshopt_decodeFilterOct(out.data(), c.count, c.stride);
     if (c.filter == "QUATERNION") meshopt_decodeFilterQuat(out.data(), c.count, c.stride);
     if (c.filter == "EXPONENTIAL") meshopt_decodeFilterExp(out.data(), c.count, c.stride);

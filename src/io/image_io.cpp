@@ -56,8 +56,9 @@ void check_output_path(const fs::path& file) {
     if (dir.empty()) dir = ".";
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
-        throw input_error(name, "", "output directory '" + dir.string() +
-                                        (fs::exists(dir, ec) ? "' is not a directory" : "' does not exist"));
+        throw input_error(name, "",
+                          "output directory '" + dir.string() +
+                              (fs::exists(dir, ec) ? "' is not a directory" : "' does not exist"));
     // Checked now, not when the finished image cannot be renamed onto it.
     if (fs::is_directory(file, ec)) throw input_error(name, "", "is a directory, not an image file name");
     if (::access(dir.c_str(), W_OK) != 0) throw input_error(name, "", "output directory is not writable");

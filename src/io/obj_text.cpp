@@ -41,8 +41,8 @@ std::string encode_blanks(std::string_view name) {
 bool is_data_line(std::string_view t) {
     const size_t end = t.find_first_of(" \t");
     const std::string_view key = t.substr(0, end);
-    return end != std::string_view::npos &&
-           (key == "v" || key == "vt" || key == "vn" || key == "vp" || key == "f" || key == "l" || key == "p");
+    return end != std::string_view::npos && (key == "v" || key == "vt" || key == "vn" || key == "vp" ||
+                                             key == "f" || key == "l" || key == "p");
 }
 
 std::string clean_data_line(std::string_view t) {

@@ -80,11 +80,11 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     value["textures"] = textures;
     const bool pbr = m.type == MaterialType::pbr;
     // Every type but dielectric and emissive has an albedo that vertex colours tint.
-    const bool tinted = m.vertex_colors && m.type != MaterialType::dielectric && m.type != MaterialType::emissive;
+    const bool tinted =
+        m.vertex_colors && m.type != MaterialType::dielectric && m.type != MaterialType::emissive;
     value["vertex_colors"] = tinted;
     value["vertex_alpha"] = m.vertex_alpha;
-    if (tinted)
-        parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
+    if (tinted) parts.push_back(m.vertex_alpha ? "vertex colours and alpha" : "vertex colours");
     value["emission"] = emits_light(m);
     if (emits_light(m) && m.type != MaterialType::emissive) parts.push_back("emission");
     const bool transmits = pbr && (m.transmission > 0.0f || m.transmission_texture >= 0);

@@ -34,14 +34,16 @@ Json convert(const py::handle& h, const std::string& what, const std::string& pa
         try {
             return h.cast<uint64_t>();  // a seed may use all 64 bits
         } catch (const py::cast_error&) {
-            throw py::value_error(where(what, path) + ": integer too large (" + std::string(py::str(h)) + ")");
+            throw py::value_error(where(what, path) + ": integer too large (" + std::string(py::str(h)) +
+                                  ")");
         }
     }
     if (py::isinstance<py::float_>(h)) {
         // JSON has no NaN or infinity: the parser would see null and say so.
         const double v = h.cast<double>();
         if (!std::isfinite(v))
-            throw InputError(where(what, path) + ": expected a finite number, got " + std::string(py::repr(h)));
+            throw InputError(where(what, path) + ": expected a finite number, got " +
+                             std::string(py::repr(h)));
         return v;
     }
     if (py::isinstance<py::str>(h)) return h.cast<std::string>();

@@ -50,7 +50,8 @@ struct BsdfSample {
 /// colour (1 without). The Lambertian reflectance, the metal's F0, pbr's base
 /// colour, and what the albedo image shows; every albedo is evaluated here so
 /// that vertex colours tint all material types alike.
-Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
+                    const std::vector<TextureDesc>& textures);
 
 /// The BSDF of material `m` at `si`.
 Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);

@@ -136,7 +136,7 @@ Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
 
 // Declared in render/bsdf.h; here because it shares texcoord with the pbr inputs.
 Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures) {
+                    const std::vector<TextureDesc>& textures) {
     return eval_color(m.albedo, textures, si.p, texcoord(si, textures, m.albedo.texture)) * si.color;
 }
 

@@ -64,7 +64,8 @@ BvhCostImage render_bvh_cost(const Scene& scene, int width, int height, int thre
     // last column repeats the colour of the one before it.
     for (int x = bar_x0; x <= std::min(bar_x1, width - 1); ++x) {
         // An image under 18 pixels wide has a one-column bar: no 0/0 there.
-        const Rgb c = heat_color(float(std::min(x, bar_x1 - 1) - bar_x0) / float(std::max(1, bar_x1 - bar_x0 - 1)));
+        const Rgb c =
+            heat_color(float(std::min(x, bar_x1 - 1) - bar_x0) / float(std::max(1, bar_x1 - bar_x0 - 1)));
         for (int y = bar_y0; y <= bar_y1; ++y) set(x, y, c);
     }
     out.labels.push_back({"0", bar_x0, bar_y1 + 4, kLabelSize, false});

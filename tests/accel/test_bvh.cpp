@@ -197,7 +197,8 @@ TEST_CASE("reinsertion never raises the SAH cost of its input") {
             CHECK(compute_bvh_stats(optimized).sah_cost <= compute_bvh_stats(input).sah_cost * (1 + 1e-9));
         }
         const double binned = compute_bvh_stats(build_for_mesh(m, BvhBuilder::binned)).sah_cost;
-        const double reinsert = compute_bvh_stats(build_for_mesh(m, BvhBuilder::reinsert, plain_sah)).sah_cost;
+        const double reinsert =
+            compute_bvh_stats(build_for_mesh(m, BvhBuilder::reinsert, plain_sah)).sah_cost;
         INFO(m.name, " binned ", binned, " reinsert ", reinsert);
         CHECK(reinsert <= binned * (1 + 1e-9));
     }

@@ -95,9 +95,11 @@ void add_box(TriangleMesh& m, const Vec3& lo, const Vec3& hi) {
     const auto base = uint32_t(m.positions.size());
     for (int i = 0; i < 8; ++i)
         m.positions.push_back(Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
-    const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                  {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
     for (const auto& f : faces)
-        m.indices.insert(m.indices.end(), {base + f[0], base + f[1], base + f[2], base + f[0], base + f[2], base + f[3]});
+        m.indices.insert(m.indices.end(),
+                         {base + f[0], base + f[1], base + f[2], base + f[0], base + f[2], base + f[3]});
 }
 
 /// An open-plan office: floor and ceiling slabs with a thickness reaching under the
@@ -106,9 +108,9 @@ TriangleMesh make_slab_office() {
     TriangleMesh m;
     m.name = "slab office";
     const float length = 30, width = 16, height = 3.2f, t = 0.3f;
-    add_box(m, Vec3(-t, -t, -t), Vec3(length + t, width + t, 0));                // floor slab
-    add_box(m, Vec3(-t, -t, height), Vec3(length + t, width + t, height + t));   // ceiling slab
-    add_box(m, Vec3(0, -t, 0), Vec3(length, 0, height));                         // walls
+    add_box(m, Vec3(-t, -t, -t), Vec3(length + t, width + t, 0));               // floor slab
+    add_box(m, Vec3(-t, -t, height), Vec3(length + t, width + t, height + t));  // ceiling slab
+    add_box(m, Vec3(0, -t, 0), Vec3(length, 0, height));                        // walls
     add_box(m, Vec3(0, width, 0), Vec3(length, width + t, height));
     add_box(m, Vec3(-t, 0, 0), Vec3(0, width, height));
     add_box(m, Vec3(length, 0, 0), Vec3(length + t, width, height));
@@ -285,8 +287,8 @@ TEST_CASE("reinsertion keeps the slabs of a room out of large leaves") {
     const uint32_t with_rule = largest_leaf_with_large_primitive(bvh, boxes, share);
     BvhBuildParams plain = params;
     plain.large_leaf_cost_factor = 1.0f;
-    const uint32_t without_rule =
-        largest_leaf_with_large_primitive(build_bvh({boxes, centers}, BvhBuilder::reinsert, plain), boxes, share);
+    const uint32_t without_rule = largest_leaf_with_large_primitive(
+        build_bvh({boxes, centers}, BvhBuilder::reinsert, plain), boxes, share);
     INFO("with the rule ", with_rule, ", without ", without_rule);
     CHECK(with_rule > 0);
     CHECK(with_rule <= 4);

@@ -34,8 +34,8 @@ inline GridMesh grid_mesh(int n = 4) {
     const auto at = [n](int x, int y) { return uint32_t(y * (n + 1) + x); };
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-            g.indices.insert(g.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y), at(x + 1, y + 1),
-                                               at(x, y + 1)});
+            g.indices.insert(g.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y),
+                                               at(x + 1, y + 1), at(x, y + 1)});
     return g;
 }
 
@@ -52,8 +52,8 @@ inline Doc plain_grid_doc(const GridMesh& g) {
 
 /// Checks that `got` has the triangles of `want`, corner by corner, with
 /// positions, normals and uvs equal within `pos_tol`, `nrm_tol` and `uv_tol`.
-inline void check_same_corners(const TriangleMesh& got, const TriangleMesh& want, float pos_tol, float nrm_tol,
-                               float uv_tol) {
+inline void check_same_corners(const TriangleMesh& got, const TriangleMesh& want, float pos_tol,
+                               float nrm_tol, float uv_tol) {
     REQUIRE(got.indices.size() == want.indices.size());
     REQUIRE(got.normals.size() == got.positions.size());
     REQUIRE(got.uvs.size() == got.positions.size());
@@ -64,7 +64,8 @@ inline void check_same_corners(const TriangleMesh& got, const TriangleMesh& want
             pos_err = std::max(pos_err, std::abs(got.positions[a][k] - want.positions[b][k]));
             nrm_err = std::max(nrm_err, std::abs(got.normals[a][k] - want.normals[b][k]));
         }
-        uv_err = std::max({uv_err, std::abs(got.uvs[a].x - want.uvs[b].x), std::abs(got.uvs[a].y - want.uvs[b].y)});
+        uv_err = std::max(
+            {uv_err, std::abs(got.uvs[a].x - want.uvs[b].x), std::abs(got.uvs[a].y - want.uvs[b].y)});
     }
     CHECK(pos_err <= pos_tol);
     CHECK(nrm_err <= nrm_tol);

@@ -29,7 +29,8 @@ std::vector<uint8_t> draco_bytes(const GridMesh& g, bool sequential = true) {
                                     &g.positions[3 * i[2]]);
         b.SetAttributeValuesForFace(nrm, draco::FaceIndex(f), &g.normals[3 * i[0]], &g.normals[3 * i[1]],
                                     &g.normals[3 * i[2]]);
-        b.SetAttributeValuesForFace(uv, draco::FaceIndex(f), &g.uvs[2 * i[0]], &g.uvs[2 * i[1]], &g.uvs[2 * i[2]]);
+        b.SetAttributeValuesForFace(uv, draco::FaceIndex(f), &g.uvs[2 * i[0]], &g.uvs[2 * i[1]],
+                                    &g.uvs[2 * i[2]]);
     }
     const std::unique_ptr<draco::Mesh> mesh = b.Finalize();
     REQUIRE(mesh != nullptr);
@@ -68,8 +69,9 @@ Doc draco_doc(const std::vector<uint8_t>& bytes, const std::vector<uint8_t>& sou
     d.j["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     const size_t at = d.blob.add(bytes);
     d.j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", at}, {"byteLength", bytes.size()}});
-    for (const json& a : {compressed_accessor(5126, "VEC3", points), compressed_accessor(5126, "VEC3", points),
-                          compressed_accessor(5126, "VEC2", points), compressed_accessor(5123, "SCALAR", 3 * faces)})
+    for (const json& a :
+         {compressed_accessor(5126, "VEC3", points), compressed_accessor(5126, "VEC3", points),
+          compressed_accessor(5126, "VEC2", points), compressed_accessor(5123, "SCALAR", 3 * faces)})
         d.j["accessors"].push_back(a);
     d.node({{"mesh", d.mesh(0, 3, 4, {{"NORMAL", 1}, {"TEXCOORD_0", 2}})}});
     d.j["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"] = {
@@ -127,8 +129,9 @@ TEST_CASE("glTF KHR_draco_mesh_compression accessor counts must match the decode
     const std::vector<uint8_t> bytes = draco_bytes(grid_mesh());
     Doc d = draco_doc(bytes, bytes);
     d.j["accessors"][1]["count"] = 3;
-    CHECK(error_of([&] { load_gltf(d.write(dir / "n.gltf")); }).find(std::string(kElement) + ".attributes.NORMAL") !=
-          std::string::npos);
+    CHECK(error_of([&] {
+              load_gltf(d.write(dir / "n.gltf"));
+          }).find(std::string(kElement) + ".attributes.NORMAL") != std::string::npos);
     d = draco_doc(bytes, bytes);
     d.j["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["NORMAL"] = 7;
     const std::string e = error_of([&] { load_gltf(d.write(dir / "id.gltf")); });
@@ -150,8 +153,10 @@ TEST_CASE("glTF KHR_draco_mesh_compression corrupt bitstreams are InputErrors na
     for (size_t i = 0; i < good.size(); ++i) {
         for (int variant = 0; variant < 2; ++variant) {
             bytes = good;
-            if (variant == 0) bytes[i] ^= 0xFF;
-            else bytes.resize(std::max<size_t>(i, 1));  // (no empty view: the test blob copies bytes)
+            if (variant == 0)
+                bytes[i] ^= 0xFF;
+            else
+                bytes.resize(std::max<size_t>(i, 1));  // (no empty view: the test blob copies bytes)
             try {
                 load_gltf(draco_doc(bytes, good).write(dir / "flip.gltf"));
             } catch (const InputError&) {

@@ -25,9 +25,10 @@ struct MeshoptDoc {
         const size_t at = d.blob.add(compressed);
         json view = {{"buffer", 1}, {"byteOffset", fallback_size}, {"byteLength", count * stride}};
         if (std::string(mode) == "ATTRIBUTES") view["byteStride"] = stride;
-        view["extensions"][kExt] = {{"buffer", 0},          {"byteOffset", at}, {"byteLength", compressed.size()},
-                                    {"byteStride", stride}, {"count", count},   {"mode", mode},
-                                    {"filter", filter}};
+        view["extensions"][kExt] = {
+            {"buffer", 0},          {"byteOffset", at}, {"byteLength", compressed.size()},
+            {"byteStride", stride}, {"count", count},   {"mode", mode},
+            {"filter", filter}};
         fallback_size += (count * stride + 3) / 4 * 4;
         d.j["bufferViews"].push_back(view);
         json a = {{"bufferView", d.j["bufferViews"].size() - 1},
@@ -77,7 +78,8 @@ std::vector<uint8_t> encode_triangles(const std::vector<uint32_t>& idx, size_t v
 /// may be rotated (same corners, same winding), so corners compare in that order.
 GridMesh as_index_codec_returns(GridMesh g) {
     const std::vector<uint8_t> bytes = encode_triangles(g.indices, g.vertices());
-    REQUIRE(meshopt_decodeIndexBuffer(g.indices.data(), g.indices.size(), 4, bytes.data(), bytes.size()) == 0);
+    REQUIRE(meshopt_decodeIndexBuffer(g.indices.data(), g.indices.size(), 4, bytes.data(), bytes.size()) ==
+            0);
     return g;
 }
 
@@ -90,14 +92,16 @@ MeshoptDoc meshopt_grid(const GridMesh& g, bool triangles_mode) {
     const size_t n = g.vertices();
     const int pos = m.accessor(encode_vertices(g.positions, 12), n, 12, "ATTRIBUTES", "NONE", 5126, "VEC3");
     std::vector<float> n4;
-    for (size_t i = 0; i < n; ++i) n4.insert(n4.end(), {g.normals[3 * i], g.normals[3 * i + 1], g.normals[3 * i + 2], 0});
+    for (size_t i = 0; i < n; ++i)
+        n4.insert(n4.end(), {g.normals[3 * i], g.normals[3 * i + 1], g.normals[3 * i + 2], 0});
     std::vector<int8_t> oct(4 * n);
     meshopt_encodeFilterOct(oct.data(), n, 4, 8, n4.data());
     const int nrm = m.accessor(encode_vertices(oct, 4), n, 4, "ATTRIBUTES", "OCTAHEDRAL", 5120, "VEC3", true);
     const int uv = m.accessor(encode_vertices(g.uvs, 8), n, 8, "ATTRIBUTES", "NONE", 5126, "VEC2");
     int idx = -1;
     if (triangles_mode) {
-        idx = m.accessor(encode_triangles(g.indices, n), g.indices.size(), 4, "TRIANGLES", "NONE", 5125, "SCALAR");
+        idx = m.accessor(encode_triangles(g.indices, n), g.indices.size(), 4, "TRIANGLES", "NONE", 5125,
+                         "SCALAR");
     } else {
         std::vector<uint8_t> seq(meshopt_encodeIndexSequenceBound(g.indices.size(), n));
         seq.resize(meshopt_encodeIndexSequence(seq.data(), seq.size(), g.indices.data(), g.indices.size()));
@@ -118,8 +122,10 @@ TEST_CASE("glTF EXT_meshopt_compression loads like the uncompressed mesh (.gltf 
         const LoadedModel plain = load_gltf(plain_grid_doc(want).write(dir / "plain.gltf"));
         MeshoptDoc m = meshopt_grid(g, triangles_mode);
         // Unfiltered data is exact; 8-bit octahedral normals are within about 1/127.
-        check_same_corners(load_gltf(m.write(dir / "m.gltf")).meshes.at(0), plain.meshes[0], 0.0f, 0.02f, 0.0f);
-        check_same_corners(load_gltf(m.write_glb(dir / "m.glb")).meshes.at(0), plain.meshes[0], 0.0f, 0.02f, 0.0f);
+        check_same_corners(load_gltf(m.write(dir / "m.gltf")).meshes.at(0), plain.meshes[0], 0.0f, 0.02f,
+                           0.0f);
+        check_same_corners(load_gltf(m.write_glb(dir / "m.glb")).meshes.at(0), plain.meshes[0], 0.0f, 0.02f,
+                           0.0f);
     }
 }
 
@@ -133,7 +139,8 @@ TEST_CASE("glTF EXT_meshopt_compression EXPONENTIAL filter") {
     m.accessor(encode_vertices(exp, 12), g.vertices(), 12, "ATTRIBUTES", "EXPONENTIAL", 5126, "VEC3");
     m.d.j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = m.d.j["accessors"].size() - 1;
     const LoadedModel plain = load_gltf(plain_grid_doc(as_index_codec_returns(g)).write(dir / "plain.gltf"));
-    check_same_corners(load_gltf(m.write(dir / "exp.gltf")).meshes.at(0), plain.meshes[0], 1e-5f, 0.02f, 0.0f);
+    check_same_corners(load_gltf(m.write(dir / "exp.gltf")).meshes.at(0), plain.meshes[0], 1e-5f, 0.02f,
+                       0.0f);
 }
 
 TEST_CASE("glTF EXT_meshopt_compression corrupt data is an InputError naming the bufferView") {
@@ -143,14 +150,16 @@ TEST_CASE("glTF EXT_meshopt_compression corrupt data is an InputError naming the
     json& ext = m.d.j["bufferViews"][0]["extensions"][kExt];
     const size_t length = ext["byteLength"];
     ext["byteLength"] = length / 2;
-    CHECK(error_of([&] { load_gltf(m.write(dir / "half.gltf")); }).find("bufferViews[0].extensions." + std::string(kExt)) !=
-          std::string::npos);
+    CHECK(error_of([&] {
+              load_gltf(m.write(dir / "half.gltf"));
+          }).find("bufferViews[0].extensions." + std::string(kExt)) != std::string::npos);
     ext["byteLength"] = length;
     ext["mode"] = "SPIRAL";
     CHECK(error_of([&] { load_gltf(m.write(dir / "mode.gltf")); }).find("mode must be") != std::string::npos);
     ext["mode"] = "ATTRIBUTES";
     ext["count"] = 1u << 30;  // a few bytes cannot hold 12 GB
-    CHECK(error_of([&] { load_gltf(m.write(dir / "count.gltf")); }).find("bufferViews[0]") != std::string::npos);
+    CHECK(error_of([&] { load_gltf(m.write(dir / "count.gltf")); }).find("bufferViews[0]") !=
+          std::string::npos);
     // Every single flipped byte of the index data: an InputError or a mesh, never a crash.
     MeshoptDoc good = meshopt_grid(g, true);
     const json idx_ext = good.d.j["bufferViews"][3]["extensions"][kExt];

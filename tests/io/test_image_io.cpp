@@ -113,7 +113,8 @@ TEST_CASE("an output name that is a directory or under a file is refused with th
     fs::create_directory(dir / "taken.png");
     std::ofstream(dir / "plain.txt") << "x";
     CHECK_THROWS_WITH(check_output_path(dir / "taken.png"), doctest::Contains("is a directory"));
-    CHECK_THROWS_WITH(check_output_path(dir / "plain.txt" / "x.png"), doctest::Contains("is not a directory"));
+    CHECK_THROWS_WITH(check_output_path(dir / "plain.txt" / "x.png"),
+                      doctest::Contains("is not a directory"));
     // Written anyway, the rename fails; the message gives its real reason.
     try {
         write_image(dir / "taken.png", 2, 2, std::vector<float>(12, 0.5f));
@@ -122,7 +123,8 @@ TEST_CASE("an output name that is a directory or under a file is refused with th
         CHECK(std::string(e.what()).find("Success") == std::string::npos);
     }
     int files = 0;
-    for (const auto& e : fs::directory_iterator(dir)) files += e.path().filename().string().find(".tmp") != std::string::npos;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.path().filename().string().find(".tmp") != std::string::npos;
     CHECK(files == 0);
 }
 
