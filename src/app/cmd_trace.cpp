@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "scene/accelerator.h"
@@ -85,7 +87,35 @@ struct TraceArgs {
     bool help = false;
 };
 
+/// An output that names an input (or the other output) would replace the very file
+/// being read: refused before anything is traced. Outputs that do not exist yet are
+/// new files, so only existing ones are compared.
+void check_outputs_are_new_files(const TraceArgs& args) {
+    const std::pair<const std::string*, const char*> inputs[] = {
+        {&args.mesh, "the mesh"}, {&args.rays, "--rays"}, {&args.hits, "--hits"}};
+    const std::pair<const std::string*, const char*> outputs[] = {{&args.hits, "--hits"},
+                                                                  {&args.occlusion, "--occlusion"}};
+    std::error_code ec, ec2;
+    if (!args.occlusion.empty()) {
+        const auto hits = std::filesystem::weakly_canonical(args.hits, ec);
+        const auto occl = std::filesystem::weakly_canonical(args.occlusion, ec2);
+        if (!ec && !ec2 && hits == occl)
+            throw input_error(args.occlusion, "", "--occlusion names the same file as --hits");
+    }
+    for (const auto& [out, out_name] : outputs) {
+        if (out->empty() || !std::filesystem::exists(*out, ec)) continue;
+        for (const auto& [in, in_name] : inputs) {
+            if (in == out || in->empty()) continue;
+            if (std::filesystem::equivalent(*out, *in, ec))
+                throw input_error(*out, "",
+                                  std::string(out_name) + " names the same file as " + in_name +
+                                      "; refusing to overwrite it");
+        }
+    }
+}
+
 int trace(const TraceArgs& args) {
+    check_outputs_are_new_files(args);
     if (const FileKind kind = file_kind(args.mesh); kind == FileKind::scene || kind == FileKind::gltf)
         throw input_error(args.mesh, "",
                           "trace reads OBJ meshes only (primitive indices are OBJ triangle indices)");

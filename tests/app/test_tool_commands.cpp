@@ -136,6 +136,16 @@ TEST_CASE("trace command: hits, occlusion, fan-split indices and bad input") {
     CHECK(run({"trace", obj.string(), "--rays", (dir / "missing.rays").string(), "--hits", out2.string()}) ==
           2);
     CHECK(!std::filesystem::exists(out2));
+    // An output naming an input file is refused, and the input stays as it was.
+    const auto rays_size = std::filesystem::file_size(rays_file);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", rays_file.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--occlusion",
+               (dir / "." / "in.rays").string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", obj.string()}) == 2);
+    CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--occlusion",
+               out2.string()}) == 2);
+    CHECK(std::filesystem::file_size(rays_file) == rays_size);
+    CHECK(!std::filesystem::exists(out2));
     CHECK(run({"trace", obj.string(), "--hits", out2.string()}) == 2);
     CHECK(run({"trace", obj.string(), "--rays", rays_file.string(), "--hits", out2.string(), "--bogus"}) ==
           2);
