@@ -90,10 +90,18 @@ std::pair<int, int> parse_size_value(const std::string& flag, const std::string&
         const int n = int(parse_int_value(flag, value, 1, 32768));
         return {n, n};
     }
-    if (value.find('x', x + 1) != std::string::npos)
+    if (value.find('x', x + 1) != std::string::npos || x == 0 || x + 1 == value.size())
         throw UsageError(flag + ": expected WxH or N, got '" + value + "'");
-    return {int(parse_int_value(flag, value.substr(0, x), 1, 32768)),
-            int(parse_int_value(flag, value.substr(x + 1), 1, 32768))};
+    // The width or height alone is named in the message, with the whole value beside it.
+    const auto side = [&](const std::string& part, const char* name) {
+        try {
+            return int(parse_int_value(flag, part, 1, 32768));
+        } catch (const UsageError&) {
+            throw UsageError(flag + ": the " + name + " must be an integer in 1..32768, got '" + part +
+                             "' in '" + value + "'");
+        }
+    };
+    return {side(value.substr(0, x), "width"), side(value.substr(x + 1), "height")};
 }
 
 CLI::Option* add_threads_option(CLI::App& app, int& threads) {

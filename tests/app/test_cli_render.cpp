@@ -385,6 +385,19 @@ TEST_CASE("render flags accept the scene file's ranges, and --size WxH or N") {
     CHECK_THROWS_AS(parse_render_args({"--max-depth", "0"}), UsageError);
     CHECK_THROWS_AS(parse_render_args({"--max-depth", "1025"}), UsageError);
     CHECK_THROWS_AS(parse_render_args({"--size", "8x8x8"}), UsageError);
+    // A missing or bad side is named, with the value it came from.
+    for (const auto& [value, says] :
+         {std::pair{"10x", "expected WxH or N, got '10x'"}, std::pair{"x10", "expected WxH or N, got 'x10'"},
+          std::pair{"0x10", "the width must be an integer in 1..32768, got '0'"},
+          std::pair{"10xq", "the height must be an integer in 1..32768, got 'q'"}}) {
+        CAPTURE(value);
+        try {
+            parse_render_args({"--size", value});
+            FAIL("no error");
+        } catch (const UsageError& e) {
+            CHECK(std::string(e.what()).find(says) != std::string::npos);
+        }
+    }
     // A repeated option keeps its last value, as before.
     CHECK(*parse_render_args({"--spp", "2", "--spp", "5"}).overrides.spp == 5);
 }

@@ -62,7 +62,7 @@ TEST_CASE("cli usage: missing and malformed values are one line too") {
     check_one_line_usage_error("render --max-depth 0", "render",
                                "--max-depth: expected an integer in 1..1024");
     check_one_line_usage_error("render --threads 0", "render", "--threads: expected an integer in 1..1024");
-    check_one_line_usage_error("view m.obj --size 8x", "view", "--size: expected an integer");
+    check_one_line_usage_error("view m.obj --size 8x", "view", "--size: expected WxH or N, got '8x'");
     check_one_line_usage_error("bvh m.obj --size 0", "bvh", "--size: expected an integer");
     check_one_line_usage_error("--bogus render", "", "unknown option '--bogus'");
     check_one_line_usage_error("trace m.obj", "trace", "--rays and --hits are required");
