@@ -1,7 +1,6 @@
 /// `sahara trace`: traces a raw ray file against a mesh and writes raw hit
 /// (and optionally occlusion) files, for checking sahara against other tracers.
 #include <CLI/CLI.hpp>
-#include <unistd.h>
 
 #include <bit>
 #include <cmath>
@@ -19,7 +18,6 @@
 #include "pipeline/mesh_input.h"
 #include "app/cli_args.h"
 #include "base/error.h"
-#include "base/pending_file.h"
 #include "io/files.h"
 
 namespace sahara {
@@ -59,27 +57,16 @@ std::vector<Ray> read_ray_file(const std::string& path) {
     return rays;
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then rename.
-void write_atomically(const std::string& path, const std::vector<char>& bytes) {
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-    const PendingFile pending(tmp);  // an interrupt removes the temporary
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw input_error(path, "", "cannot write output");
-        out.write(bytes.data(), std::streamsize(bytes.size()));
-        out.flush();
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            throw input_error(path, "", "write failed");
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw input_error(path, "", "cannot rename temporary file into place");
-    }
+/// Writes `bytes` to `path` through a temporary: an interrupted or failed trace leaves no half file.
+void write_output(const std::string& path, const std::vector<char>& bytes) {
+    write_via_temporary(
+        path,
+        [&](const std::filesystem::path& tmp) {
+            std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+            out.write(bytes.data(), std::streamsize(bytes.size()));
+            return out.flush() ? std::string() : std::string("cannot write the file");
+        },
+        "output");
 }
 
 struct TraceArgs {
@@ -135,8 +122,8 @@ int trace(const TraceArgs& args) {
         std::memcpy(&hits[8 * i + 4], &prim, 4);
         if (want_occl) occl[i] = accel.occluded(rays[i]) ? 1 : 0;
     }
-    write_atomically(args.hits, hits);
-    if (want_occl) write_atomically(args.occlusion, occl);
+    write_output(args.hits, hits);
+    if (want_occl) write_output(args.occlusion, occl);
     return 0;
 }
 

@@ -1,10 +1,13 @@
 #include "io/files.h"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 
 #include "base/error.h"
+#include "base/pending_file.h"
 
 namespace sahara {
 
@@ -59,6 +62,27 @@ FileKind file_kind(const fs::path& file) {
     for (const auto& [name, kind] : kinds)
         if (ext == name) return kind;
     return FileKind::other;
+}
+
+void write_via_temporary(const fs::path& file, const std::function<std::string(const fs::path& tmp)>& write,
+                         const std::string& what) {
+    fs::path tmp = file;
+    std::string name(".");  // built piecewise: gcc 12 warns falsely (-Wrestrict) on a + chain
+    name.append(file.stem().string()).append(".tmp").append(std::to_string(::getpid()));
+    name.append(file.extension().string());
+    tmp.replace_filename(name);
+    const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
+    std::error_code ec;
+    if (const std::string why = write(tmp); !why.empty()) {
+        fs::remove(tmp, ec);
+        throw input_error(file.string(), "", why);
+    }
+    fs::rename(tmp, file, ec);
+    if (ec) {
+        const std::string why = ec.message();  // before remove() overwrites ec
+        fs::remove(tmp, ec);
+        throw input_error(file.string(), "", "cannot move the finished " + what + " into place: " + why);
+    }
 }
 
 }  // namespace sahara

@@ -1,8 +1,9 @@
 #pragma once
-/// The one whole-file reader and the one extension check of sahara: every
+/// The one whole-file reader, the one output writer and the one extension check of sahara: every
 /// command and loader reads input files and decides a file's kind here, so a
 /// missing file reads the same everywhere and `MODEL.OBJ` works like `model.obj`.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,15 @@ namespace sahara {
 std::string read_file(const std::filesystem::path& file, const std::string& what = "");
 /// The same, as bytes (binary formats such as .glb).
 std::vector<unsigned char> read_file_bytes(const std::filesystem::path& file, const std::string& what = "");
+
+/// The one way sahara writes an output file: `write(tmp)` writes a temporary beside
+/// `file` (hidden, same extension, so a codec picks the same writer) and returns "" or
+/// why it failed; the temporary is then renamed onto `file`. A signal during the write
+/// removes the temporary; on any failure no temporary is left and InputError names
+/// `file`. `what` ("image", "plot") names the output in the rename failure.
+void write_via_temporary(const std::filesystem::path& file,
+                         const std::function<std::string(const std::filesystem::path& tmp)>& write,
+                         const std::string& what);
 
 /// What a file is, by its extension, case-insensitively.
 enum class FileKind {

@@ -11,7 +11,6 @@
 #include <system_error>
 
 #include "base/error.h"
-#include "base/pending_file.h"
 #include "io/files.h"
 #include "io/image_bytes.h"
 #include "io/image_codec.h"
@@ -106,16 +105,6 @@ void encode_pixels(const fs::path& file, int width, int height, const std::vecto
     e.spec.lossless_zip = true;  // the extra channels must survive bit for bit
 }
 
-fs::path temp_path_for(const fs::path& file) {
-    // The temporary keeps the real extension so OIIO picks the right writer.
-    fs::path tmp = file;
-    std::string tmp_name(".");  // built piecewise: gcc 12 warns falsely (-Wrestrict) on a + chain here
-    tmp_name.append(file.stem().string()).append(".tmp").append(std::to_string(::getpid()));
-    tmp_name.append(file.extension().string());
-    tmp.replace_filename(tmp_name);
-    return tmp;
-}
-
 /// Writes linear RGB as a portable float map: "PF", the size, -1 (little-endian
 /// floats), then the rows bottom to top. Written here, not by OpenImageIO: the
 /// 2.4 release Debian ships reads PFM but has no writer for it. Returns "" or why it failed.
@@ -136,7 +125,6 @@ std::string write_pfm(const fs::path& path, int width, int height, const std::ve
 void write_image(const fs::path& file, int width, int height, const std::vector<float>& rgb,
                  const ImageMetadata& metadata, const std::vector<ExtraChannel>& extra) {
     const std::string name = file.string();
-    const fs::path tmp = temp_path_for(file);
     const bool pfm = file_kind(file) == FileKind::pfm;
     const ImageCodecApi* codec = pfm ? nullptr : &image_codec(name);
     EncodedPixels pixels;
@@ -144,21 +132,12 @@ void write_image(const fs::path& file, int width, int height, const std::vector<
     for (const auto& [key, value] : metadata) pixels.spec.attributes.emplace_back("sahara:" + key, value);
     pixels.spec.attributes.emplace_back("Software", std::string("sahara ") + SAHARA_VERSION);
 
-    const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
-    if (const std::string why =
-            pfm ? write_pfm(tmp, width, height, rgb) : codec->encode(tmp.string(), pixels.spec);
-        !why.empty()) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        throw input_error(name, "", why);
-    }
-    std::error_code ec;
-    fs::rename(tmp, file, ec);
-    if (ec) {
-        const std::string why = ec.message();  // before remove() overwrites ec
-        fs::remove(tmp, ec);
-        throw input_error(name, "", "cannot move the finished image into place: " + why);
-    }
+    write_via_temporary(
+        file,
+        [&](const fs::path& tmp) {
+            return pfm ? write_pfm(tmp, width, height, rgb) : codec->encode(tmp.string(), pixels.spec);
+        },
+        "image");
 }
 
 ImageMetadata read_image_metadata(const fs::path& file) {

@@ -8,10 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
-
 #include "base/error.h"
-#include "base/pending_file.h"
+#include "io/files.h"
 #include "io/image_codec.h"
 
 namespace sahara {
@@ -293,46 +291,22 @@ std::string plot_svg(const PlotDrawing& d) {
     return s + "</svg>\n";
 }
 
-namespace {
-
-/// Runs `write` (returns an error message, empty on success) on a temporary
-/// beside `file`, then renames it into place: an interrupted run leaves no half
-/// plot behind. The temporary keeps the extension, which picks the PNG writer.
-template <class Write>
-void write_via_temporary(const std::string& file, Write&& write) {
-    fs::path tmp(file);
-    std::string name(".");  // built piecewise: gcc 12 warns falsely (-Wrestrict) on a + chain
-    name.append(tmp.stem().string()).append(".tmp").append(std::to_string(::getpid()));
-    name.append(tmp.extension().string());
-    tmp.replace_filename(name);
-    const PendingFile pending(tmp.string());  // a signal during the write removes the temporary
-    std::error_code ec;
-    if (const std::string why = write(tmp.string()); !why.empty()) {
-        fs::remove(tmp, ec);
-        throw input_error(file, "", why);
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) {
-        const std::string why = ec.message();  // before remove() overwrites ec
-        fs::remove(tmp, ec);
-        throw input_error(file, "", "cannot move the finished plot into place: " + why);
-    }
-}
-
-}  // namespace
-
 void write_plot_svg(const std::string& file, const PlotDrawing& drawing) {
-    write_via_temporary(file, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << plot_svg(drawing);
-        return out.flush() ? std::string() : "cannot write the file";
-    });
+    write_via_temporary(
+        file,
+        [&](const fs::path& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            out << plot_svg(drawing);
+            return out.flush() ? std::string() : "cannot write the file";
+        },
+        "plot");
 }
 
 std::string write_plot_png(const std::string& file, const PlotDrawing& drawing) {
     const ImageCodecApi& codec = image_codec(file);
     std::string warning;
-    write_via_temporary(file, [&](const std::string& tmp) { return codec.draw_plot(tmp, drawing, warning); });
+    write_via_temporary(
+        file, [&](const fs::path& tmp) { return codec.draw_plot(tmp.string(), drawing, warning); }, "plot");
     return warning;
 }
 
