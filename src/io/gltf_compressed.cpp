@@ -11,9 +11,6 @@ namespace sahara::gltf {
 
 namespace {
 
-constexpr const char* kMeshopt = "EXT_meshopt_compression";
-constexpr const char* kDraco = "KHR_draco_mesh_compression";
-
 bool has_extension(const nlohmann::json& element, const char* name) {
     return element.is_object() && element.contains("extensions") && element["extensions"].is_object() &&
            element["extensions"].contains(name);

@@ -13,6 +13,9 @@
 
 namespace sahara::gltf {
 
+inline constexpr const char* kMeshopt = "EXT_meshopt_compression";
+inline constexpr const char* kDraco = "KHR_draco_mesh_compression";
+
 /// The whole file again, changed where tinygltf would refuse a compressed file
 /// before sahara decodes it (see gltf_compressed.cpp); nothing if unchanged.
 /// `json` is the JSON text inside `file_bytes`.

@@ -17,8 +17,6 @@ namespace sahara::gltf {
 
 namespace {
 
-constexpr const char* kDraco = "KHR_draco_mesh_compression";
-
 template <class T>
 void append(std::vector<unsigned char>& out, const T* values, size_t n) {
     const size_t at = out.size();

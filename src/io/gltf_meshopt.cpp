@@ -12,8 +12,6 @@ namespace sahara::gltf {
 
 namespace {
 
-constexpr const char* kMeshopt = "EXT_meshopt_compression";
-
 /// The extension object of one bufferView, as its specification defines it.
 struct Compressed {
     int buffer = -1;
