@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <tuple>
@@ -125,13 +126,19 @@ nlohmann::ordered_json throughput_json(double count, const PassTimes& ours, cons
             {"hit_rate", count == 0.0 ? 0.0 : double(a.hits()) / count}};
 }
 
+/// a / b, or null when there is no ratio to give (an empty ray set: no rays, no rate).
+nlohmann::ordered_json ratio_or_null(double a, double b) {
+    const double r = a / b;
+    return std::isfinite(r) && b > 0.0 ? nlohmann::ordered_json(r) : nlohmann::ordered_json(nullptr);
+}
+
 /// Adds Embree's median throughput, the ratios and the disagreements to `j`.
 void add_embree_json(nlohmann::ordered_json& j, double count, const PassTimes& theirs,
                      const Disagreements& d) {
     j["embree_mrays_s"] = count / median(theirs.wall) * 1e-6;
     j["embree_mrays_cpu_s"] = count / median(theirs.cpu) * 1e-6;
-    j["ratio"] = j["mrays_s"].get<double>() / j["embree_mrays_s"].get<double>();
-    j["ratio_cpu"] = j["mrays_cpu_s"].get<double>() / j["embree_mrays_cpu_s"].get<double>();
+    j["ratio"] = ratio_or_null(j["mrays_s"].get<double>(), j["embree_mrays_s"].get<double>());
+    j["ratio_cpu"] = ratio_or_null(j["mrays_cpu_s"].get<double>(), j["embree_mrays_cpu_s"].get<double>());
     j["disagreements"] = d.total;
     j["ties"] = d.ties;
     j["confirmed_for_sahara"] = d.confirmed_for_a;
@@ -149,8 +156,9 @@ void add_cached_json(nlohmann::ordered_json& j, double count, const PassTimes& c
     for (size_t i = 0; i < plain.prim.size(); ++i) differ += plain.prim[i] != with_cache.prim[i];
     j["cached_answers_differ"] = differ;
     if (!embree) return;
-    j["cached_ratio"] = j["cached_mrays_s"].get<double>() / (count / median(theirs.wall) * 1e-6);
-    j["cached_ratio_cpu"] = j["cached_mrays_cpu_s"].get<double>() / (count / median(theirs.cpu) * 1e-6);
+    j["cached_ratio"] = ratio_or_null(j["cached_mrays_s"].get<double>(), count / median(theirs.wall) * 1e-6);
+    j["cached_ratio_cpu"] =
+        ratio_or_null(j["cached_mrays_cpu_s"].get<double>(), count / median(theirs.cpu) * 1e-6);
 }
 
 nlohmann::ordered_json bench_set(const TriangleMesh& mesh, const Accelerator& accel,
@@ -312,6 +320,14 @@ nlohmann::ordered_json run_bench(const BenchOptions& opt) {
 }
 
 /// The process's resident memory by stage: what it left, and its peak while it ran.
+/// A ratio for the text table: two decimals, or "-" where the JSON has null.
+std::string ratio_text(const nlohmann::ordered_json& r) {
+    if (!r.is_number()) return "-";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f", r.get<double>());
+    return text;
+}
+
 void print_memory(const nlohmann::ordered_json& m) {
     std::printf("memory      resident MiB after (peak during): input %.0f (%.0f), sahara's build %.0f (%.0f)",
                 m["input_rss_mib"].get<double>(), m["input_peak_rss_mib"].get<double>(),
@@ -375,9 +391,9 @@ void print_text(const nlohmann::ordered_json& j) {
         std::printf("%-14s %9zu %8.3f %8.2f %8.2f", name.c_str(), r["count"].get<size_t>(),
                     r["hit_rate"].get<double>(), r["mrays_s"].get<double>(), r["mrays_cpu_s"].get<double>());
         if (embree)
-            std::printf(" %8.2f %8.2f %6.2f %6.2f %6zu %5zu %9zu", r["embree_mrays_s"].get<double>(),
-                        r["embree_mrays_cpu_s"].get<double>(), r["ratio"].get<double>(),
-                        r["ratio_cpu"].get<double>(), r["disagreements"].get<size_t>(),
+            std::printf(" %8.2f %8.2f %6s %6s %6zu %5zu %9zu", r["embree_mrays_s"].get<double>(),
+                        r["embree_mrays_cpu_s"].get<double>(), ratio_text(r["ratio"]).c_str(),
+                        ratio_text(r["ratio_cpu"]).c_str(), r["disagreements"].get<size_t>(),
                         r["ties"].get<size_t>(), r["confirmed_for_sahara"].get<size_t>());
         std::printf("\n");
     }
@@ -386,8 +402,8 @@ void print_text(const nlohmann::ordered_json& j) {
         std::printf("shadow, cached: %.2f MRays/s, CPU %.2f", r["cached_mrays_s"].get<double>(),
                     r["cached_mrays_cpu_s"].get<double>());
         if (r.contains("cached_ratio"))
-            std::printf(", ratio %.2f, CPU %.2f", r["cached_ratio"].get<double>(),
-                        r["cached_ratio_cpu"].get<double>());
+            std::printf(", ratio %s, CPU %s", ratio_text(r["cached_ratio"]).c_str(),
+                        ratio_text(r["cached_ratio_cpu"]).c_str());
         std::printf(" (per-thread shadow cache; %zu answers differ from the plain traversal)\n",
                     r["cached_answers_differ"].get<size_t>());
     }

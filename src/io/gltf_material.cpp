@@ -154,7 +154,12 @@ void Materials::set_alpha(MaterialDesc& out, const tinygltf::Material& m, float 
 void Materials::set_emission(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
     float strength = 1.0f;
     if (auto it = m.extensions.find("KHR_materials_emissive_strength"); it != m.extensions.end())
-        strength = std::max(0.0f, float(number(it->second, "emissiveStrength", 1.0)));
+        strength = float(number(it->second, "emissiveStrength", 1.0));
+    if (strength < 0.0f) {  // the extension's schema has minimum 0; a light cannot absorb
+        log_warning(src_.file + ": " + element + ": KHR_materials_emissive_strength: emissiveStrength " +
+                    std::to_string(strength) + " is negative, using 0");
+        strength = 0.0f;
+    }
     const Rgb emission = rgb_of(m.emissiveFactor, Rgb(0.0f)) * strength;
     if (!(max_component(emission) > 0.0f)) return;  // a texture times a zero factor emits nothing
     out.radiance.color = emission;

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
+#include <fstream>
 #include <string>
 
 #include "cli_test_util.h"
@@ -44,4 +45,31 @@ TEST_CASE("bench --generated-mesh refuses odd counts and a file besides it with 
     const CliRun both = run_sahara("bench some.obj --generated-mesh 1000 --no-embree", dir);
     CHECK(both.code == 2);
     CHECK(both.err.find("or --generated-mesh N") != std::string::npos);
+}
+
+TEST_CASE("bench gives no ratio for a ray set with no rays instead of printing nan") {
+    // The camera looks away from the only triangle: no primary ray hits, so the diffuse
+    // and shadow sets (spawned from hits) are empty and have no rate to compare.
+    TempDir dir("bench_empty_sets");
+    {
+        std::ofstream(dir / "tri.obj") << "v 0 100 0\nv 1 100 0\nv 0 100 1\nf 1 2 3\n";
+        std::ofstream(dir / "away.json") << R"({"camera": {"position": [0, 0, 0], "look_at": [0, -1, 0]},
+                   "lights": [{"type": "point", "position": [0, 0, 5], "intensity": [1, 1, 1]}],
+                   "materials": {"grey": {"type": "lambertian", "albedo": [0.5, 0.5, 0.5]}},
+                   "objects": [{"type": "mesh", "file": "tri.obj", "material": "grey"}]})";
+    }
+    const CliRun run = run_sahara("bench away.json --json --size 16 --repeat 1 --threads 1", dir);
+    REQUIRE(run.code == 0);
+    const auto j = nlohmann::json::parse(run.out);
+    CHECK(j["rays"]["primary"]["hit_rate"] == 0.0);
+    CHECK(j["rays"]["shadow"]["count"] == 0);
+    if (j.contains("embree_build_ms")) {
+        CHECK(j["rays"]["shadow"]["ratio"].is_null());
+        CHECK(j["rays"]["shadow"]["ratio_cpu"].is_null());
+        CHECK(j["rays"]["primary"]["ratio"].is_number());
+    }
+    const CliRun text = run_sahara("bench away.json --size 16 --repeat 1 --threads 1", dir);
+    REQUIRE(text.code == 0);
+    CHECK(text.out.find("nan") == std::string::npos);
+    CHECK(text.out.find("shadow") != std::string::npos);
 }

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "gltf_test_doc.h"
+#include "base/log.h"
 #include "scene/texture.h"
 
 using namespace sahara;
@@ -183,4 +184,16 @@ TEST_CASE("glTF: the material's TEXCOORD set / normalized byte normals / u8 and 
     CHECK(mesh.uvs1[1].y == 1.0f);                   // v_gltf = 0 -> 1
     CHECK(mesh.normals[2] == Vec3(0, -1, 0));
     CHECK(mesh.indices == std::vector<uint32_t>{2, 1, 0});
+}
+
+TEST_CASE("glTF materials: a negative emissiveStrength emits nothing and is warned about") {
+    const fs::path dir = scratch("negative_strength");
+    const json material = {{"emissiveFactor", {1, 1, 1}},
+                           {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -3}}}}}};
+    Doc d = textured_doc(material);
+    const int warnings = warning_count();
+    const LoadedModel m = load_gltf(d.write(dir / "negative.gltf"));
+    REQUIRE(m.materials.size() == 1);
+    CHECK(m.materials[0].radiance.color == Rgb(0.0f));
+    CHECK(warning_count() == warnings + 1);
 }
