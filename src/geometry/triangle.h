@@ -31,9 +31,8 @@ struct TriangleRay {
     TriangleRay() = default;
     /// Picks the axes with branches: cheapest when the rays of one call site share
     /// their dominant axis (camera rays, shadow rays towards one light), which the
-    /// branch predictor then learns. `inv_dir` is 1 / ray.dir per axis (BvhRay::inv_dir),
-    /// or null: then it divides (the same quotient either way).
-    __attribute__((always_inline)) explicit TriangleRay(const Ray& ray, const float* inv_dir = nullptr) {
+    /// branch predictor then learns.
+    __attribute__((always_inline)) explicit TriangleRay(const Ray& ray) {
         org[0] = load_scalar(ray.origin.x);
         org[1] = load_scalar(ray.origin.y);
         org[2] = load_scalar(ray.origin.z);
@@ -48,7 +47,7 @@ struct TriangleRay {
             kx = ky;
             ky = t;
         }
-        shear(ray.dir[kx], ray.dir[ky], inv_dir ? inv_dir[kz] : 1.0f / ray.dir[kz]);
+        shear(ray.dir[kx], ray.dir[ky], 1.0f / ray.dir[kz]);
     }
 
     /// sz = 1 / d[kz], sx = d[kx] sz, sy = d[ky] sz: products, not the paper's quotients

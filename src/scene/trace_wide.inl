@@ -33,11 +33,9 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
     auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
         if (!tr_ready) {
             // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
-            // Only the AVX-512 body takes 1 / d[kz] from the box test's inverse direction
-            // (an occlusion ray makes these at its first leaf, where a division would sit
-            // on the chain to that leaf's test); the AVX2 body divides, which is faster there.
-            const float* inv = kAvx512 ? br.inv_dir : nullptr;
-            tr = kAnyHit ? TriangleRay(ray, inv) : TriangleRay::scattered(ray, inv);
+            // Only the AVX-512 body takes 1 / d[kz] from the box test's inverse direction:
+            // the AVX2 body divides, which is faster there.
+            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray, kAvx512 ? br.inv_dir : nullptr);
             tr_ready = true;
         }
         return tr;
