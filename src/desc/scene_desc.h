@@ -54,12 +54,14 @@ struct ColorSource {
     Vec3 checker_offset{0, 0, 0};
 };
 
-enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr };
+/// unlit: glTF KHR_materials_unlit, the albedo shown as it is to camera rays,
+/// invisible to every other ray (render/integrator.cpp).
+enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr, unlit };
 
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
-    ColorSource albedo;      ///< lambertian and metal; pbr: base colour (factor x texture)
+    ColorSource albedo;      ///< lambertian and metal; pbr: base colour (factor x texture); unlit: the colour
     float roughness = 0.0f;  ///< metal; pbr: perceptual roughness (alpha = roughness^2)
     float ior = 1.5f;        ///< dielectric; pbr: ior of the dielectric layer (F0 0.04 at 1.5)
     /// emissive: radiance of the front side; pbr: emission (factor x texture x
@@ -91,6 +93,9 @@ struct MaterialDesc {
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
+    /// The file-format extensions the loader applied to this material (glTF
+    /// KHR_materials_*, EXT_texture_webp), for `sahara info`.
+    std::vector<std::string> extensions;
 };
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.

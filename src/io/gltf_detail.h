@@ -54,6 +54,8 @@ class Materials {
 
    private:
     MaterialDesc convert(const tinygltf::Material& m, const std::string& element);
+    void set_base_color(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);
+    MaterialDesc convert_unlit(const tinygltf::Material& m, const std::string& element, MaterialDesc out);
     void set_alpha(MaterialDesc& out, const tinygltf::Material& m, float factor_alpha, int base_tex,
                    const std::string& element);
     void set_emission(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);

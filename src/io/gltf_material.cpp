@@ -108,18 +108,9 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
     out.name = m.name.empty() ? element : m.name;
     out.type = MaterialType::pbr;
     out.double_sided = m.doubleSided;
+    if (m.extensions.count("KHR_materials_unlit")) return convert_unlit(m, element, std::move(out));
     const auto& pbr = m.pbrMetallicRoughness;
-    const std::vector<double>& f = pbr.baseColorFactor;
-    out.albedo.color = rgb_of(f, Rgb(1.0f));
-    int base_tex = -1;
-    if (pbr.baseColorTexture.index >= 0) {
-        base_tex = texture(pbr.baseColorTexture, true, element + ".pbrMetallicRoughness.baseColorTexture");
-        if (base_tex >= 0) {
-            out.albedo.kind = ColorSource::Kind::texture;
-            out.albedo.texture = base_tex;
-        }
-    }
-    set_alpha(out, m, f.size() >= 4 ? float(f[3]) : 1.0f, base_tex, element);
+    set_base_color(out, m, element);
     out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
     out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
     if (pbr.metallicRoughnessTexture.index >= 0)
@@ -134,6 +125,32 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
     if (m.occlusionTexture.index >= 0) out.ignored.push_back("occlusion map");
     set_emission(out, m, element);
     set_extensions(out, m, element);
+    return out;
+}
+
+/// baseColorFactor x baseColorTexture, and alpha from both.
+void Materials::set_base_color(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
+    const auto& pbr = m.pbrMetallicRoughness;
+    const std::vector<double>& f = pbr.baseColorFactor;
+    out.albedo.color = rgb_of(f, Rgb(1.0f));
+    int base_tex = -1;
+    if (pbr.baseColorTexture.index >= 0) {
+        base_tex = texture(pbr.baseColorTexture, true, element + ".pbrMetallicRoughness.baseColorTexture");
+        if (base_tex >= 0) {
+            out.albedo.kind = ColorSource::Kind::texture;
+            out.albedo.texture = base_tex;
+        }
+    }
+    set_alpha(out, m, f.size() >= 4 ? float(f[3]) : 1.0f, base_tex, element);
+}
+
+/// KHR_materials_unlit: the base colour (and alpha) only; every other input of
+/// the material is a fallback for viewers without the extension, so none is read.
+MaterialDesc Materials::convert_unlit(const tinygltf::Material& m, const std::string& element,
+                                      MaterialDesc out) {
+    out.type = MaterialType::unlit;
+    set_base_color(out, m, element);
+    out.extensions.push_back("KHR_materials_unlit");
     return out;
 }
 

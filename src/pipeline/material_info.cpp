@@ -23,6 +23,8 @@ const char* material_type_name(MaterialType t) {
             return "emissive";
         case MaterialType::pbr:
             return "pbr";
+        case MaterialType::unlit:
+            return "unlit";
     }
     return "?";
 }
@@ -102,6 +104,8 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     if (alpha == "blend") parts.push_back("alpha blend");
     value["double_sided"] = m.double_sided;
     if (!m.double_sided) parts.push_back("one-sided");
+    value["extensions"] = m.extensions;
+    if (!m.extensions.empty()) parts.push_back("extensions: " + join(m.extensions, ", "));
     s.add("Materials", label, join(parts, "; "), value);
 }
 
@@ -123,7 +127,7 @@ bool emits_light(const MaterialDesc& m) {
 void describe_materials(StatsReport& s, const SceneDesc& d) {
     s.add_count("Materials", "Total", d.materials.size());
     for (MaterialType t : {MaterialType::lambertian, MaterialType::metal, MaterialType::dielectric,
-                           MaterialType::emissive, MaterialType::pbr})
+                           MaterialType::emissive, MaterialType::pbr, MaterialType::unlit})
         s.add_count("Materials", material_type_name(t),
                     uint64_t(std::count_if(d.materials.begin(), d.materials.end(),
                                            [t](const MaterialDesc& m) { return m.type == t; })));

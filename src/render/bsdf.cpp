@@ -95,6 +95,7 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
             b.eta = si.front_face ? m.ior : 1.0f / m.ior;
             break;
         case MaterialType::emissive:
+        case MaterialType::unlit:  // the integrators show its colour without scattering
             b.kind = BsdfKind::none;
             break;
     }
