@@ -63,6 +63,13 @@ class Materials {
     std::optional<TextureRef> texture_info(const tinygltf::Value& ext, const char* key) const;
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
     int texture(const TextureRef& ref, bool srgb, const std::string& element);
+    /// A texture's sampler, uv transform and decoded image (null if it cannot be
+    /// read), not yet added to the model; `cache_key` says which texture() keeps.
+    std::optional<TextureDesc> texture_desc(const TextureRef& ref, bool srgb, const std::string& element,
+                                            std::string* cache_key);
+    /// KHR_materials_pbrSpecularGlossiness converted to metallic-roughness (gltf_spec_gloss.cpp).
+    void convert_spec_gloss(MaterialDesc& out, const tinygltf::Material& m, const tinygltf::Value& ext,
+                            const std::string& element);
     std::shared_ptr<const Image> image(int index, bool srgb, const std::string& element);
     std::shared_ptr<const Image> decode_buffer_view_image(const tinygltf::Image& img, bool srgb,
                                                           const std::string& element);

@@ -76,6 +76,11 @@ Rgb rgb_of(const std::vector<double>& v, Rgb fallback) {
     return Rgb(float(v[0]), float(v[1]), float(v[2]));
 }
 
+/// Material extensions that convert() reads before set_extensions runs.
+bool read_elsewhere(const std::string& name) {
+    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_pbrSpecularGlossiness";
+}
+
 TextureRef texture_ref(const tinygltf::TextureInfo& info) {
     return {info.index, info.texCoord, transform_of(info.extensions)};
 }
@@ -109,13 +114,18 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
     out.type = MaterialType::pbr;
     out.double_sided = m.doubleSided;
     if (m.extensions.count("KHR_materials_unlit")) return convert_unlit(m, element, std::move(out));
-    const auto& pbr = m.pbrMetallicRoughness;
-    set_base_color(out, m, element);
-    out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
-    out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
-    if (pbr.metallicRoughnessTexture.index >= 0)
-        out.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, false,
-                                                 element + ".pbrMetallicRoughness.metallicRoughnessTexture");
+    if (auto sg = m.extensions.find("KHR_materials_pbrSpecularGlossiness"); sg != m.extensions.end()) {
+        convert_spec_gloss(out, m, sg->second, element);  // replaces pbrMetallicRoughness, as its spec says
+    } else {
+        const auto& pbr = m.pbrMetallicRoughness;
+        set_base_color(out, m, element);
+        out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+        out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+        if (pbr.metallicRoughnessTexture.index >= 0)
+            out.metallic_roughness_texture =
+                texture(pbr.metallicRoughnessTexture, false,
+                        element + ".pbrMetallicRoughness.metallicRoughnessTexture");
+    }
     if (m.normalTexture.index >= 0) {
         const TextureRef ref{m.normalTexture.index, m.normalTexture.texCoord,
                              transform_of(m.normalTexture.extensions)};
@@ -208,7 +218,7 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
             const float distance = float(number(value, "attenuationDistance", kInfinity));
             if (distance > 0.0f) out.attenuation_distance = distance;
             out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
-        } else if (name != "KHR_materials_emissive_strength") {
+        } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
                 log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
@@ -231,6 +241,17 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
 }
 
 int Materials::texture(const TextureRef& ref, bool srgb, const std::string& element) {
+    std::string key;
+    std::optional<TextureDesc> desc = texture_desc(ref, srgb, element, &key);
+    if (!desc) return -1;
+    if (auto it = texture_keys_.find(key); it != texture_keys_.end()) return it->second;
+    if (!desc->image) return texture_keys_[key] = -1;
+    out_.textures.push_back(std::move(*desc));
+    return texture_keys_[key] = int(out_.textures.size()) - 1;
+}
+
+std::optional<TextureDesc> Materials::texture_desc(const TextureRef& ref, bool srgb,
+                                                   const std::string& element, std::string* cache_key) {
     const tinygltf::Model& m = src_.model;
     if (ref.index < 0 || size_t(ref.index) >= m.textures.size())
         throw input_error(src_.file, element, "texture " + std::to_string(ref.index) + " does not exist");
@@ -239,7 +260,7 @@ int Materials::texture(const TextureRef& ref, bool srgb, const std::string& elem
     if (tex.source < 0) {
         log_warning(src_.file + ": " + tex_name +
                     ": no image source (extension-only images are not supported), ignored");
-        return -1;
+        return std::nullopt;
     }
     if (tex.sampler >= 0 && size_t(tex.sampler) >= m.samplers.size())
         throw input_error(src_.file, tex_name, "sampler " + std::to_string(tex.sampler) + " does not exist");
@@ -266,13 +287,13 @@ int Materials::texture(const TextureRef& ref, bool srgb, const std::string& elem
     std::ostringstream key;
     key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x
         << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' ' << desc.texcoord;
-    if (auto it = texture_keys_.find(key.str()); it != texture_keys_.end()) return it->second;
-    desc.image = image(tex.source, srgb, tex_name);
-    if (!desc.image) return texture_keys_[key.str()] = -1;
-    const tinygltf::Image& img = m.images[size_t(tex.source)];
-    desc.path = img.uri.empty() ? src_.file + ": images[" + std::to_string(tex.source) + "]" : img.uri;
-    out_.textures.push_back(std::move(desc));
-    return texture_keys_[key.str()] = int(out_.textures.size()) - 1;
+    *cache_key = key.str();
+    const int source = tex.source;
+    desc.image = image(source, srgb, tex_name);
+    if (!desc.image) return desc;
+    const tinygltf::Image& img = m.images[size_t(source)];
+    desc.path = img.uri.empty() ? src_.file + ": images[" + std::to_string(source) + "]" : img.uri;
+    return desc;
 }
 
 std::shared_ptr<const Image> Materials::image(int index, bool srgb, const std::string& user) {
