@@ -88,8 +88,15 @@ struct MaterialDesc {
     /// KHR_materials_volume: light inside decays to attenuation_color after this distance.
     float attenuation_distance = kInfinity;
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
-    bool double_sided = true;  ///< false: back faces are invisible
-    bool thin_walled = false;  ///< transmission without refraction (no volume behind the surface)
+    /// KHR_materials_specular: the dielectric layer reflects
+    /// min(F0(ior) x specular_color, 1) x specular at normal incidence, and
+    /// specular at grazing angles; the base gets what that layer leaves.
+    float specular = 1.0f;
+    int specular_texture = -1;  ///< A scales specular
+    Rgb specular_color{1.0f, 1.0f, 1.0f};
+    int specular_color_texture = -1;  ///< RGB (sRGB-decoded) scales specular_color
+    bool double_sided = true;         ///< false: back faces are invisible
+    bool thin_walled = false;         ///< transmission without refraction (no volume behind the surface)
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;

@@ -67,6 +67,7 @@ class Materials {
     /// read), not yet added to the model; `cache_key` says which texture() keeps.
     std::optional<TextureDesc> texture_desc(const TextureRef& ref, bool srgb, const std::string& element,
                                             std::string* cache_key);
+    void set_specular(MaterialDesc& out, const tinygltf::Value& ext, const std::string& where);
     /// KHR_materials_pbrSpecularGlossiness converted to metallic-roughness (gltf_spec_gloss.cpp).
     void convert_spec_gloss(MaterialDesc& out, const tinygltf::Material& m, const tinygltf::Value& ext,
                             const std::string& element);

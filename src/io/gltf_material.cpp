@@ -78,7 +78,8 @@ Rgb rgb_of(const std::vector<double>& v, Rgb fallback) {
 
 /// Material extensions that convert() reads before set_extensions runs.
 bool read_elsewhere(const std::string& name) {
-    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_pbrSpecularGlossiness";
+    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_pbrSpecularGlossiness" ||
+           name == "KHR_materials_specular";
 }
 
 TextureRef texture_ref(const tinygltf::TextureInfo& info) {
@@ -126,6 +127,8 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
                 texture(pbr.metallicRoughnessTexture, false,
                         element + ".pbrMetallicRoughness.metallicRoughnessTexture");
     }
+    if (auto sp = m.extensions.find("KHR_materials_specular"); sp != m.extensions.end())
+        set_specular(out, sp->second, element + ".extensions.KHR_materials_specular");
     if (m.normalTexture.index >= 0) {
         const TextureRef ref{m.normalTexture.index, m.normalTexture.texCoord,
                              transform_of(m.normalTexture.extensions)};
@@ -224,6 +227,20 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
                 log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
         }
     }
+}
+
+/// KHR_materials_specular: the strength (texture A) and colour (texture RGB,
+/// sRGB) of the dielectric layer's reflection. The colour factor may exceed 1
+/// (F0 is clamped to 1 where it is used).
+void Materials::set_specular(MaterialDesc& out, const tinygltf::Value& ext, const std::string& where) {
+    out.specular = std::clamp(float(number(ext, "specularFactor", 1.0)), 0.0f, 1.0f);
+    if (auto info = texture_info(ext, "specularTexture"))
+        out.specular_texture = texture(*info, false, where + ".specularTexture");
+    const Rgb color = rgb_of(numbers(ext, "specularColorFactor"), Rgb(1.0f));
+    out.specular_color = Rgb(std::max(color.x, 0.0f), std::max(color.y, 0.0f), std::max(color.z, 0.0f));
+    if (auto info = texture_info(ext, "specularColorTexture"))
+        out.specular_color_texture = texture(*info, true, where + ".specularColorTexture");
+    out.extensions.push_back("KHR_materials_specular");
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).

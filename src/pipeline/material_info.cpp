@@ -52,6 +52,8 @@ std::vector<std::pair<std::string, int>> textures_of(const MaterialDesc& m) {
     add("normal map", m.normal_texture);
     if (m.radiance.kind == ColorSource::Kind::texture) add("emission", m.radiance.texture);
     add("transmission", m.transmission_texture);
+    add("specular", m.specular_texture);
+    add("specular colour", m.specular_color_texture);
     // glTF takes alpha from the base colour texture: name it only when it is another image.
     if (m.alpha_texture != m.albedo.texture || m.albedo.kind != ColorSource::Kind::texture)
         add("alpha", m.alpha_texture);

@@ -65,7 +65,8 @@ Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const Material
     const Rgb diffuse = b.albedo * (1.0f - b.metallic);
     Rgb radiance =
         diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
-    const Rgb f = fresnel_schlick(b.albedo * b.metallic + Rgb(b.f0 * (1.0f - b.metallic)), dot(wo, si.ns));
+    const Rgb f = fresnel_schlick(b.albedo * b.metallic + b.f0_color * (1.0f - b.metallic),
+                                  1.0f - (1.0f - b.metallic) * (1.0f - b.f90), dot(wo, si.ns));
     const Vec3 wr = reflect(wo, si.ns);
     if (dot(wr, si.ng) > 0)
         radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));

@@ -99,3 +99,31 @@ TEST_CASE("KHR_materials_pbrSpecularGlossiness textures are converted texel by t
     CHECK(texel(mr, 1, 0).z == doctest::Approx(1.0f));    // metallic
     CHECK(near(texel(base, 0, 1), Rgb(0, 0, 1), 0.02f));  // bottom left: blue diffuse
 }
+
+TEST_CASE("KHR_materials_specular reads strength and colour with their textures") {
+    const fs::path dir = scratch("specular");
+    json ext = {{"KHR_materials_specular",
+                 {{"specularFactor", 0.5},
+                  {"specularTexture", {{"index", 0}}},
+                  {"specularColorFactor", {2.0, 1.0, 0.5}},
+                  {"specularColorTexture", {{"index", 1}}}}}};
+    Doc d = doc_with(ext, {"KHR_materials_specular"});
+    d.j["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.3, 0.3, 0.3, 1}}};
+    const std::vector<uint8_t> png = tiny_png(dir);
+    d.j["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
+    d.j["samplers"] = {{{"wrapS", 33071}}};
+    d.j["textures"] = {{{"source", 0}}, {{"source", 0}, {"sampler", 0}}};
+    const LoadedModel m = load_gltf(d.write(dir / "s.gltf"));
+    const MaterialDesc& mat = m.materials.at(0);
+    CHECK(mat.specular == 0.5f);
+    CHECK(mat.specular_color == Rgb(2.0f, 1.0f, 0.5f));  // above 1 is allowed: F0 is clamped where it is used
+    REQUIRE(mat.specular_texture >= 0);
+    REQUIRE(mat.specular_color_texture >= 0);
+    // The strength texture is data (linear), the colour texture sRGB.
+    CHECK(texel(m.textures.at(size_t(mat.specular_texture)), 1, 0).y == doctest::Approx(128 / 255.0f));
+    CHECK(texel(m.textures.at(size_t(mat.specular_color_texture)), 1, 0).y ==
+          doctest::Approx(srgb_decode(128 / 255.0f)));
+    CHECK(mat.albedo.color == Rgb(0.3f));
+    CHECK(mat.ignored.empty());
+    CHECK(mat.extensions == std::vector<std::string>{"KHR_materials_specular"});
+}
