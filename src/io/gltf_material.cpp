@@ -138,6 +138,7 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
     if (m.occlusionTexture.index >= 0) out.ignored.push_back("occlusion map");
     set_emission(out, m, element);
     set_extensions(out, m, element);
+    note_webp(out);
     return out;
 }
 
@@ -164,6 +165,7 @@ MaterialDesc Materials::convert_unlit(const tinygltf::Material& m, const std::st
     out.type = MaterialType::unlit;
     set_base_color(out, m, element);
     out.extensions.push_back("KHR_materials_unlit");
+    note_webp(out);
     return out;
 }
 
@@ -259,24 +261,38 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
 
 int Materials::texture(const TextureRef& ref, bool srgb, const std::string& element) {
     std::string key;
-    std::optional<TextureDesc> desc = texture_desc(ref, srgb, element, &key);
+    bool webp = false;
+    std::optional<TextureDesc> desc = texture_desc(ref, srgb, element, &key, &webp);
     if (!desc) return -1;
     if (auto it = texture_keys_.find(key); it != texture_keys_.end()) return it->second;
     if (!desc->image) return texture_keys_[key] = -1;
     out_.textures.push_back(std::move(*desc));
+    if (webp) webp_textures_.insert(int(out_.textures.size()) - 1);
     return texture_keys_[key] = int(out_.textures.size()) - 1;
 }
 
+void Materials::note_webp(MaterialDesc& out) const {
+    if (webp_textures_.empty()) return;
+    for (int t :
+         {out.albedo.texture, out.radiance.texture, out.metallic_roughness_texture, out.normal_texture,
+          out.transmission_texture, out.specular_texture, out.specular_color_texture})
+        if (webp_textures_.count(t)) {
+            out.extensions.push_back("EXT_texture_webp");
+            return;
+        }
+}
+
 std::optional<TextureDesc> Materials::texture_desc(const TextureRef& ref, bool srgb,
-                                                   const std::string& element, std::string* cache_key) {
+                                                   const std::string& element, std::string* cache_key,
+                                                   bool* from_webp) {
     const tinygltf::Model& m = src_.model;
     if (ref.index < 0 || size_t(ref.index) >= m.textures.size())
         throw input_error(src_.file, element, "texture " + std::to_string(ref.index) + " does not exist");
     const tinygltf::Texture& tex = m.textures[size_t(ref.index)];
     const std::string tex_name = "textures[" + std::to_string(ref.index) + "]";
-    if (tex.source < 0) {
-        log_warning(src_.file + ": " + tex_name +
-                    ": no image source (extension-only images are not supported), ignored");
+    const int webp = webp_source(tex);
+    if (tex.source < 0 && webp < 0) {
+        log_warning(src_.file + ": " + tex_name + ": no image source sahara reads, ignored");
         return std::nullopt;
     }
     if (tex.sampler >= 0 && size_t(tex.sampler) >= m.samplers.size())
@@ -302,15 +318,46 @@ std::optional<TextureDesc> Materials::texture_desc(const TextureRef& ref, bool s
     }
     set_transform(desc, offset, rotation, scale);
     std::ostringstream key;
-    key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x
-        << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' ' << desc.texcoord;
+    key << tex.source << ' ' << webp << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v)
+        << ' ' << offset.x << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' '
+        << desc.texcoord;
     *cache_key = key.str();
-    const int source = tex.source;
-    desc.image = image(source, srgb, tex_name);
+    int source = tex.source;
+    desc.image =
+        webp >= 0 ? webp_image(webp, tex.source, srgb, tex_name, &source) : image(source, srgb, tex_name);
     if (!desc.image) return desc;
+    if (from_webp) *from_webp = webp >= 0 && source == webp;
     const tinygltf::Image& img = m.images[size_t(source)];
     desc.path = img.uri.empty() ? src_.file + ": images[" + std::to_string(source) + "]" : img.uri;
     return desc;
+}
+
+/// EXT_texture_webp's image index, -1 without the extension.
+int Materials::webp_source(const tinygltf::Texture& tex) const {
+    auto it = tex.extensions.find("EXT_texture_webp");
+    return it == tex.extensions.end() ? -1 : int(number(it->second, "source", -1));
+}
+
+/// The WebP image of a texture, or its `fallback` source when the WebP one
+/// cannot be read (the extension's rule for optional use); `used` says which.
+std::shared_ptr<const Image> Materials::webp_image(int webp, int fallback, bool srgb,
+                                                   const std::string& tex_name, int* used) {
+    const std::string element = tex_name + ".extensions.EXT_texture_webp";
+    std::shared_ptr<const Image> result;
+    std::string reason = "not found";
+    try {
+        result = image(webp, srgb, element);
+    } catch (const InputError& e) {
+        if (fallback < 0)
+            throw input_error(src_.file, element, std::string("no fallback source: ") + e.what());
+        reason = e.what();
+    }
+    *used = webp;
+    if (result || fallback < 0) return result;
+    log_warning(src_.file + ": " + element + ": WebP image " + std::to_string(webp) + " unreadable (" +
+                reason + "), fallback images[" + std::to_string(fallback) + "] used");
+    *used = fallback;
+    return image(fallback, srgb, tex_name);
 }
 
 std::shared_ptr<const Image> Materials::image(int index, bool srgb, const std::string& user) {

@@ -127,3 +127,48 @@ TEST_CASE("KHR_materials_specular reads strength and colour with their textures"
     CHECK(mat.ignored.empty());
     CHECK(mat.extensions == std::vector<std::string>{"KHR_materials_specular"});
 }
+
+TEST_CASE("EXT_texture_webp: the WebP source loads and an unreadable one falls back to source") {
+    const fs::path dir = scratch("webp");
+    const uint8_t green[16] = {0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255, 0, 255};
+    const uint8_t red[16] = {255, 0, 0, 255, 255, 0, 0, 255, 255, 0, 0, 255, 255, 0, 0, 255};
+    write_image_u8(dir / "green.webp", 2, 2, 4, green);
+    write_image_u8(dir / "red.png", 2, 2, 4, red);
+    write_text(dir / "broken.webp", "RIFF not really a webp file");
+    const auto load = [&](const json& texture, const std::vector<std::string>& required) {
+        Doc d = textured_doc({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+        d.j["images"] = {{{"uri", "red.png"}}, {{"uri", "green.webp"}}, {{"uri", "broken.webp"}}};
+        d.j["textures"] = {texture};
+        d.j["extensionsUsed"] = {"EXT_texture_webp"};
+        if (!required.empty()) d.j["extensionsRequired"] = required;
+        return load_gltf(d.write(dir / "w.gltf"));
+    };
+    const auto color = [](const LoadedModel& m) {
+        REQUIRE(m.materials.at(0).albedo.kind == ColorSource::Kind::texture);
+        return texel(m.textures.at(size_t(m.materials[0].albedo.texture)), 0, 0);
+    };
+    const json webp_green = {{"EXT_texture_webp", {{"source", 1}}}};
+    const json webp_broken = {{"EXT_texture_webp", {{"source", 2}}}};
+    const LoadedModel with_fallback = load({{"source", 0}, {"extensions", webp_green}}, {});
+    CHECK(near(color(with_fallback), Rgb(0, 1, 0), 0.05f));
+    CHECK(with_fallback.materials[0].extensions == std::vector<std::string>{"EXT_texture_webp"});
+    CHECK(near(color(load({{"extensions", webp_green}}, {"EXT_texture_webp"})), Rgb(0, 1, 0), 0.05f));
+    const LoadedModel fell_back = load({{"source", 0}, {"extensions", webp_broken}}, {});
+    CHECK(near(color(fell_back), Rgb(1, 0, 0), 1e-6f));
+    CHECK(fell_back.materials[0].extensions.empty());  // the PNG was used
+    // Without a fallback an unreadable WebP image is an error naming the texture's extension.
+    const std::string error = error_of([&] { load({{"extensions", webp_broken}}, {"EXT_texture_webp"}); });
+    CHECK(error.find("EXT_texture_webp") != std::string::npos);
+}
+
+TEST_CASE("extensionsRequired: the new extensions are accepted and an unknown one is named") {
+    const fs::path dir = scratch("required");
+    Doc d = doc_with({{"KHR_materials_unlit", json::object()}},
+                     {"KHR_materials_unlit", "KHR_materials_specular", "KHR_materials_pbrSpecularGlossiness",
+                      "EXT_texture_webp"});
+    CHECK_NOTHROW(load_gltf(d.write(dir / "ok.gltf")));
+    d.j["extensionsRequired"].push_back("KHR_materials_made_up");
+    const std::string error = error_of([&] { load_gltf(d.write(dir / "bad.gltf")); });
+    CHECK(error.find("extensionsRequired") != std::string::npos);
+    CHECK(error.find("KHR_materials_made_up is not supported") != std::string::npos);
+}
