@@ -4,6 +4,7 @@
 // OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -335,7 +336,11 @@ std::optional<TextureDesc> Materials::texture_desc(const TextureRef& ref, bool s
 /// EXT_texture_webp's image index, -1 without the extension.
 int Materials::webp_source(const tinygltf::Texture& tex) const {
     auto it = tex.extensions.find("EXT_texture_webp");
-    return it == tex.extensions.end() ? -1 : int(number(it->second, "source", -1));
+    if (it == tex.extensions.end()) return -1;
+    const double source = number(it->second, "source", -1);
+    if (source < 0) return -1;
+    // A huge index must not reach the int cast; image() names it as missing.
+    return source < double(std::numeric_limits<int>::max()) ? int(source) : std::numeric_limits<int>::max();
 }
 
 /// The WebP image of a texture, or its `fallback` source when the WebP one
