@@ -177,15 +177,36 @@ struct Medium {
     }
 };
 
+/// The next hit along `ray`: the packet's answer when the camera ray was traced
+/// in one (`first`), else a trace.
+inline bool next_hit(const Scene& scene, Ray& ray, const Hit* first, Hit& hit) {
+    if (!first) return scene.intersect(ray, hit);
+    hit = *first;
+    if (hit.hit()) ray.tmax = hit.t;
+    return hit.hit();
+}
+
 /// Unlit surfaces (glTF KHR_materials_unlit) the way Blender's glTF importer
-/// builds them for Cycles: the camera ray sees the colour as it is, every
-/// other ray goes on behind the surface as if it were not there. They
-/// neither light nor shadow nor reflect in anything, so they add no energy.
-/// Returns true when the path ends here (the camera saw the colour).
-inline bool unlit_hit(const Scene& scene, const SurfaceInteraction& si, const MaterialDesc& mat, int depth,
-                      const Rgb& beta, Rgb& radiance) {
-    if (depth > 1) return false;
-    radiance += beta * material_albedo(mat, si, scene.textures);
+/// builds them for Cycles: the camera ray sees the colour as it is (the path
+/// ends: false), every later ray goes on behind the surface as if it were not
+/// there (true). They neither light nor shadow nor reflect in anything, so
+/// they add no energy.
+inline bool pass_unlit(const Scene& scene, const SurfaceInteraction& si, const MaterialDesc& mat,
+                       const Hit& hit, int depth, const Rgb& beta, Rgb& radiance, Ray& ray) {
+    if (depth == 1) {
+        radiance += beta * material_albedo(mat, si, scene.textures);
+        return false;
+    }
+    ray.tmin = hit.t;  // the next hit beyond this one: (tmin, tmax) is open
+    ray.tmax = kInfinity;
+    return true;
+}
+
+/// Russian roulette: false ends the path, true scales beta to keep the estimate unbiased.
+inline bool survive_roulette(Sampler& sampler, Rgb& beta, float eta_scale) {
+    const float survive = std::min(1.0f, max_component(beta) * eta_scale);
+    if (sampler.next_1d() >= survive) return false;
+    beta /= survive;
     return true;
 }
 
@@ -203,14 +224,7 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
     [[maybe_unused]] int unlit_passes = 0;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
-        bool found;
-        if (depth == 1 && first) {  // the camera ray, already traced in a packet
-            hit = *first;
-            found = hit.hit();
-            if (found) ray.tmax = hit.t;
-        } else {
-            found = scene.intersect(ray, hit);
-        }
+        const bool found = next_hit(scene, ray, depth == 1 ? first : nullptr, hit);
         if constexpr (!kLambertOnly)
             if (medium.absorbs)
                 beta *= medium.transmittance(found ? (hit.t - ray.tmin) * length(ray.dir) : kInfinity);
@@ -224,17 +238,14 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
             if constexpr (kEmission) radiance += beta * hit_emission<S>(scene, ray, hit, si, mat, prev);
             break;
         }
-        if constexpr (kUnlit) {
-            if (mat.type == MaterialType::unlit) {
-                if (unlit_hit(scene, si, mat, depth, beta, radiance) || ++unlit_passes > kMaxUnlitPasses)
+        if constexpr (kUnlit)
+            if (mat.type == MaterialType::unlit) {  // no scattering event: the same depth goes on
+                if (!pass_unlit(scene, si, mat, hit, depth, beta, radiance, ray) ||
+                    ++unlit_passes > kMaxUnlitPasses)
                     break;
-                // Not a scattering event: the same ray goes on past the hit, at the same depth.
-                ray.tmin = hit.t;
-                ray.tmax = kInfinity;
                 --depth;
                 continue;
             }
-        }
         if constexpr (kEmission)
             radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if constexpr (!kLambertOnly)
@@ -257,11 +268,7 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         if constexpr (!kLambertOnly)
             if (bs.transmit) medium = Medium::after_refraction(mat, si.front_face);
         prev = PrevVertex{si.p, bs.pdf, bs.delta};
-        if (depth >= kRouletteStartDepth) {
-            const float survive = std::min(1.0f, max_component(beta) * eta_scale);
-            if (sampler.next_1d() >= survive) break;
-            beta /= survive;
-        }
+        if (depth >= kRouletteStartDepth && !survive_roulette(sampler, beta, eta_scale)) break;
         ray = Ray{offset_ray_origin(si.p, bs.transmit ? -si.ng : si.ng), bs.wi, 0.0f, kInfinity, ray.time};
     }
     return radiance;
