@@ -54,12 +54,14 @@ struct ColorSource {
     Vec3 checker_offset{0, 0, 0};
 };
 
-enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr };
+/// unlit: glTF KHR_materials_unlit, the albedo shown as it is to camera rays,
+/// invisible to every other ray (render/integrator.cpp).
+enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr, unlit };
 
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
-    ColorSource albedo;      ///< lambertian and metal; pbr: base colour (factor x texture)
+    ColorSource albedo;      ///< lambertian and metal; pbr: base colour (factor x texture); unlit: the colour
     float roughness = 0.0f;  ///< metal; pbr: perceptual roughness (alpha = roughness^2)
     float ior = 1.5f;        ///< dielectric; pbr: ior of the dielectric layer (F0 0.04 at 1.5)
     /// emissive: radiance of the front side; pbr: emission (factor x texture x
@@ -86,11 +88,21 @@ struct MaterialDesc {
     /// KHR_materials_volume: light inside decays to attenuation_color after this distance.
     float attenuation_distance = kInfinity;
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
-    bool double_sided = true;  ///< false: back faces are invisible
-    bool thin_walled = false;  ///< transmission without refraction (no volume behind the surface)
+    /// KHR_materials_specular: the dielectric layer reflects
+    /// min(F0(ior) x specular_color, 1) x specular at normal incidence, and
+    /// specular at grazing angles; the base gets what that layer leaves.
+    float specular = 1.0f;
+    int specular_texture = -1;  ///< A scales specular
+    Rgb specular_color{1.0f, 1.0f, 1.0f};
+    int specular_color_texture = -1;  ///< RGB (sRGB-decoded) scales specular_color
+    bool double_sided = true;         ///< false: back faces are invisible
+    bool thin_walled = false;         ///< transmission without refraction (no volume behind the surface)
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
+    /// The file-format extensions the loader applied to this material (glTF
+    /// KHR_materials_*, EXT_texture_webp), for `sahara info`.
+    std::vector<std::string> extensions;
 };
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.

@@ -54,6 +54,8 @@ class Materials {
 
    private:
     MaterialDesc convert(const tinygltf::Material& m, const std::string& element);
+    void set_base_color(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);
+    MaterialDesc convert_unlit(const tinygltf::Material& m, const std::string& element, MaterialDesc out);
     void set_alpha(MaterialDesc& out, const tinygltf::Material& m, float factor_alpha, int base_tex,
                    const std::string& element);
     void set_emission(MaterialDesc& out, const tinygltf::Material& m, const std::string& element);
@@ -61,7 +63,20 @@ class Materials {
     std::optional<TextureRef> texture_info(const tinygltf::Value& ext, const char* key) const;
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
     int texture(const TextureRef& ref, bool srgb, const std::string& element);
+    /// A texture's sampler, uv transform and decoded image (null if it cannot be
+    /// read), not yet added to the model; `cache_key` says which texture() keeps.
+    std::optional<TextureDesc> texture_desc(const TextureRef& ref, bool srgb, const std::string& element,
+                                            std::string* cache_key, bool* from_webp = nullptr);
+    /// Names EXT_texture_webp among the material's extensions if one of its textures came from WebP.
+    void note_webp(MaterialDesc& out) const;
+    void set_specular(MaterialDesc& out, const tinygltf::Value& ext, const std::string& where);
+    /// KHR_materials_pbrSpecularGlossiness converted to metallic-roughness (gltf_spec_gloss.cpp).
+    void convert_spec_gloss(MaterialDesc& out, const tinygltf::Material& m, const tinygltf::Value& ext,
+                            const std::string& element);
     std::shared_ptr<const Image> image(int index, bool srgb, const std::string& element);
+    int webp_source(const tinygltf::Texture& tex) const;
+    std::shared_ptr<const Image> webp_image(int webp, int fallback, bool srgb, const std::string& tex_name,
+                                            int* used);
     std::shared_ptr<const Image> decode_buffer_view_image(const tinygltf::Image& img, bool srgb,
                                                           const std::string& element);
 
@@ -71,6 +86,7 @@ class Materials {
     std::map<std::string, int> texture_keys_;
     std::map<std::pair<int, bool>, std::shared_ptr<const Image>> images_;
     std::set<std::string> ignored_;  ///< extensions already warned about
+    std::set<int> webp_textures_;    ///< indices into out_.textures decoded from EXT_texture_webp images
 };
 
 /// Primitive `p` of mesh `mesh` in model space: triangles, normals, both uv sets,

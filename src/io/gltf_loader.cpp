@@ -31,6 +31,14 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_materials_volume",       "KHR_lights_punctual",
     "KHR_mesh_quantization",      "KHR_draco_mesh_compression",
     "EXT_meshopt_compression"};
+/// More of them: material models and image formats.
+const std::set<std::string> kSupportedRequiredMaterials = {"KHR_materials_unlit",
+                                                           "KHR_materials_pbrSpecularGlossiness",
+                                                           "KHR_materials_specular", "EXT_texture_webp"};
+
+bool supported_required(const std::string& name) {
+    return kSupportedRequired.count(name) || kSupportedRequiredMaterials.count(name);
+}
 
 /// "major.minor" as two numbers; nothing if the text is not of that form.
 std::optional<std::pair<int, int>> version_numbers(const std::string& text) {
@@ -103,7 +111,7 @@ void precheck(const std::string& file, const std::filesystem::path& dir, const J
     check_version(file, doc);
     if (auto req = doc.find("extensionsRequired"); req != doc.end() && req->is_array())
         for (const auto& ext : *req)
-            if (ext.is_string() && !kSupportedRequired.count(ext.get<std::string>()))
+            if (ext.is_string() && !supported_required(ext.get<std::string>()))
                 throw input_error(file, "extensionsRequired", ext.get<std::string>() + " is not supported");
     auto buffers = doc.find("buffers");
     if (buffers == doc.end() || !buffers->is_array()) return;

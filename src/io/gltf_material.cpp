@@ -4,6 +4,7 @@
 // OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -76,6 +77,12 @@ Rgb rgb_of(const std::vector<double>& v, Rgb fallback) {
     return Rgb(float(v[0]), float(v[1]), float(v[2]));
 }
 
+/// Material extensions that convert() reads before set_extensions runs.
+bool read_elsewhere(const std::string& name) {
+    return name == "KHR_materials_emissive_strength" || name == "KHR_materials_pbrSpecularGlossiness" ||
+           name == "KHR_materials_specular";
+}
+
 TextureRef texture_ref(const tinygltf::TextureInfo& info) {
     return {info.index, info.texCoord, transform_of(info.extensions)};
 }
@@ -108,6 +115,36 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
     out.name = m.name.empty() ? element : m.name;
     out.type = MaterialType::pbr;
     out.double_sided = m.doubleSided;
+    if (m.extensions.count("KHR_materials_unlit")) return convert_unlit(m, element, std::move(out));
+    if (auto sg = m.extensions.find("KHR_materials_pbrSpecularGlossiness"); sg != m.extensions.end()) {
+        convert_spec_gloss(out, m, sg->second, element);  // replaces pbrMetallicRoughness, as its spec says
+    } else {
+        const auto& pbr = m.pbrMetallicRoughness;
+        set_base_color(out, m, element);
+        out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+        out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+        if (pbr.metallicRoughnessTexture.index >= 0)
+            out.metallic_roughness_texture =
+                texture(pbr.metallicRoughnessTexture, false,
+                        element + ".pbrMetallicRoughness.metallicRoughnessTexture");
+    }
+    if (auto sp = m.extensions.find("KHR_materials_specular"); sp != m.extensions.end())
+        set_specular(out, sp->second, element + ".extensions.KHR_materials_specular");
+    if (m.normalTexture.index >= 0) {
+        const TextureRef ref{m.normalTexture.index, m.normalTexture.texCoord,
+                             transform_of(m.normalTexture.extensions)};
+        out.normal_texture = texture(ref, false, element + ".normalTexture");
+        out.normal_scale = float(m.normalTexture.scale);
+    }
+    if (m.occlusionTexture.index >= 0) out.ignored.push_back("occlusion map");
+    set_emission(out, m, element);
+    set_extensions(out, m, element);
+    note_webp(out);
+    return out;
+}
+
+/// baseColorFactor x baseColorTexture, and alpha from both.
+void Materials::set_base_color(MaterialDesc& out, const tinygltf::Material& m, const std::string& element) {
     const auto& pbr = m.pbrMetallicRoughness;
     const std::vector<double>& f = pbr.baseColorFactor;
     out.albedo.color = rgb_of(f, Rgb(1.0f));
@@ -120,20 +157,16 @@ MaterialDesc Materials::convert(const tinygltf::Material& m, const std::string& 
         }
     }
     set_alpha(out, m, f.size() >= 4 ? float(f[3]) : 1.0f, base_tex, element);
-    out.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
-    out.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
-    if (pbr.metallicRoughnessTexture.index >= 0)
-        out.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, false,
-                                                 element + ".pbrMetallicRoughness.metallicRoughnessTexture");
-    if (m.normalTexture.index >= 0) {
-        const TextureRef ref{m.normalTexture.index, m.normalTexture.texCoord,
-                             transform_of(m.normalTexture.extensions)};
-        out.normal_texture = texture(ref, false, element + ".normalTexture");
-        out.normal_scale = float(m.normalTexture.scale);
-    }
-    if (m.occlusionTexture.index >= 0) out.ignored.push_back("occlusion map");
-    set_emission(out, m, element);
-    set_extensions(out, m, element);
+}
+
+/// KHR_materials_unlit: the base colour (and alpha) only; every other input of
+/// the material is a fallback for viewers without the extension, so none is read.
+MaterialDesc Materials::convert_unlit(const tinygltf::Material& m, const std::string& element,
+                                      MaterialDesc out) {
+    out.type = MaterialType::unlit;
+    set_base_color(out, m, element);
+    out.extensions.push_back("KHR_materials_unlit");
+    note_webp(out);
     return out;
 }
 
@@ -196,12 +229,26 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
             const float distance = float(number(value, "attenuationDistance", kInfinity));
             if (distance > 0.0f) out.attenuation_distance = distance;
             out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
-        } else if (name != "KHR_materials_emissive_strength") {
+        } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
                 log_warning(src_.file + ": " + ext + ": extension not supported, ignored");
         }
     }
+}
+
+/// KHR_materials_specular: the strength (texture A) and colour (texture RGB,
+/// sRGB) of the dielectric layer's reflection. The colour factor may exceed 1
+/// (F0 is clamped to 1 where it is used).
+void Materials::set_specular(MaterialDesc& out, const tinygltf::Value& ext, const std::string& where) {
+    out.specular = std::clamp(float(number(ext, "specularFactor", 1.0)), 0.0f, 1.0f);
+    if (auto info = texture_info(ext, "specularTexture"))
+        out.specular_texture = texture(*info, false, where + ".specularTexture");
+    const Rgb color = rgb_of(numbers(ext, "specularColorFactor"), Rgb(1.0f));
+    out.specular_color = Rgb(std::max(color.x, 0.0f), std::max(color.y, 0.0f), std::max(color.z, 0.0f));
+    if (auto info = texture_info(ext, "specularColorTexture"))
+        out.specular_color_texture = texture(*info, true, where + ".specularColorTexture");
+    out.extensions.push_back("KHR_materials_specular");
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).
@@ -219,15 +266,40 @@ int Materials::texture(const tinygltf::TextureInfo& info, bool srgb, const std::
 }
 
 int Materials::texture(const TextureRef& ref, bool srgb, const std::string& element) {
+    std::string key;
+    bool webp = false;
+    std::optional<TextureDesc> desc = texture_desc(ref, srgb, element, &key, &webp);
+    if (!desc) return -1;
+    if (auto it = texture_keys_.find(key); it != texture_keys_.end()) return it->second;
+    if (!desc->image) return texture_keys_[key] = -1;
+    out_.textures.push_back(std::move(*desc));
+    if (webp) webp_textures_.insert(int(out_.textures.size()) - 1);
+    return texture_keys_[key] = int(out_.textures.size()) - 1;
+}
+
+void Materials::note_webp(MaterialDesc& out) const {
+    if (webp_textures_.empty()) return;
+    for (int t :
+         {out.albedo.texture, out.radiance.texture, out.metallic_roughness_texture, out.normal_texture,
+          out.transmission_texture, out.specular_texture, out.specular_color_texture})
+        if (webp_textures_.count(t)) {
+            out.extensions.push_back("EXT_texture_webp");
+            return;
+        }
+}
+
+std::optional<TextureDesc> Materials::texture_desc(const TextureRef& ref, bool srgb,
+                                                   const std::string& element, std::string* cache_key,
+                                                   bool* from_webp) {
     const tinygltf::Model& m = src_.model;
     if (ref.index < 0 || size_t(ref.index) >= m.textures.size())
         throw input_error(src_.file, element, "texture " + std::to_string(ref.index) + " does not exist");
     const tinygltf::Texture& tex = m.textures[size_t(ref.index)];
     const std::string tex_name = "textures[" + std::to_string(ref.index) + "]";
-    if (tex.source < 0) {
-        log_warning(src_.file + ": " + tex_name +
-                    ": no image source (extension-only images are not supported), ignored");
-        return -1;
+    const int webp = webp_source(tex);
+    if (tex.source < 0 && webp < 0) {
+        log_warning(src_.file + ": " + tex_name + ": no image source sahara reads, ignored");
+        return std::nullopt;
     }
     if (tex.sampler >= 0 && size_t(tex.sampler) >= m.samplers.size())
         throw input_error(src_.file, tex_name, "sampler " + std::to_string(tex.sampler) + " does not exist");
@@ -252,15 +324,50 @@ int Materials::texture(const TextureRef& ref, bool srgb, const std::string& elem
     }
     set_transform(desc, offset, rotation, scale);
     std::ostringstream key;
-    key << tex.source << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v) << ' ' << offset.x
-        << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' ' << desc.texcoord;
-    if (auto it = texture_keys_.find(key.str()); it != texture_keys_.end()) return it->second;
-    desc.image = image(tex.source, srgb, tex_name);
-    if (!desc.image) return texture_keys_[key.str()] = -1;
-    const tinygltf::Image& img = m.images[size_t(tex.source)];
-    desc.path = img.uri.empty() ? src_.file + ": images[" + std::to_string(tex.source) + "]" : img.uri;
-    out_.textures.push_back(std::move(desc));
-    return texture_keys_[key.str()] = int(out_.textures.size()) - 1;
+    key << tex.source << ' ' << webp << ' ' << srgb << ' ' << int(desc.wrap_u) << ' ' << int(desc.wrap_v)
+        << ' ' << offset.x << ' ' << offset.y << ' ' << scale.x << ' ' << scale.y << ' ' << rotation << ' '
+        << desc.texcoord;
+    *cache_key = key.str();
+    int source = tex.source;
+    desc.image =
+        webp >= 0 ? webp_image(webp, tex.source, srgb, tex_name, &source) : image(source, srgb, tex_name);
+    if (!desc.image) return desc;
+    if (from_webp) *from_webp = webp >= 0 && source == webp;
+    const tinygltf::Image& img = m.images[size_t(source)];
+    desc.path = img.uri.empty() ? src_.file + ": images[" + std::to_string(source) + "]" : img.uri;
+    return desc;
+}
+
+/// EXT_texture_webp's image index, -1 without the extension.
+int Materials::webp_source(const tinygltf::Texture& tex) const {
+    auto it = tex.extensions.find("EXT_texture_webp");
+    if (it == tex.extensions.end()) return -1;
+    const double source = number(it->second, "source", -1);
+    if (source < 0) return -1;
+    // A huge index must not reach the int cast; image() names it as missing.
+    return source < double(std::numeric_limits<int>::max()) ? int(source) : std::numeric_limits<int>::max();
+}
+
+/// The WebP image of a texture, or its `fallback` source when the WebP one
+/// cannot be read (the extension's rule for optional use); `used` says which.
+std::shared_ptr<const Image> Materials::webp_image(int webp, int fallback, bool srgb,
+                                                   const std::string& tex_name, int* used) {
+    const std::string element = tex_name + ".extensions.EXT_texture_webp";
+    std::shared_ptr<const Image> result;
+    std::string reason = "not found";
+    try {
+        result = image(webp, srgb, element);
+    } catch (const InputError& e) {
+        if (fallback < 0)
+            throw input_error(src_.file, element, std::string("no fallback source: ") + e.what());
+        reason = e.what();
+    }
+    *used = webp;
+    if (result || fallback < 0) return result;
+    log_warning(src_.file + ": " + element + ": WebP image " + std::to_string(webp) + " unreadable (" +
+                reason + "), fallback images[" + std::to_string(fallback) + "] used");
+    *used = fallback;
+    return image(fallback, srgb, tex_name);
 }
 
 std::shared_ptr<const Image> Materials::image(int index, bool srgb, const std::string& user) {

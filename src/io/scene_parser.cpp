@@ -184,6 +184,8 @@ MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext&
         case MaterialType::pbr:
             parse_pbr_material(o, ctx, m);
             break;
+        case MaterialType::unlit:  // glTF files only (KHR_materials_unlit): not among the names above
+            break;
     }
     o.finish();
     return m;

@@ -437,6 +437,11 @@ void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uin
             shift(m.albedo.texture);
             shift(m.radiance.texture);
             shift(m.alpha_texture);
+            shift(m.metallic_roughness_texture);
+            shift(m.normal_texture);
+            shift(m.transmission_texture);
+            shift(m.specular_texture);
+            shift(m.specular_color_texture);
             scene.materials.push_back(std::move(m));
         }
         for (TextureDesc& t : model.textures) scene.textures.push_back(std::move(t));

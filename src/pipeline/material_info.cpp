@@ -23,6 +23,8 @@ const char* material_type_name(MaterialType t) {
             return "emissive";
         case MaterialType::pbr:
             return "pbr";
+        case MaterialType::unlit:
+            return "unlit";
     }
     return "?";
 }
@@ -50,6 +52,8 @@ std::vector<std::pair<std::string, int>> textures_of(const MaterialDesc& m) {
     add("normal map", m.normal_texture);
     if (m.radiance.kind == ColorSource::Kind::texture) add("emission", m.radiance.texture);
     add("transmission", m.transmission_texture);
+    add("specular", m.specular_texture);
+    add("specular colour", m.specular_color_texture);
     // glTF takes alpha from the base colour texture: name it only when it is another image.
     if (m.alpha_texture != m.albedo.texture || m.albedo.kind != ColorSource::Kind::texture)
         add("alpha", m.alpha_texture);
@@ -102,6 +106,8 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     if (alpha == "blend") parts.push_back("alpha blend");
     value["double_sided"] = m.double_sided;
     if (!m.double_sided) parts.push_back("one-sided");
+    value["extensions"] = m.extensions;
+    if (!m.extensions.empty()) parts.push_back("extensions: " + join(m.extensions, ", "));
     s.add("Materials", label, join(parts, "; "), value);
 }
 
@@ -123,7 +129,7 @@ bool emits_light(const MaterialDesc& m) {
 void describe_materials(StatsReport& s, const SceneDesc& d) {
     s.add_count("Materials", "Total", d.materials.size());
     for (MaterialType t : {MaterialType::lambertian, MaterialType::metal, MaterialType::dielectric,
-                           MaterialType::emissive, MaterialType::pbr})
+                           MaterialType::emissive, MaterialType::pbr, MaterialType::unlit})
         s.add_count("Materials", material_type_name(t),
                     uint64_t(std::count_if(d.materials.begin(), d.materials.end(),
                                            [t](const MaterialDesc& m) { return m.type == t; })));

@@ -23,6 +23,12 @@ Rgb fresnel_schlick(const Rgb& f0, float cos_i) {
     return f0 + (Rgb(1.0f) - f0) * m5;
 }
 
+Rgb fresnel_schlick(const Rgb& f0, float f90, float cos_i) {
+    const float m = std::clamp(1.0f - cos_i, 0.0f, 1.0f);
+    const float m5 = (m * m) * (m * m) * m;
+    return f0 + (Rgb(f90) - f0) * m5;
+}
+
 bool refract(const Vec3& wo, const Vec3& n, float eta, Vec3* wt) {
     const float cos_i = dot(wo, n);
     const float sin2_t = std::max(0.0f, 1.0f - cos_i * cos_i) / (eta * eta);
@@ -95,6 +101,7 @@ Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
             b.eta = si.front_face ? m.ior : 1.0f / m.ior;
             break;
         case MaterialType::emissive:
+        case MaterialType::unlit:  // the integrators show its colour without scattering
             b.kind = BsdfKind::none;
             break;
     }

@@ -29,7 +29,9 @@ struct Bsdf {
     // pbr only (render/bsdf_pbr.h)
     float roughness = 0;  ///< perceptual roughness, for the albedo tables
     float metallic = 0;
-    float f0 = 0.04f;        ///< dielectric layer's reflectance at normal incidence
+    float f0 = 0.04f;     ///< dielectric layer's reflectance at normal incidence (largest channel)
+    Rgb f0_color{0.04f};  ///< the same per channel (KHR_materials_specular colours it)
+    float f90 = 1;        ///< the dielectric layer's reflectance at grazing angles (KHR_materials_specular)
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
     bool thin = false;       ///< thin-walled: transmission without refraction
 
@@ -69,6 +71,8 @@ float fresnel_dielectric(float cos_i, float eta);
 
 /// Schlick's approximation with reflectance f0 at normal incidence (used for metals).
 Rgb fresnel_schlick(const Rgb& f0, float cos_i);
+/// Schlick's approximation from f0 at normal incidence to f90 at grazing angles.
+Rgb fresnel_schlick(const Rgb& f0, float f90, float cos_i);
 
 /// Mirror reflection of w about n.
 inline Vec3 reflect(const Vec3& w, const Vec3& n) { return n * (2.0f * dot(w, n)) - w; }

@@ -23,8 +23,8 @@ Rgb multiscatter_fresnel(const Rgb& f_avg, float e_avg) {
             multiscatter_fresnel(f_avg.z, e_avg)};
 }
 
-/// Hemispherical average of Schlick's Fresnel: F0 + (1 - F0) / 21.
-float schlick_average(float f0) { return f0 + (1.0f - f0) / 21.0f; }
+/// Hemispherical average of Schlick's Fresnel: F0 + (F90 - F0) / 21.
+float schlick_average(float f0, float f90) { return f0 + (f90 - f0) / 21.0f; }
 
 /// Everything the lobes need that depends on the material only, from the tables.
 struct PbrTerms {
@@ -33,26 +33,38 @@ struct PbrTerms {
     float dielectric_ms = 0;   ///< F_ms of the dielectric layer alone
     float dielectric_avg = 0;  ///< Ed_avg: the dielectric layer's average albedo
     Rgb f0{0.04f};             ///< Schlick F0 of the specular lobe, mixed by metallic
+    float f90 = 1;             ///< and its F90 (below 1 only with KHR_materials_specular)
     Rgb diffuse{0.0f};         ///< Lambertian base weight (1 - metallic)(1 - transmission) base
 };
+
+/// F_ms of a dielectric layer whose F0 has a colour (KHR_materials_specular).
+Rgb tinted_dielectric_ms(const Bsdf& b, float e_avg) {
+    return {multiscatter_fresnel(schlick_average(b.f0_color.x, b.f90), e_avg),
+            multiscatter_fresnel(schlick_average(b.f0_color.y, b.f90), e_avg),
+            multiscatter_fresnel(schlick_average(b.f0_color.z, b.f90), e_avg)};
+}
 
 PbrTerms pbr_terms(const Bsdf& b, const GgxAlbedo& avg) {
     PbrTerms t;
     t.e_avg = avg.e;
     t.one_minus_e_avg = 1.0f - avg.e;
     const Rgb base = b.albedo;
-    t.f0 = lerp(Rgb(b.f0), base, b.metallic);
-    t.dielectric_ms = multiscatter_fresnel(schlick_average(b.f0), avg.e);
+    t.f0 = lerp(b.f0_color, base, b.metallic);
+    t.f90 = 1.0f - (1.0f - b.metallic) * (1.0f - b.f90);  // exactly 1 without the specular extension
+    // The layer's albedo uses the largest channel of F0 (b.f0), as the extension's
+    // fresnel_mix does, so that the base below never gets more than one channel lets through.
+    t.dielectric_ms = multiscatter_fresnel(schlick_average(b.f0, b.f90), avg.e);
+    const Rgb dielectric_ms = b.f0_color == Rgb(b.f0) ? Rgb(t.dielectric_ms) : tinted_dielectric_ms(b, avg.e);
     const Rgb metal_avg = base + (Rgb(1.0f) - base) * (1.0f / 21.0f);
-    t.spec_ms = lerp(Rgb(t.dielectric_ms), multiscatter_fresnel(metal_avg, avg.e), b.metallic);
-    t.dielectric_avg = b.f0 * avg.e + (1.0f - b.f0) * avg.e_schlick + t.one_minus_e_avg * t.dielectric_ms;
+    t.spec_ms = lerp(dielectric_ms, multiscatter_fresnel(metal_avg, avg.e), b.metallic);
+    t.dielectric_avg = b.f0 * avg.e + (b.f90 - b.f0) * avg.e_schlick + t.one_minus_e_avg * t.dielectric_ms;
     t.diffuse = base * ((1.0f - b.metallic) * (1.0f - b.transmission));
     return t;
 }
 
 /// Ed(mu): albedo of the dielectric layer (single and multiple scattering).
 float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
-    return b.f0 * e.e + (1.0f - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
+    return b.f0 * e.e + (b.f90 - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
 }
 
 /// Single-scattering GGX reflection, f cos.
@@ -60,7 +72,7 @@ Rgb eval_specular(const Bsdf& b, const PbrTerms& t, const Vec3& wo, const Vec3& 
     const Vec3 wm = normalize(wo + wi);
     const float lo = ggx_lambda(wo, b.alpha), li = ggx_lambda(wi, b.alpha);
     const float g2 = 1.0f / (1.0f + lo + li);
-    return fresnel_schlick(t.f0, std::abs(dot(wo, wm))) * (ggx_d(wm, b.alpha) * g2 / (4.0f * wo.z));
+    return fresnel_schlick(t.f0, t.f90, std::abs(dot(wo, wm))) * (ggx_d(wm, b.alpha) * g2 / (4.0f * wo.z));
 }
 
 /// The half vector of a refraction from wo (outside, +z) to wi (below), facing +z.
@@ -80,14 +92,14 @@ Rgb eval_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf)
         const Vec3 wr(wi.x, wi.y, -wi.z);
         const Vec3 wm = normalize(wo + wr);
         *pdf = ggx_reflection_pdf(wo, wr, b.alpha);
-        const float fresnel_t = 1.0f - fresnel_schlick(Rgb(b.f0), dot(wo, wm)).x;
+        const float fresnel_t = 1.0f - fresnel_schlick(Rgb(b.f0), b.f90, dot(wo, wm)).x;
         return tint * (fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) / (4.0f * wo.z));
     }
     const Vec3 wm = refraction_half_vector(wo, wi, b.eta);
     const float o_m = dot(wo, wm), i_m = dot(wi, wm);
     if (o_m <= 0 || i_m >= 0) return Rgb(0.0f);  // not a refraction through this microfacet
     const float denom = (i_m + o_m / b.eta) * (i_m + o_m / b.eta);
-    const float fresnel_t = 1.0f - fresnel_dielectric(o_m, b.eta);
+    const float fresnel_t = 1.0f - b.f90 * fresnel_dielectric(o_m, b.eta);
     *pdf = ggx_vndf_pdf(wo, wm, b.alpha) * std::abs(i_m) / denom;
     // Radiance is compressed by eta^2 entering the denser side, as for `dielectric`.
     const float f = fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) /
@@ -132,6 +144,32 @@ Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
     return dot(ns, si.ng) > 0 ? ns : si.ns;  // a map must not turn the surface away from the viewer's side
 }
 
+bool has_specular_inputs(const MaterialDesc& m) {
+    return m.specular != 1.0f || m.specular_texture >= 0 || m.specular_color != Rgb(1.0f) ||
+           m.specular_color_texture >= 0;
+}
+
+/// KHR_materials_specular: F0 = min(F0(ior) x colour, 1) x weight, F90 = weight.
+void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                    const std::vector<TextureDesc>& textures) {
+    float weight = m.specular;
+    if (m.specular_texture >= 0) {
+        float alpha = 1.0f;
+        sample_texture_rgb(textures[size_t(m.specular_texture)], texcoord(si, textures, m.specular_texture),
+                           &alpha);
+        weight *= alpha;
+    }
+    Rgb color = m.specular_color;
+    if (m.specular_color_texture >= 0)
+        color *= sample_texture_rgb(textures[size_t(m.specular_color_texture)],
+                                    texcoord(si, textures, m.specular_color_texture));
+    weight = std::clamp(weight, 0.0f, 1.0f);
+    const Rgb f0 = Rgb(b.f0) * color;
+    b.f0_color = Rgb(std::min(f0.x, 1.0f), std::min(f0.y, 1.0f), std::min(f0.z, 1.0f)) * weight;
+    b.f0 = max_component(b.f0_color);
+    b.f90 = weight;
+}
+
 }  // namespace
 
 // Declared in render/bsdf.h; here because it shares texcoord with the pbr inputs.
@@ -166,6 +204,8 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.transmission = std::clamp(transmission, 0.0f, 1.0f);
     const float r = (m.ior - 1.0f) / (m.ior + 1.0f);
     b.f0 = r * r;
+    b.f0_color = Rgb(b.f0);
+    if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
     b.thin = m.thin_walled;
     b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m, si, textures));
@@ -177,7 +217,7 @@ PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
     const GgxAlbedo e = table.at(wo.z, b.roughness);
     PbrLobeWeights w;
     const float f0 = mean(t.f0);
-    w.specular = f0 * e.e + (1.0f - f0) * e.e_schlick;
+    w.specular = f0 * e.e + (t.f90 - f0) * e.e_schlick;
     w.cosine = mean(t.spec_ms) * (1.0f - e.e) + mean(t.diffuse) * (1.0f - dielectric_albedo(b, t, e));
     w.transmit = (1.0f - b.metallic) * b.transmission * mean(b.albedo) * (1.0f - f0);
     const float sum = w.specular + w.cosine + w.transmit;
@@ -206,8 +246,11 @@ Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)
         f += t.spec_ms * ((1.0f - eo.e) * (1.0f - ei.e) / t.one_minus_e_avg * cos_pi);
-    const float diffuse_scale = (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) /
-                                (1.0f - t.dielectric_avg);
+    // A layer that reflects everything (F0 clamped to 1 by KHR_materials_specular) leaves the base nothing.
+    const float base_avg = 1.0f - t.dielectric_avg;
+    const float diffuse_scale = base_avg > 1e-6f ? (1.0f - dielectric_albedo(b, t, eo)) *
+                                                       (1.0f - dielectric_albedo(b, t, ei)) / base_avg
+                                                 : 0.0f;
     f += t.diffuse * (diffuse_scale * cos_pi);
     *pdf = p.specular * ggx_reflection_pdf(wo, wi, b.alpha) + p.cosine * cos_pi;
     return f;

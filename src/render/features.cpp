@@ -34,6 +34,7 @@ std::string material_types(const Scene& scene) {
     if (f.has_dielectric) add("dielectric");
     if (emissive) add("emissive");
     if (f.has_pbr) add("pbr (metallic-roughness)");
+    if (f.has_unlit) add("unlit");
     return types.empty() ? std::string("none") : types;
 }
 

@@ -19,6 +19,10 @@ namespace {
 /// Paths shorter than this never face Russian roulette.
 constexpr int kRouletteStartDepth = 4;
 
+/// Unlit surfaces one path or shadow ray passes at most (each pass moves on along the
+/// ray, so the bound only guards against pathological stacks of coplanar sheets).
+constexpr int kMaxUnlitPasses = 64;
+
 /// What light sampling a kernel does. `none`: the scene has nothing to sample
 /// (or BSDF sampling only is forced); `delta`: point/directional lights only,
 /// so no MIS is ever needed; `mis`: everything; `light_only`: for tests.
@@ -77,8 +81,9 @@ auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si,
         return make_bsdf(m, si, textures);
 }
 
-/// Next-event estimation at a non-delta vertex: one emitter, one shadow ray.
-template <Strategy S, class Shading>
+/// Next-event estimation at a non-delta vertex: one emitter, one shadow ray
+/// (which passes unlit surfaces in scenes that have them, kUnlit).
+template <Strategy S, bool kUnlit, class Shading>
 Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading& bsdf, const Vec3& wo,
                  float time, float u_select, Vec2 u) {
     LightSample ls;
@@ -86,7 +91,10 @@ Rgb direct_light(const Scene& scene, const SurfaceInteraction& si, const Shading
     float bsdf_pdf = 0;
     const Rgb f_cos = eval_shading(bsdf, wo, ls.wi, &bsdf_pdf);
     if (max_component(f_cos) <= 0 || max_component(ls.li) <= 0) return Rgb(0.0f);
-    if (scene.occluded(shadow_ray(si.p, si.ng, ls, time), shadow_cache(ls.emitter))) return Rgb(0.0f);
+    const Ray shadow = shadow_ray(si.p, si.ng, ls, time);
+    if (kUnlit ? occluded_except_unlit(scene, shadow, shadow_cache(ls.emitter))
+               : scene.occluded(shadow, shadow_cache(ls.emitter)))
+        return Rgb(0.0f);
     const float w = (S == Strategy::mis && !ls.delta) ? power_heuristic(ls.pdf, bsdf_pdf) : 1.0f;
     return f_cos * ls.li * (w / ls.pdf);
 }
@@ -169,9 +177,43 @@ struct Medium {
     }
 };
 
+/// The next hit along `ray`: the packet's answer when the camera ray was traced
+/// in one (`first`), else a trace.
+inline bool next_hit(const Scene& scene, Ray& ray, const Hit* first, Hit& hit) {
+    if (!first) return scene.intersect(ray, hit);
+    hit = *first;
+    if (hit.hit()) ray.tmax = hit.t;
+    return hit.hit();
+}
+
+/// Unlit surfaces (glTF KHR_materials_unlit) the way Blender's glTF importer
+/// builds them for Cycles: the camera ray sees the colour as it is (the path
+/// ends: false), every later ray goes on behind the surface as if it were not
+/// there (true). They neither light nor shadow nor reflect in anything, so
+/// they add no energy.
+inline bool pass_unlit(const Scene& scene, const SurfaceInteraction& si, const MaterialDesc& mat,
+                       const Hit& hit, int depth, const Rgb& beta, Rgb& radiance, Ray& ray) {
+    if (depth == 1) {
+        radiance += beta * material_albedo(mat, si, scene.textures);
+        return false;
+    }
+    ray.tmin = hit.t;  // the next hit beyond this one: (tmin, tmax) is open
+    ray.tmax = kInfinity;
+    return true;
+}
+
+/// Russian roulette: false ends the path, true scales beta to keep the estimate unbiased.
+inline bool survive_roulette(Sampler& sampler, Rgb& beta, float eta_scale) {
+    const float survive = std::min(1.0f, max_component(beta) * eta_scale);
+    if (sampler.next_1d() >= survive) return false;
+    beta /= survive;
+    return true;
+}
+
 /// One path. D rays at most, camera ray included; a shadow ray counts as the
-/// next ray, so direct light is gathered only below max_depth.
-template <Strategy S, bool kLambertOnly>
+/// next ray, so direct light is gathered only below max_depth. kUnlit: the
+/// scene has unlit materials.
+template <Strategy S, bool kLambertOnly, bool kUnlit = false>
 Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, const Hit* first = nullptr) {
     // The plain Lambertian kernel is chosen only for scenes without any emission.
     constexpr bool kEmission = !(S == Strategy::none && kLambertOnly);
@@ -179,18 +221,13 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
     float eta_scale = 1;  // undoes the 1/eta^2 of refraction for Russian roulette
     PrevVertex prev;
     Medium medium;
+    [[maybe_unused]] int unlit_passes = 0;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
-        bool found;
-        if (depth == 1 && first) {  // the camera ray, already traced in a packet
-            hit = *first;
-            found = hit.hit();
-            if (found) ray.tmax = hit.t;
-        } else {
-            found = scene.intersect(ray, hit);
-        }
+        const bool found = next_hit(scene, ray, depth == 1 ? first : nullptr, hit);
         if constexpr (!kLambertOnly)
-            if (medium.absorbs) beta *= medium.transmittance(found ? hit.t * length(ray.dir) : kInfinity);
+            if (medium.absorbs)
+                beta *= medium.transmittance(found ? (hit.t - ray.tmin) * length(ray.dir) : kInfinity);
         if (!found) {
             radiance += beta * escaped<S>(scene, ray, prev);
             break;
@@ -201,6 +238,14 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
             if constexpr (kEmission) radiance += beta * hit_emission<S>(scene, ray, hit, si, mat, prev);
             break;
         }
+        if constexpr (kUnlit)
+            if (mat.type == MaterialType::unlit) {  // no scattering event: the same depth goes on
+                if (!pass_unlit(scene, si, mat, hit, depth, beta, radiance, ray) ||
+                    ++unlit_passes > kMaxUnlitPasses)
+                    break;
+                --depth;
+                continue;
+            }
         if constexpr (kEmission)
             radiance += beta * mat.emission;  // non-zero only on glowing Lambertian surfaces
         if constexpr (!kLambertOnly)
@@ -214,7 +259,7 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
             const float u_select = sampler.next_1d();
             const Vec2 u_light = sampler.next_2d();
             if (!bsdf.is_delta())
-                radiance += beta * direct_light<S>(scene, si, bsdf, wo, ray.time, u_select, u_light);
+                radiance += beta * direct_light<S, kUnlit>(scene, si, bsdf, wo, ray.time, u_select, u_light);
         }
         BsdfSample bs;
         if (!sample_shading(bsdf, wo, sampler, bs)) break;
@@ -223,28 +268,53 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         if constexpr (!kLambertOnly)
             if (bs.transmit) medium = Medium::after_refraction(mat, si.front_face);
         prev = PrevVertex{si.p, bs.pdf, bs.delta};
-        if (depth >= kRouletteStartDepth) {
-            const float survive = std::min(1.0f, max_component(beta) * eta_scale);
-            if (sampler.next_1d() >= survive) break;
-            beta /= survive;
-        }
+        if (depth >= kRouletteStartDepth && !survive_roulette(sampler, beta, eta_scale)) break;
         ray = Ray{offset_ray_origin(si.p, bs.transmit ? -si.ng : si.ng), bs.wi, 0.0f, kInfinity, ray.time};
     }
     return radiance;
 }
 
 /// The kernels a scene can get; chosen once per scene from its features.
-enum class PathKernel : uint8_t { plain_lambert, plain, delta_lambert, delta, mis_lambert, mis };
+enum class PathKernel : uint8_t {
+    plain_lambert,
+    plain,
+    plain_unlit,
+    delta_lambert,
+    delta,
+    delta_unlit,
+    mis_lambert,
+    mis,
+    mis_unlit
+};
 
 PathKernel choose_kernel(const SceneFeatures& f) {
+    // Unlit surfaces make every shadow ray look past them: only scenes with them pay for it.
     if (f.has_area_lights || f.has_envmap)
-        return f.lambertian_only ? PathKernel::mis_lambert : PathKernel::mis;
-    if (f.has_lights) return f.lambertian_only ? PathKernel::delta_lambert : PathKernel::delta;
+        return f.lambertian_only ? PathKernel::mis_lambert
+               : f.has_unlit     ? PathKernel::mis_unlit
+                                 : PathKernel::mis;
+    if (f.has_lights)
+        return f.lambertian_only ? PathKernel::delta_lambert
+               : f.has_unlit     ? PathKernel::delta_unlit
+                                 : PathKernel::delta;
     // The plain Lambertian kernel skips emission altogether.
-    return f.lambertian_only && !f.has_emitters ? PathKernel::plain_lambert : PathKernel::plain;
+    if (f.lambertian_only && !f.has_emitters) return PathKernel::plain_lambert;
+    return f.has_unlit ? PathKernel::plain_unlit : PathKernel::plain;
 }
 
 }  // namespace
+
+bool occluded_except_unlit(const Scene& scene, Ray ray, OcclusionCache& cache) {
+    if (!scene.occluded(ray, cache)) return false;  // nothing at all in the way: the common answer
+    for (int pass = 0; pass <= kMaxUnlitPasses; ++pass) {
+        Ray probe = ray;
+        Hit hit;
+        if (!scene.intersect(probe, hit)) return false;
+        if (scene.materials[scene.interact(probe, hit).material].type != MaterialType::unlit) return true;
+        ray.tmin = hit.t;  // the next hit beyond this one: (tmin, tmax) is open
+    }
+    return true;
+}
 
 Rgb path_trace_first_hit(const Scene& scene, Ray ray, const Hit* first, Sampler& sampler, int max_depth) {
     switch (choose_kernel(scene.features)) {
@@ -252,12 +322,18 @@ Rgb path_trace_first_hit(const Scene& scene, Ray ray, const Hit* first, Sampler&
             return path_kernel<Strategy::none, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::plain:
             return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth, first);
+        case PathKernel::plain_unlit:
+            return path_kernel<Strategy::none, false, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::delta_lambert:
             return path_kernel<Strategy::delta, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::delta:
             return path_kernel<Strategy::delta, false>(scene, ray, sampler, max_depth, first);
+        case PathKernel::delta_unlit:
+            return path_kernel<Strategy::delta, false, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::mis_lambert:
             return path_kernel<Strategy::mis, true>(scene, ray, sampler, max_depth, first);
+        case PathKernel::mis_unlit:
+            return path_kernel<Strategy::mis, false, true>(scene, ray, sampler, max_depth, first);
         case PathKernel::mis:
             break;
     }
@@ -271,13 +347,13 @@ Rgb path_trace(const Scene& scene, Ray ray, Sampler& sampler, int max_depth) {
 Rgb path_trace_with(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, LightStrategy strategy) {
     switch (strategy) {
         case LightStrategy::bsdf_only:
-            return path_kernel<Strategy::none, false>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::none, false, true>(scene, ray, sampler, max_depth);
         case LightStrategy::light_only:
-            return path_kernel<Strategy::light_only, false>(scene, ray, sampler, max_depth);
+            return path_kernel<Strategy::light_only, false, true>(scene, ray, sampler, max_depth);
         case LightStrategy::mis:
             break;
     }
-    return path_kernel<Strategy::mis, false>(scene, ray, sampler, max_depth);
+    return path_kernel<Strategy::mis, false, true>(scene, ray, sampler, max_depth);
 }
 
 const char* path_kernel_name(const Scene& scene) {
@@ -286,12 +362,18 @@ const char* path_kernel_name(const Scene& scene) {
             return "path<no light sampling, lambertian only>";
         case PathKernel::plain:
             return "path<no light sampling, all materials>";
+        case PathKernel::plain_unlit:
+            return "path<no light sampling, all materials, unlit>";
         case PathKernel::delta_lambert:
             return "path<delta lights, lambertian only>";
         case PathKernel::delta:
             return "path<delta lights, all materials>";
+        case PathKernel::delta_unlit:
+            return "path<delta lights, all materials, unlit>";
         case PathKernel::mis_lambert:
             return "path<MIS, lambertian only>";
+        case PathKernel::mis_unlit:
+            return "path<MIS, all materials, unlit>";
         case PathKernel::mis:
             break;
     }

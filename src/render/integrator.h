@@ -33,6 +33,10 @@ Rgb path_trace_with(const Scene& scene, Ray ray, Sampler& sampler, int max_depth
 /// shadows, perfect mirrors and Fresnel-weighted reflection + refraction.
 Rgb whitted(const Scene& scene, Ray ray, int max_depth);
 
+/// Scene::occluded for a scene with unlit materials: whether anything but
+/// unlit surfaces (which only camera rays see) blocks the ray.
+bool occluded_except_unlit(const Scene& scene, Ray ray, OcclusionCache& cache);
+
 /// Name of the path-tracing kernel chosen for the scene's features.
 const char* path_kernel_name(const Scene& scene);
 

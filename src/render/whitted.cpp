@@ -38,7 +38,9 @@ Rgb direct_lights(const Scene& scene, const SurfaceInteraction& si, const Rgb& a
         }
         const float cos = dot(wi, si.ns);
         if (cos <= 0 || dot(wi, si.ng) <= 0) continue;
-        if (scene.occluded(Ray{offset_ray_origin(si.p, si.ng), wi, 0.0f, tmax, time}, shadow_cache(light)))
+        const Ray shadow{offset_ray_origin(si.p, si.ng), wi, 0.0f, tmax, time};
+        if (scene.features.has_unlit ? occluded_except_unlit(scene, shadow, shadow_cache(light))
+                                     : scene.occluded(shadow, shadow_cache(light)))
             continue;
         sum += e * cos;
     }
@@ -63,18 +65,33 @@ Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const Material
     const Rgb diffuse = b.albedo * (1.0f - b.metallic);
     Rgb radiance =
         diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
-    const Rgb f = fresnel_schlick(b.albedo * b.metallic + Rgb(b.f0 * (1.0f - b.metallic)), dot(wo, si.ns));
+    const Rgb f = fresnel_schlick(b.albedo * b.metallic + b.f0_color * (1.0f - b.metallic),
+                                  1.0f - (1.0f - b.metallic) * (1.0f - b.f90), dot(wo, si.ns));
     const Vec3 wr = reflect(wo, si.ns);
     if (dot(wr, si.ng) > 0)
         radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));
     return radiance;
 }
 
+/// The first hit that counts for a ray of recursion level `depth`: unlit
+/// surfaces show their colour to camera rays and let all other rays pass, as in the path tracer.
+bool first_hit(const Scene& scene, Ray& ray, int depth, Hit& hit, SurfaceInteraction& si) {
+    for (int pass = 0; pass <= 64; ++pass) {
+        if (!scene.intersect(ray, hit)) return false;
+        si = scene.interact(ray, hit);
+        if (depth == 1 || scene.materials[si.material].type != MaterialType::unlit) return true;
+        ray.tmin = hit.t;
+        ray.tmax = kInfinity;
+    }
+    return false;
+}
+
 Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     Hit hit;
-    if (!scene.intersect(ray, hit)) return eval_background(scene.background, ray.dir);
-    const SurfaceInteraction si = scene.interact(ray, hit);
+    SurfaceInteraction si;
+    if (!first_hit(scene, ray, depth, hit, si)) return eval_background(scene.background, ray.dir);
     const MaterialDesc& m = scene.materials[si.material];
+    if (m.type == MaterialType::unlit) return material_albedo(m, si, scene.textures);
     if (m.type == MaterialType::emissive)
         return si.front_face ? eval_color(m.radiance, scene.textures, si.p, si.uv) : Rgb(0.0f);
     Rgb radiance = m.type == MaterialType::lambertian ? m.emission
@@ -114,6 +131,7 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
             break;
         }
         case MaterialType::emissive:
+        case MaterialType::unlit:
             break;
     }
     return radiance;

@@ -60,7 +60,8 @@ struct SceneFeatures {
     bool has_textures = false;           ///< checker or image colour sources
     bool has_metal = false, has_rough_metal = false, has_dielectric = false;
     bool has_pbr = false;         ///< glTF metallic-roughness materials
-    bool lambertian_only = true;  ///< no metal, no dielectric, no pbr
+    bool has_unlit = false;       ///< glTF unlit materials (seen by camera rays only)
+    bool lambertian_only = true;  ///< no metal, no dielectric, no pbr, no unlit
     bool forced_all = false;      ///< everything on (prepare_lighting(true)), for measurements
 };
 

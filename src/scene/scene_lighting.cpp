@@ -132,13 +132,14 @@ void collect_features(const Scene& s, SceneFeatures& f) {
                           (m.type == MaterialType::lambertian && max_component(m.emission) > 0) ||
                           (m.type == MaterialType::pbr && mean_color(m.radiance) > 0);
         f.has_pbr |= m.type == MaterialType::pbr;
+        f.has_unlit |= m.type == MaterialType::unlit;
         f.has_metal |= m.type == MaterialType::metal;
         f.has_rough_metal |= m.type == MaterialType::metal && m.roughness > 0;
         f.has_dielectric |= m.type == MaterialType::dielectric;
         f.has_textures |=
             m.albedo.kind != ColorSource::Kind::constant || m.radiance.kind != ColorSource::Kind::constant;
     }
-    f.lambertian_only = !f.has_metal && !f.has_dielectric && !f.has_pbr;
+    f.lambertian_only = !f.has_metal && !f.has_dielectric && !f.has_pbr && !f.has_unlit;
     const bool shutter = s.camera.shutter_close > s.camera.shutter_open;
     for (const Sphere& sp : s.spheres) f.has_motion |= shutter && sp.velocity != Vec3(0.0f);
     if (s.instances()) f.has_motion |= shutter && s.instances()->has_motion();
@@ -150,7 +151,7 @@ void force_all(SceneFeatures& f) {
     f.has_delta_lights_only = false;
     f.has_motion = f.has_lens = f.has_textures = true;
     f.has_metal = f.has_rough_metal = f.has_dielectric = f.has_pbr = true;
-    f.lambertian_only = false;
+    f.lambertian_only = false;  // has_unlit stays as found: it changes what is rendered, not only how fast
     f.forced_all = true;
 }
 

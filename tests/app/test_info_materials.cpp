@@ -98,6 +98,30 @@ TEST_CASE("info: an opaque glTF material has no alpha and ignores no vertex-colo
     CHECK_FALSE(j.contains("Ignored inputs"));  // OPAQUE: glTF itself ignores alpha
 }
 
+TEST_CASE("info: glTF material extensions are named with the materials that use them") {
+    const fs::path dir = gltf::scratch("info_extensions");
+    const json unlit = {{"extensions", {{"KHR_materials_unlit", json::object()}}}};
+    json j = scene_info(write_gltf(dir, unlit).string()).to_json();
+    CHECK(j["Materials"]["unlit"] == 1);
+    const json& u = j["Materials"]["[0] materials[0]"];
+    CHECK(u["type"] == "unlit");
+    CHECK(u["extensions"] == json::array({"KHR_materials_unlit"}));
+    CHECK_FALSE(j.contains("Ignored inputs"));
+
+    const json specular = {
+        {"extensions", {{"KHR_materials_specular", {{"specularColorTexture", {{"index", 1}}}}}}}};
+    j = scene_info(write_gltf(dir, specular).string()).to_json();
+    const json& s = j["Materials"]["[0] materials[0]"];
+    CHECK(s["type"] == "pbr");
+    CHECK(s["textures"].contains("specular colour"));
+    CHECK(s["extensions"] == json::array({"KHR_materials_specular"}));
+
+    TempDir run("info_extensions_text");
+    const CliRun r = run_sahara("info " + (dir / "m.gltf").string(), run);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("extensions: KHR_materials_specular") != std::string::npos);
+}
+
 TEST_CASE("info: OBJ and MTL materials by what they use") {
     TempDir dir("info_obj");
     gltf::tiny_png(dir.path);
