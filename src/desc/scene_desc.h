@@ -56,6 +56,26 @@ struct ColorSource {
 
 enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr };
 
+/// pbr only: the layers KHR_materials_clearcoat and KHR_materials_sheen put over
+/// the base (render/bsdf_layers.h). A zero clearcoat and a black sheen colour
+/// leave the material as it is, and cost nothing at render time.
+struct PbrLayersDesc {
+    float clearcoat = 0.0f;                ///< coat weight in [0, 1]
+    int clearcoat_texture = -1;            ///< R scales clearcoat
+    float clearcoat_roughness = 0.0f;      ///< perceptual (alpha = roughness^2)
+    int clearcoat_roughness_texture = -1;  ///< G scales clearcoat_roughness
+    int clearcoat_normal_texture = -1;     ///< the coat's own normal map; without it the coat is not bumped
+    float clearcoat_normal_scale = 1.0f;
+    Rgb sheen_color{0.0f, 0.0f, 0.0f};  ///< linear, in [0, 1]
+    int sheen_color_texture = -1;       ///< RGB (sRGB-decoded) scales sheen_color
+    float sheen_roughness = 0.0f;       ///< perceptual
+    int sheen_roughness_texture = -1;   ///< A scales sheen_roughness
+
+    bool any() const {
+        return clearcoat > 0.0f || sheen_color.x > 0.0f || sheen_color.y > 0.0f || sheen_color.z > 0.0f;
+    }
+};
+
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
@@ -88,6 +108,7 @@ struct MaterialDesc {
     Rgb attenuation_color{1.0f, 1.0f, 1.0f};
     bool double_sided = true;  ///< false: back faces are invisible
     bool thin_walled = false;  ///< transmission without refraction (no volume behind the surface)
+    PbrLayersDesc layers;      ///< clearcoat and sheen
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;

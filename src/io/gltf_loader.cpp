@@ -30,7 +30,8 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_volume",       "KHR_lights_punctual",
     "KHR_mesh_quantization",      "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression"};
+    "EXT_meshopt_compression",    "KHR_materials_clearcoat",
+    "KHR_materials_sheen"};
 
 /// "major.minor" as two numbers; nothing if the text is not of that form.
 std::optional<std::pair<int, int>> version_numbers(const std::string& text) {
