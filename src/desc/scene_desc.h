@@ -58,6 +58,26 @@ struct ColorSource {
 /// invisible to every other ray (render/integrator.cpp).
 enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr, unlit };
 
+/// pbr only: the layers KHR_materials_clearcoat and KHR_materials_sheen put over
+/// the base (render/bsdf_layers.h). A zero clearcoat and a black sheen colour
+/// leave the material as it is, and cost nothing at render time.
+struct PbrLayersDesc {
+    float clearcoat = 0.0f;                ///< coat weight in [0, 1]
+    int clearcoat_texture = -1;            ///< R scales clearcoat
+    float clearcoat_roughness = 0.0f;      ///< perceptual (alpha = roughness^2)
+    int clearcoat_roughness_texture = -1;  ///< G scales clearcoat_roughness
+    int clearcoat_normal_texture = -1;     ///< the coat's own normal map; without it the coat is not bumped
+    float clearcoat_normal_scale = 1.0f;
+    Rgb sheen_color{0.0f, 0.0f, 0.0f};  ///< linear, in [0, 1]
+    int sheen_color_texture = -1;       ///< RGB (sRGB-decoded) scales sheen_color
+    float sheen_roughness = 0.0f;       ///< perceptual
+    int sheen_roughness_texture = -1;   ///< A scales sheen_roughness
+
+    bool any() const {
+        return clearcoat > 0.0f || sheen_color.x > 0.0f || sheen_color.y > 0.0f || sheen_color.z > 0.0f;
+    }
+};
+
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
@@ -97,6 +117,7 @@ struct MaterialDesc {
     int specular_color_texture = -1;  ///< RGB (sRGB-decoded) scales specular_color
     bool double_sided = true;         ///< false: back faces are invisible
     bool thin_walled = false;         ///< transmission without refraction (no volume behind the surface)
+    PbrLayersDesc layers;             ///< clearcoat and sheen
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
@@ -104,6 +125,27 @@ struct MaterialDesc {
     /// KHR_materials_*, EXT_texture_webp), for `sahara info`.
     std::vector<std::string> extensions;
 };
+
+/// Calls f(role, index) with every texture index a material holds (-1 where a
+/// slot is empty), by reference: one list for every pass that must see them all,
+/// renumbering textures when a model joins a scene and `sahara info` alike, so a
+/// new slot cannot be missed by one of them.
+template <class Material, class F>
+void for_each_texture_slot(Material& m, F&& f) {
+    f("base colour", m.albedo.texture);
+    f("metallic-roughness", m.metallic_roughness_texture);
+    f("normal map", m.normal_texture);
+    f("emission", m.radiance.texture);
+    f("transmission", m.transmission_texture);
+    f("specular", m.specular_texture);
+    f("specular colour", m.specular_color_texture);
+    f("clearcoat", m.layers.clearcoat_texture);
+    f("clearcoat roughness", m.layers.clearcoat_roughness_texture);
+    f("clearcoat normal map", m.layers.clearcoat_normal_texture);
+    f("sheen colour", m.layers.sheen_color_texture);
+    f("sheen roughness", m.layers.sheen_roughness_texture);
+    f("alpha", m.alpha_texture);
+}
 
 /// Either form of the scene-format camera; the renderer turns both into one basis.
 struct CameraDesc {

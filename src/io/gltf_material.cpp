@@ -1,5 +1,5 @@
 // glTF materials -> MaterialDesc of type pbr (every core input and the
-// transmission, ior, volume and emissive-strength extensions), textures ->
+// transmission, ior, volume, emissive-strength, clearcoat and sheen extensions), textures ->
 // TextureDesc with the uv convention of scene_desc.h, images decoded through
 // OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
@@ -229,6 +229,12 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
             const float distance = float(number(value, "attenuationDistance", kInfinity));
             if (distance > 0.0f) out.attenuation_distance = distance;
             out.attenuation_color = rgb_of(numbers(value, "attenuationColor"), Rgb(1.0f));
+        } else if (name == "KHR_materials_clearcoat") {
+            set_clearcoat(out.layers, value, ext);
+            out.extensions.push_back(name);
+        } else if (name == "KHR_materials_sheen") {
+            set_sheen(out.layers, value, ext);
+            out.extensions.push_back(name);
         } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
@@ -249,6 +255,34 @@ void Materials::set_specular(MaterialDesc& out, const tinygltf::Value& ext, cons
     if (auto info = texture_info(ext, "specularColorTexture"))
         out.specular_color_texture = texture(*info, true, where + ".specularColorTexture");
     out.extensions.push_back("KHR_materials_specular");
+}
+
+/// KHR_materials_clearcoat: the coat's weight (texture R), roughness (texture G)
+/// and its own normal map. Data textures, read linear.
+void Materials::set_clearcoat(PbrLayersDesc& out, const tinygltf::Value& ext, const std::string& element) {
+    out.clearcoat = std::clamp(float(number(ext, "clearcoatFactor", 0.0)), 0.0f, 1.0f);
+    if (auto info = texture_info(ext, "clearcoatTexture"))
+        out.clearcoat_texture = texture(*info, false, element + ".clearcoatTexture");
+    out.clearcoat_roughness = std::clamp(float(number(ext, "clearcoatRoughnessFactor", 0.0)), 0.0f, 1.0f);
+    if (auto info = texture_info(ext, "clearcoatRoughnessTexture"))
+        out.clearcoat_roughness_texture = texture(*info, false, element + ".clearcoatRoughnessTexture");
+    if (auto info = texture_info(ext, "clearcoatNormalTexture")) {
+        out.clearcoat_normal_texture = texture(*info, false, element + ".clearcoatNormalTexture");
+        out.clearcoat_normal_scale = float(number(ext.Get("clearcoatNormalTexture"), "scale", 1.0));
+    }
+}
+
+/// KHR_materials_sheen: the sheen colour (texture RGB, sRGB-encoded like every
+/// colour) and roughness (texture A, linear).
+void Materials::set_sheen(PbrLayersDesc& out, const tinygltf::Value& ext, const std::string& element) {
+    const Rgb color = rgb_of(numbers(ext, "sheenColorFactor"), Rgb(0.0f));
+    out.sheen_color = Rgb(std::clamp(color.x, 0.0f, 1.0f), std::clamp(color.y, 0.0f, 1.0f),
+                          std::clamp(color.z, 0.0f, 1.0f));
+    if (auto info = texture_info(ext, "sheenColorTexture"))
+        out.sheen_color_texture = texture(*info, true, element + ".sheenColorTexture");
+    out.sheen_roughness = std::clamp(float(number(ext, "sheenRoughnessFactor", 0.0)), 0.0f, 1.0f);
+    if (auto info = texture_info(ext, "sheenRoughnessTexture"))
+        out.sheen_roughness_texture = texture(*info, false, element + ".sheenRoughnessTexture");
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).

@@ -434,14 +434,7 @@ void merge_loaded_model(SceneDesc& scene, LoadedModel&& model, std::optional<uin
     };
     if (!material_override) {
         for (MaterialDesc& m : model.materials) {
-            shift(m.albedo.texture);
-            shift(m.radiance.texture);
-            shift(m.alpha_texture);
-            shift(m.metallic_roughness_texture);
-            shift(m.normal_texture);
-            shift(m.transmission_texture);
-            shift(m.specular_texture);
-            shift(m.specular_color_texture);
+            for_each_texture_slot(m, [&](const char*, int& t) { shift(t); });
             scene.materials.push_back(std::move(m));
         }
         for (TextureDesc& t : model.textures) scene.textures.push_back(std::move(t));

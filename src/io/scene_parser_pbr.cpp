@@ -55,6 +55,15 @@ void parse_alpha_mode(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     }
 }
 
+/// clearcoat and sheen (glTF's KHR_materials_clearcoat and KHR_materials_sheen), factors only.
+void parse_pbr_layers(JsonObject& o, PbrLayersDesc& l) {
+    const NumberRange unit = NumberRange::closed(0, 1);
+    if (auto v = o.get("clearcoat")) l.clearcoat = v->number_f(unit);
+    if (auto v = o.get("clearcoat_roughness")) l.clearcoat_roughness = v->number_f(unit);
+    if (auto v = o.get("sheen_color")) l.sheen_color = v->vec3(unit);
+    if (auto v = o.get("sheen_roughness")) l.sheen_roughness = v->number_f(unit);
+}
+
 }  // namespace
 
 void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
@@ -79,6 +88,7 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     if (auto v = o.get("thin_walled")) m.thin_walled = v->boolean();
     if (auto v = o.get("double_sided")) m.double_sided = v->boolean();
     parse_alpha_mode(o, ctx, m);
+    parse_pbr_layers(o, m.layers);
 }
 
 }  // namespace sahara

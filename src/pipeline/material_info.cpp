@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -44,19 +45,15 @@ std::string number_text(float v) {
 /// Texture roles in the order a reader expects them: {role, texture index}.
 std::vector<std::pair<std::string, int>> textures_of(const MaterialDesc& m) {
     std::vector<std::pair<std::string, int>> out;
-    auto add = [&](const char* role, int t) {
-        if (t >= 0) out.emplace_back(role, t);
-    };
-    if (m.albedo.kind == ColorSource::Kind::texture) add("base colour", m.albedo.texture);
-    add("metallic-roughness", m.metallic_roughness_texture);
-    add("normal map", m.normal_texture);
-    if (m.radiance.kind == ColorSource::Kind::texture) add("emission", m.radiance.texture);
-    add("transmission", m.transmission_texture);
-    add("specular", m.specular_texture);
-    add("specular colour", m.specular_color_texture);
-    // glTF takes alpha from the base colour texture: name it only when it is another image.
-    if (m.alpha_texture != m.albedo.texture || m.albedo.kind != ColorSource::Kind::texture)
-        add("alpha", m.alpha_texture);
+    for_each_texture_slot(m, [&](const char* role, int t) {
+        const std::string_view r = role;
+        if (t < 0) return;
+        if (r == "base colour" && m.albedo.kind != ColorSource::Kind::texture) return;
+        if (r == "emission" && m.radiance.kind != ColorSource::Kind::texture) return;
+        // glTF takes alpha from the base colour texture: name it only when it is another image.
+        if (r == "alpha" && t == m.albedo.texture && m.albedo.kind == ColorSource::Kind::texture) return;
+        out.emplace_back(role, t);
+    });
     return out;
 }
 
@@ -71,6 +68,23 @@ bool attenuates(const MaterialDesc& m) {
 }
 
 /// One material's line: text and JSON say the same things.
+/// pbr's clearcoat and sheen, when it has them.
+void describe_layers(std::vector<std::string>& parts, nlohmann::json& value, const MaterialDesc& m) {
+    const PbrLayersDesc& l = m.layers;
+    const bool pbr = m.type == MaterialType::pbr;
+    value["clearcoat"] = pbr ? l.clearcoat : 0.0f;
+    if (pbr && l.clearcoat > 0.0f)
+        parts.push_back("clearcoat " + number_text(l.clearcoat) + " (roughness " +
+                        number_text(l.clearcoat_roughness) + ")");
+    const bool sheen = pbr && max_component(l.sheen_color) > 0.0f;
+    value["sheen_color"] = sheen ? std::vector<float>{l.sheen_color.x, l.sheen_color.y, l.sheen_color.z}
+                                 : std::vector<float>{0.0f, 0.0f, 0.0f};
+    if (sheen)
+        parts.push_back("sheen [" + number_text(l.sheen_color.x) + ", " + number_text(l.sheen_color.y) +
+                        ", " + number_text(l.sheen_color.z) + "] (roughness " +
+                        number_text(l.sheen_roughness) + ")");
+}
+
 void describe_material(StatsReport& s, const std::string& label, const MaterialDesc& m) {
     std::vector<std::string> parts{material_type_name(m.type)};
     nlohmann::json value = {{"name", m.name}, {"type", material_type_name(m.type)}};
@@ -99,6 +113,7 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     value["volume_attenuation"] = transmits && !m.thin_walled && attenuates(m);
     if (value["volume_attenuation"] == true)
         parts.push_back("volume attenuation over " + number_text(m.attenuation_distance));
+    describe_layers(parts, value, m);
     const std::string alpha = alpha_mode(m);
     value["alpha_mode"] = alpha;
     if (m.alpha_cutoff) value["alpha_cutoff"] = *m.alpha_cutoff;

@@ -18,6 +18,16 @@ enum class BsdfKind : uint8_t { lambertian, mirror, ggx, dielectric, pbr, none }
 /// tinier alpha is numerically a delta anyway).
 inline constexpr float kMinGgxAlpha = 1e-3f;
 
+/// pbr's clearcoat and sheen at one point (render/bsdf_layers.h); read only when `on`.
+struct BsdfLayers {
+    bool on = false;
+    bool coat_frame = false;    ///< the coat's normal is not the base's: coat_normal holds it
+    Vec3 coat_normal{0, 0, 1};  ///< in the base's local frame
+    float clearcoat = 0, coat_roughness = 0, coat_alpha = 0;
+    Rgb sheen{0.0f};
+    float sheen_roughness = 0, sheen_alpha = 0;
+};
+
 /// A BSDF instantiated at one surface point.
 struct Bsdf {
     BsdfKind kind = BsdfKind::none;
@@ -34,6 +44,7 @@ struct Bsdf {
     float f90 = 1;        ///< the dielectric layer's reflectance at grazing angles (KHR_materials_specular)
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
     bool thin = false;       ///< thin-walled: transmission without refraction
+    BsdfLayers layers;       ///< clearcoat and sheen over all of the above
 
     bool is_delta() const { return kind == BsdfKind::mirror || kind == BsdfKind::dielectric; }
 };

@@ -2,7 +2,9 @@
 
 #include <cmath>
 
+#include "render/bsdf_layers.h"
 #include "render/ggx_albedo.h"
+#include "render/sheen.h"
 #include "scene/texture.h"
 
 namespace sahara {
@@ -123,10 +125,10 @@ Vec2 texcoord(const SurfaceInteraction& si, const std::vector<TextureDesc>& text
 }
 
 /// The shading normal bent by a tangent-space normal map (glTF: +Y towards
-/// increasing v, xy scaled by normal_scale). The map describes the front
+/// increasing v, xy scaled by `scale`). The map describes the front
 /// side; a back face sees the same bumps from behind, so the frame is built
 /// on the front side and the result turned around.
-Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
+Vec3 mapped_normal(int texture, float scale, const SurfaceInteraction& si,
                    const std::vector<TextureDesc>& textures) {
     if (length_squared(si.tangent) <= 0) return si.ns;
     const Vec3 n_front = si.front_face ? si.ns : -si.ns;
@@ -134,9 +136,8 @@ Vec3 mapped_normal(const MaterialDesc& m, const SurfaceInteraction& si,
     if (length_squared(t0) <= 1e-12f) return si.ns;
     const Vec3 t = normalize(t0);
     const Vec3 bt = cross(n_front, t) * si.tangent_sign;
-    const Rgb c =
-        sample_texture_rgb(textures[size_t(m.normal_texture)], texcoord(si, textures, m.normal_texture));
-    const float x = (2.0f * c.x - 1.0f) * m.normal_scale, y = (2.0f * c.y - 1.0f) * m.normal_scale;
+    const Rgb c = sample_texture_rgb(textures[size_t(texture)], texcoord(si, textures, texture));
+    const float x = (2.0f * c.x - 1.0f) * scale, y = (2.0f * c.y - 1.0f) * scale;
     const float z = 2.0f * c.z - 1.0f;
     const Vec3 n = t * x + bt * y + n_front * z;
     if (!(length_squared(n) > 0)) return si.ns;
@@ -168,6 +169,46 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.f0_color = Rgb(std::min(f0.x, 1.0f), std::min(f0.y, 1.0f), std::min(f0.z, 1.0f)) * weight;
     b.f0 = max_component(b.f0_color);
     b.f90 = weight;
+}
+
+/// One channel of a data texture (read linear), or 1 without one.
+float texture_channel(int texture, int channel, const SurfaceInteraction& si,
+                      const std::vector<TextureDesc>& textures) {
+    if (texture < 0) return 1.0f;
+    float alpha = 1.0f;
+    const Rgb c = sample_texture_rgb(textures[size_t(texture)], texcoord(si, textures, texture),
+                                     channel == 3 ? &alpha : nullptr);
+    return channel == 3 ? alpha : c[channel];
+}
+
+/// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.
+/// Without its own normal map the coat follows the interpolated normal, not
+/// the base's normal map (as the extension says): a smooth lacquer over bumps.
+void set_pbr_layers(Bsdf& b, const PbrLayersDesc& d, const SurfaceInteraction& si,
+                    const std::vector<TextureDesc>& textures) {
+    BsdfLayers& l = b.layers;
+    l.clearcoat = std::clamp(d.clearcoat * texture_channel(d.clearcoat_texture, 0, si, textures), 0.0f, 1.0f);
+    l.coat_roughness = std::clamp(
+        d.clearcoat_roughness * texture_channel(d.clearcoat_roughness_texture, 1, si, textures), 0.0f, 1.0f);
+    l.coat_alpha = pbr_alpha(l.coat_roughness);
+    Rgb sheen = d.sheen_color;
+    if (d.sheen_color_texture >= 0)
+        sheen = sheen * sample_texture_rgb(textures[size_t(d.sheen_color_texture)],
+                                           texcoord(si, textures, d.sheen_color_texture));
+    l.sheen = Rgb(std::clamp(sheen.x, 0.0f, 1.0f), std::clamp(sheen.y, 0.0f, 1.0f),
+                  std::clamp(sheen.z, 0.0f, 1.0f));
+    l.sheen_roughness = std::clamp(
+        d.sheen_roughness * texture_channel(d.sheen_roughness_texture, 3, si, textures), 0.0f, 1.0f);
+    l.sheen_alpha = sheen_alpha(l.sheen_roughness);
+    const bool own_normal = d.clearcoat_normal_texture >= 0;
+    if (l.clearcoat > 0 && (own_normal || !(b.frame.n == si.ns))) {
+        const Vec3 n = own_normal
+                           ? mapped_normal(d.clearcoat_normal_texture, d.clearcoat_normal_scale, si, textures)
+                           : si.ns;
+        l.coat_normal = normalize(b.frame.to_local(n));
+        l.coat_frame = true;
+    }
+    l.on = l.clearcoat > 0 || max_component(l.sheen) > 0;
 }
 
 }  // namespace
@@ -208,7 +249,8 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
     b.thin = m.thin_walled;
     b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
-    if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m, si, textures));
+    if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
+    if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);
 }
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
@@ -222,6 +264,7 @@ PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
     w.transmit = (1.0f - b.metallic) * b.transmission * mean(b.albedo) * (1.0f - f0);
     const float sum = w.specular + w.cosine + w.transmit;
     if (!(sum > 0)) return {};
+    w.total = sum;
     w.specular /= sum;
     w.cosine /= sum;
     w.transmit /= sum;
@@ -229,6 +272,10 @@ PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
 }
 
 Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
+    return b.layers.on ? eval_pbr_layered(b, wo, wi, pdf) : eval_pbr_base(b, wo, wi, pdf);
+}
+
+Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     *pdf = 0;
     if (wo.z <= 0 || wi.z == 0) return Rgb(0.0f);
     const PbrLobeWeights p = pbr_lobe_weights(b, wo);
@@ -256,19 +303,25 @@ Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     return f;
 }
 
+bool sample_pbr_base_direction(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, Vec3* wi) {
+    const PbrLobeWeights p = pbr_lobe_weights(b, wo);
+    if (u_lobe < p.specular) {
+        *wi = reflect(wo, sample_ggx_vndf(wo, b.alpha, u));
+        return wi->z > 0;
+    }
+    if (u_lobe < p.specular + p.cosine) {
+        *wi = sample_cosine_hemisphere(u);
+        return true;
+    }
+    return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(wo, b.alpha, u), wi);
+}
+
 bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s) {
     if (wo.z <= 0) return false;
-    const PbrLobeWeights p = pbr_lobe_weights(b, wo);
     Vec3 wi;
-    if (u_lobe < p.specular) {
-        wi = reflect(wo, sample_ggx_vndf(wo, b.alpha, u));
-        if (wi.z <= 0) return false;
-    } else if (u_lobe < p.specular + p.cosine) {
-        wi = sample_cosine_hemisphere(u);
-    } else {
-        if (p.transmit <= 0) return false;
-        if (!sample_transmission(b, wo, sample_ggx_vndf(wo, b.alpha, u), &wi)) return false;
-    }
+    if (!(b.layers.on ? sample_pbr_layered_direction(b, wo, u, u_lobe, &wi)
+                      : sample_pbr_base_direction(b, wo, u, u_lobe, &wi)))
+        return false;
     float pdf = 0;
     const Rgb f = eval_pbr(b, wo, wi, &pdf);
     if (!(pdf > 0)) return false;

@@ -37,6 +37,7 @@ struct PbrLobeWeights {
     float specular = 0;  ///< single-scattering GGX reflection (visible-normal sampled)
     float cosine = 0;    ///< diffuse base and multiple-scattering lobe (cosine sampled)
     float transmit = 0;  ///< rough refraction
+    float total = 0;     ///< the three before normalisation: the base's estimated albedo at wo
 };
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo);
@@ -46,5 +47,11 @@ Rgb eval_pbr(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);
 
 /// Picks a lobe by u_lobe, a direction by u; s.wi is local.
 bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s);
+
+/// The base material alone, without clearcoat and sheen (what eval_pbr is
+/// when b.layers.on is false); render/bsdf_layers.cpp layers over these.
+Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);
+/// A direction from the base's lobes (wo.z > 0); false if the lobe gives none.
+bool sample_pbr_base_direction(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, Vec3* wi);
 
 }  // namespace sahara

@@ -171,7 +171,8 @@ void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, Sur
 /// Whether a mesh uses a normal-mapped material (and so needs tangents).
 bool uses_normal_map(const SceneDesc& desc, const TriangleMesh& m) {
     auto mapped = [&](uint32_t id) {
-        return id < desc.materials.size() && desc.materials[id].normal_texture >= 0;
+        return id < desc.materials.size() && (desc.materials[id].normal_texture >= 0 ||
+                                              desc.materials[id].layers.clearcoat_normal_texture >= 0);
     };
     if (m.material_ids.empty()) return mapped(m.material);
     return std::any_of(m.material_ids.begin(), m.material_ids.end(), mapped);

@@ -52,6 +52,7 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
         {"alphaMode", "BLEND"},
         {"extensions",
          {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}},
+          {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}},
           {"KHR_materials_transmission", {{"transmissionFactor", 0.5}}},
           {"KHR_materials_volume",
            {{"thicknessFactor", 1}, {"attenuationDistance", 2}, {"attenuationColor", {1, 0.5, 0.5}}}}}}};
@@ -70,8 +71,10 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     CHECK(m["alpha_mode"] == "blend");
     CHECK(m["double_sided"] == false);
     const json& ignored = j["Ignored inputs"]["[0] paint"];
-    for (const char* what : {"occlusion map", "KHR_materials_clearcoat"})
+    for (const char* what : {"occlusion map", "KHR_materials_iridescence"})
         CHECK_MESSAGE(contains(ignored, what), std::string(what));
+    CHECK_FALSE(contains(ignored, "KHR_materials_clearcoat"));  // rendered
+    CHECK(m["clearcoat"] == 1.0);
     CHECK_FALSE(contains(ignored, "volume attenuation (not rendered yet)"));  // rendered now
     CHECK(m["volume_attenuation"] == true);
     CHECK_FALSE(contains(ignored, "vertex-colour alpha"));  // used now
@@ -80,9 +83,10 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     TempDir run("info_pbr_text");
     const CliRun r = run_sahara("info " + file, run);
     CHECK(r.code == 0);
-    for (const char* text : {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
-                             "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend",
-                             "one-sided", "Ignored inputs", "occlusion map, KHR_materials_clearcoat"})
+    for (const char* text :
+         {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
+          "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
+          "clearcoat 1 (roughness 0)", "Ignored inputs", "occlusion map, KHR_materials_iridescence"})
         CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
 }
 

@@ -139,7 +139,7 @@ TEST_CASE("glTF extensionsRequired: the material extensions sahara implements pa
     }
     Doc d;
     d.node({{"mesh", d.mesh(d.positions(kTriangle))}});
-    d.j["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_clearcoat"};
+    d.j["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_iridescence"};
     CHECK(error_of([&] { load_gltf(d.write(dir / "r.gltf")); }) ==
-          f + ": extensionsRequired: KHR_materials_clearcoat is not supported");
+          f + ": extensionsRequired: KHR_materials_iridescence is not supported");
 }

@@ -449,3 +449,44 @@ TEST_CASE("scene parser: directions of any finite length give unit vectors") {
     CHECK(s.lights[0].direction.x == doctest::Approx(std::sqrt(0.5)));
     CHECK(s.lights[0].direction.z == doctest::Approx(std::sqrt(0.5)));
 }
+
+TEST_CASE("a model joining a scene with textures has every texture slot renumbered") {
+    SceneDesc scene;
+    scene.textures.resize(3);  // the scene's own textures come first
+    LoadedModel model;
+    model.textures.resize(13);
+    MaterialDesc m;
+    m.albedo.kind = ColorSource::Kind::texture;
+    m.albedo.texture = 0;
+    m.metallic_roughness_texture = 1;
+    m.normal_texture = 2;
+    m.radiance.kind = ColorSource::Kind::texture;
+    m.radiance.texture = 3;
+    m.transmission_texture = 4;
+    m.specular_texture = 5;
+    m.specular_color_texture = 6;
+    m.layers.clearcoat_texture = 7;
+    m.layers.clearcoat_roughness_texture = 8;
+    m.layers.clearcoat_normal_texture = 9;
+    m.layers.sheen_color_texture = 10;
+    m.layers.sheen_roughness_texture = 11;
+    m.alpha_texture = 12;
+    model.materials.push_back(m);
+    merge_loaded_model(scene, std::move(model), std::nullopt);
+    REQUIRE(scene.materials.size() == 1);
+    REQUIRE(scene.textures.size() == 16);
+    const MaterialDesc& out = scene.materials[0];
+    CHECK(out.albedo.texture == 3);
+    CHECK(out.metallic_roughness_texture == 4);
+    CHECK(out.normal_texture == 5);
+    CHECK(out.radiance.texture == 6);
+    CHECK(out.transmission_texture == 7);
+    CHECK(out.specular_texture == 8);
+    CHECK(out.specular_color_texture == 9);
+    CHECK(out.layers.clearcoat_texture == 10);
+    CHECK(out.layers.clearcoat_roughness_texture == 11);
+    CHECK(out.layers.clearcoat_normal_texture == 12);
+    CHECK(out.layers.sheen_color_texture == 13);
+    CHECK(out.layers.sheen_roughness_texture == 14);
+    CHECK(out.alpha_texture == 15);
+}

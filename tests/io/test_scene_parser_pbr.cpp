@@ -99,3 +99,23 @@ TEST_CASE("scene parser: bad pbr keys are named with their path") {
     check_contains(bad(R"({"type": "pbr", "emission": [-1, 0, 0]})"), {"materials.m.emission"});
     check_contains(bad(R"({"type": "plastic"})"), {"pbr"});
 }
+
+TEST_CASE("scene parser: pbr clearcoat and sheen keys") {
+    const MaterialDesc plain = parse_one(R"({"type": "pbr"})");
+    CHECK_FALSE(plain.layers.any());
+    const MaterialDesc m = parse_one(
+        R"({"type": "pbr", "clearcoat": 0.75, "clearcoat_roughness": 0.25, "sheen_color": [1, 0.5, 0], "sheen_roughness": 0.5})");
+    CHECK(m.layers.clearcoat == 0.75f);
+    CHECK(m.layers.clearcoat_roughness == 0.25f);
+    CHECK(m.layers.sheen_color == Rgb(1.0f, 0.5f, 0.0f));
+    CHECK(m.layers.sheen_roughness == 0.5f);
+    CHECK(m.layers.any());
+    const auto bad = [](const std::string& material) {
+        return error_of(with_objects("[]", R"({"m": )" + material + "}"));
+    };
+    check_contains(bad(R"({"type": "pbr", "clearcoat": 2})"), {"materials.m.clearcoat", "[0, 1]"});
+    check_contains(bad(R"({"type": "pbr", "clearcoat_roughness": -1})"), {"materials.m.clearcoat_roughness"});
+    check_contains(bad(R"({"type": "pbr", "sheen_color": [0, 0, 1.5]})"), {"materials.m.sheen_color"});
+    check_contains(bad(R"({"type": "pbr", "sheen_roughness": "rough"})"), {"materials.m.sheen_roughness"});
+    check_contains(bad(R"({"type": "lambertian", "clearcoat": 1})"), {"clearcoat"});  // pbr only
+}
