@@ -17,6 +17,7 @@
 #include "accel/build_chunks.h"
 
 #include <algorithm>
+#include <exception>
 #include <memory>
 #include <vector>
 
@@ -57,14 +58,20 @@ class BinnedBuild {
         refs_ = BuildArray<PrimRef>(n_);
         nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
+        used_pairs_[0] = 1;  // the root and the padding node
+        new_pair_ = BuildArray<uint32_t>(n_);
         if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
+        std::exception_ptr error;
 #pragma omp parallel
-#pragma omp single
         {
-            const Range root = init_refs();
-            build(0, Bvh::kFirstPair, root, 0);
+#pragma omp single
+            {
+                const Range root = init_refs();
+                build(0, Bvh::kFirstPair, root, 0);
+            }  // its barrier waits for every subtree task
+            compact(error);
         }
-        compact();
+        if (error) std::rethrow_exception(error);
     }
 
    private:
@@ -326,29 +333,54 @@ class BinnedBuild {
     }
 
     /// Removes the unused pairs of the node regions, keeping the order (depth-first, left
-    /// before right: the order of a serial build that allocates pairs as it goes).
-    void compact() {
+    /// before right: the order of a serial build that allocates pairs as it goes). Run by
+    /// every thread of the build's region (the worker would otherwise wait through it):
+    /// the pairs are counted, numbered and copied in fixed chunks, integer sums only.
+    void compact(std::exception_ptr& error) {
         if (nodes_[0].is_leaf()) {
-            out_.nodes.assign(1, nodes_[0]);
+#pragma omp single
+            try {
+                out_.nodes.assign(1, nodes_[0]);
+            } catch (...) {
+                error = std::current_exception();
+            }
             return;
         }
-        used_pairs_[0] = 1;
-        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
-        uint32_t pairs = 0;
-        for (uint32_t k = 0; k < n_; ++k) {
-            new_pair[k] = pairs;
-            pairs += used_pairs_[k];
+        const uint32_t chunks = n_ > kParallelScanThreshold ? kScanChunks : 1;
+        auto first = [&](uint32_t c) { return uint32_t(uint64_t(n_) * c / chunks); };
+#pragma omp for schedule(static)
+        for (uint32_t c = 0; c < chunks; ++c) {
+            uint32_t used = 0;
+            for (uint32_t k = first(c); k < first(c + 1); ++k) used += used_pairs_[k];
+            chunk_pairs_[c] = used;
         }
-        out_.nodes.resize(2 * size_t(pairs));
-        for (uint32_t k = 0; k < n_; ++k) {
-            if (!used_pairs_[k]) continue;
-            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
-                BvhNode node = nodes_[2 * k + j];
-                if (!node.is_leaf()) node.index = 2 * new_pair[node.index / 2];
-                out_.nodes[2 * new_pair[k] + j] = node;
+#pragma omp single
+        {
+            uint32_t pairs = 0;
+            for (uint32_t c = 0; c < chunks; ++c) chunk_first_[c] = pairs, pairs += chunk_pairs_[c];
+            try {
+                out_.nodes.resize(2 * size_t(pairs));
+                out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};  // padding
+            } catch (...) {
+                error = std::current_exception();
             }
         }
-        out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
+        if (error) return;  // read after the single's barrier: every thread returns
+#pragma omp for schedule(static)
+        for (uint32_t c = 0; c < chunks; ++c) {
+            uint32_t pairs = chunk_first_[c];
+            for (uint32_t k = first(c); k < first(c + 1); ++k) new_pair_[k] = pairs, pairs += used_pairs_[k];
+        }
+#pragma omp for schedule(static)
+        for (uint32_t c = 0; c < chunks; ++c)
+            for (uint32_t k = first(c); k < first(c + 1); ++k) {
+                if (!used_pairs_[k]) continue;
+                for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1] is the padding
+                    BvhNode node = nodes_[2 * k + j];
+                    if (!node.is_leaf()) node.index = 2 * new_pair_[node.index / 2];
+                    out_.nodes[2 * new_pair_[k] + j] = node;
+                }
+            }
     }
 
     const BvhBuildInput& in_;
@@ -358,6 +390,8 @@ class BinnedBuild {
     BuildArray<PrimRef> refs_, scratch_;
     BuildArray<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
+    BuildArray<uint32_t> new_pair_;  ///< [k]: pair k's place after compaction
+    uint32_t chunk_pairs_[kScanChunks] = {}, chunk_first_[kScanChunks] = {};
 };
 
 }  // namespace

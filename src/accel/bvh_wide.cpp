@@ -1,6 +1,8 @@
 #include "accel/bvh_wide.h"
 
 #include <array>
+#include <atomic>
+#include <exception>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -30,17 +32,25 @@ template <int N>
 class CollapsePlan {
    public:
     CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
-        : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
-        // Each node's costs depend only on its children's, so the subtrees below the
-        // top levels are independent tasks; the result does not depend on the threads.
-        if (bvh.nodes.size() < kParallelNodes) {
-            solve(0, kTaskLevels);
-            return;
-        }
-#pragma omp parallel
-#pragma omp single
-        solve(0, 0);
-    }
+        : bvh_(bvh),
+          opt_(opt),
+          cost_(bvh.nodes.size()),
+          plan_(bvh.nodes.size()),
+          range_(bvh.nodes.size()),
+          wide_(bvh.nodes.size()) {}
+
+    /// Whether the tree is large enough for tasks (inside a parallel region).
+    bool parallel() const { return bvh_.nodes.size() >= kParallelNodes; }
+
+    /// Solves the programme for the whole tree. Each node's costs depend only on its
+    /// children's, so the subtrees below the top levels are independent tasks (when
+    /// parallel()); the result does not depend on the threads. Returns after every task.
+    void solve() { solve(0, parallel() ? 0 : kTaskLevels); }
+
+    /// Wide nodes below the one made for binary inner node x (its whole subtree but itself).
+    uint32_t nodes_below(uint32_t x) const { return wide_[x][0]; }
+    /// Whether a binary leaf holds more primitives than a wide leaf reference can.
+    bool oversize_leaf() const { return oversize_.load(std::memory_order_relaxed); }
 
     /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).
     struct Child {
@@ -60,6 +70,9 @@ class CollapsePlan {
 
    private:
     using Costs = std::array<double, N + 1>;  ///< [k]: least cost of a subtree in k slots
+    /// [k], k >= 1: wide nodes the subtree emits in k slots (as the plan places it);
+    /// [0]: wide nodes below the node made for it, its children sharing N slots.
+    using NodeCounts = std::array<uint32_t, N + 1>;
     struct Choice {
         std::array<uint8_t, N + 1> left_slots;  ///< [k]: slots of the left child when opened
         std::array<bool, N + 1> open;           ///< [k]: opened into k slots, or kept as one child
@@ -126,6 +139,8 @@ class CollapsePlan {
         if (node.is_leaf()) {
             range_[x] = {node.index, node.count};
             f.fill(opt_.block_cost * area * double(blocks(node.count)));
+            wide_[x].fill(0);
+            if (node.count > kMaxWideLeafCount) oversize_.store(true, std::memory_order_relaxed);
             return;
         }
         Choice& plan = plan_[x];
@@ -151,6 +166,19 @@ class CollapsePlan {
             plan.open[k] = opened[k] < f[1];
             f[k] = plan.open[k] ? opened[k] : f[1];
         }
+        count_nodes(x, plan);
+    }
+
+    /// wide_[x] from its children's, following the choices just made (what emit() walks).
+    void count_nodes(uint32_t x, const Choice& plan) {
+        const BvhNode& node = bvh_.nodes[x];
+        const NodeCounts& l = wide_[node.index];
+        const NodeCounts& r = wide_[node.index + 1];
+        NodeCounts& w = wide_[x];
+        auto opened = [&](int k) { return l[plan.left_slots[k]] + r[k - plan.left_slots[k]]; };
+        w[0] = opened(N);
+        w[1] = plan.leaf ? 0 : 1 + w[0];
+        for (int k = 2; k <= N; ++k) w[k] = plan.open[k] ? opened(k) : w[1];
     }
 
     static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
@@ -158,11 +186,7 @@ class CollapsePlan {
     void emit(uint32_t x, int k, Child out[N], int& n) const {
         const BvhNode& node = bvh_.nodes[x];
         if (node.is_leaf()) {
-            if (node.count > kMaxWideLeafCount)
-                throw std::invalid_argument("wide BVH leaves hold at most " +
-                                            std::to_string(kMaxWideLeafCount) +
-                                            " primitives (BvhBuildParams::max_leaf_size)");
-            out[n++] = {x, node.index, node.count};
+            out[n++] = {x, node.index, node.count};  // its count checked by oversize_leaf()
         } else if (plan_[x].open[k]) {
             const int j = plan_[x].left_slots[k];
             emit(node.index, j, out, n);
@@ -177,6 +201,8 @@ class CollapsePlan {
     BuildArray<Costs> cost_;  ///< [x][k]: least cost of subtree x in k slots
     BuildArray<Choice> plan_;
     BuildArray<Range> range_;
+    BuildArray<NodeCounts> wide_;
+    std::atomic<bool> oversize_{false};
 };
 
 /// Child slot `c` of `p`: the box of binary node `box`, a leaf of `count` slots
@@ -204,6 +230,35 @@ BvhWideNode<N> empty_node() {
     return p;
 }
 
+/// Writes the wide node made for binary inner node x at out.nodes[index] and, depth
+/// first, its subtree after it: each inner child's subtree in the next plan.nodes_below()
+/// + 1 places, so large subtrees are written by tasks at places known in advance (the
+/// same array as a serial depth-first emission).
+template <int N>
+void place(const CollapsePlan<N>& plan, const Bvh& bvh, uint32_t x, uint32_t index, bool tasks,
+           BvhWide<N>& out) {
+    // Subtrees of fewer wide nodes are written by the task that reaches them.
+    constexpr uint32_t kTaskNodes = 128;
+    typename CollapsePlan<N>::Child kids[N];
+    const int n = plan.children(x, kids);
+    BvhWideNode<N> p = empty_node<N>();
+    uint32_t next = index + 1;
+    for (int c = 0; c < n; ++c) {
+        set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
+        if (kids[c].count) continue;
+        const uint32_t kid = kids[c].node, at = next;
+        p.child[c] = BvhWide<N>::offset_of(at);
+        next += plan.nodes_below(kid) + 1;
+        if (tasks && plan.nodes_below(kid) >= kTaskNodes) {
+#pragma omp task default(shared) firstprivate(kid, at)
+            place(plan, bvh, kid, at, tasks, out);
+        } else {
+            place(plan, bvh, kid, at, tasks, out);
+        }
+    }
+    out.nodes[index] = p;
+}
+
 }  // namespace
 
 template <int N>
@@ -221,32 +276,32 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     if (opt.merge_leaves_up_to > kMaxWideLeafCount)
         throw std::invalid_argument("wide BVH leaves hold at most " + std::to_string(kMaxWideLeafCount) +
                                     " primitives (WideCollapse::merge_leaves_up_to)");
-    out.nodes.reserve(bvh.nodes.size() / (N - 1) + 1);
-    // Depth-first: (canonical inner node, wide node that must point at it, child slot).
-    struct Pending {
-        uint32_t node;
-        uint32_t parent;
-        int slot;
-    };
-    const CollapsePlan<N> plan(bvh, opt);
-    std::vector<Pending> stack{{0, kNoNode, 0}};
-    while (!stack.empty()) {
-        const Pending it = stack.back();
-        stack.pop_back();
-        const auto index = uint32_t(out.nodes.size());
-        if (it.parent != kNoNode) out.nodes[it.parent].child[it.slot] = BvhWide<N>::offset_of(index);
-        typename CollapsePlan<N>::Child kids[N];
-        const int n = plan.children(it.node, kids);
-        BvhWideNode<N> p = empty_node<N>();
-        for (int c = 0; c < n; ++c) set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
-        out.nodes.push_back(p);
-        for (int c = n - 1; c >= 0; --c)
-            if (!kids[c].count) stack.push_back({kids[c].node, index, c});
+    CollapsePlan<N> plan(bvh, opt);
+    // One parallel region for the programme and the emission: the node count is known
+    // once the programme is solved. Errors are thrown after the region.
+    size_t total = 0;
+    std::exception_ptr error;
+#pragma omp parallel if (plan.parallel())
+#pragma omp single
+    {
+        plan.solve();
+        total = size_t(plan.nodes_below(0)) + 1;
+        if (!plan.oversize_leaf() && total <= BvhWide<N>::kMaxNodes) {
+            try {
+                out.nodes.resize(total);  // not filled: place() writes every node once
+            } catch (...) {
+                error = std::current_exception();
+            }
+            if (!error) place(plan, bvh, 0, 0, plan.parallel(), out);
+        }
     }
-    if (out.nodes.size() > BvhWide<N>::kMaxNodes)
-        throw InputError("scene too large: its wide BVH has " + std::to_string(out.nodes.size()) +
-                         " nodes, more than the " + std::to_string(BvhWide<N>::kMaxNodes) +
-                         " that 32-bit node offsets reach");
+    if (error) std::rethrow_exception(error);
+    if (plan.oversize_leaf())
+        throw std::invalid_argument("wide BVH leaves hold at most " + std::to_string(kMaxWideLeafCount) +
+                                    " primitives (BvhBuildParams::max_leaf_size)");
+    if (total > BvhWide<N>::kMaxNodes)
+        throw InputError("scene too large: its wide BVH has " + std::to_string(total) + " nodes, more than the " +
+                         std::to_string(BvhWide<N>::kMaxNodes) + " that 32-bit node offsets reach");
     return out;
 }
 
