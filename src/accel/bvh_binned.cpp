@@ -16,6 +16,8 @@
 #include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <exception>
 #include <memory>
@@ -337,16 +339,16 @@ class BinnedBuild {
     /// every thread of the build's region (the worker would otherwise wait through it):
     /// the pairs are counted, numbered and copied in fixed chunks, integer sums only.
     void compact(std::exception_ptr& error) {
-        if (nodes_[0].is_leaf()) {
+        if (nodes_[0].is_leaf() || n_ <= kParallelScanThreshold || omp_get_num_threads() == 1) {
 #pragma omp single
             try {
-                out_.nodes.assign(1, nodes_[0]);
+                compact_serial();
             } catch (...) {
                 error = std::current_exception();
             }
             return;
         }
-        const uint32_t chunks = n_ > kParallelScanThreshold ? kScanChunks : 1;
+        constexpr uint32_t chunks = kScanChunks;
         auto first = [&](uint32_t c) { return uint32_t(uint64_t(n_) * c / chunks); };
 #pragma omp for schedule(static)
         for (uint32_t c = 0; c < chunks; ++c) {
@@ -372,15 +374,35 @@ class BinnedBuild {
             for (uint32_t k = first(c); k < first(c + 1); ++k) new_pair_[k] = pairs, pairs += used_pairs_[k];
         }
 #pragma omp for schedule(static)
-        for (uint32_t c = 0; c < chunks; ++c)
-            for (uint32_t k = first(c); k < first(c + 1); ++k) {
-                if (!used_pairs_[k]) continue;
-                for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1] is the padding
-                    BvhNode node = nodes_[2 * k + j];
-                    if (!node.is_leaf()) node.index = 2 * new_pair_[node.index / 2];
-                    out_.nodes[2 * new_pair_[k] + j] = node;
-                }
+        for (uint32_t c = 0; c < chunks; ++c) copy_pairs(first(c), first(c + 1));
+    }
+
+    /// compact() on one thread, in one pass less.
+    void compact_serial() {
+        if (nodes_[0].is_leaf()) {
+            out_.nodes.assign(1, nodes_[0]);
+            return;
+        }
+        uint32_t pairs = 0;
+        for (uint32_t k = 0; k < n_; ++k) {
+            new_pair_[k] = pairs;
+            pairs += used_pairs_[k];
+        }
+        out_.nodes.resize(2 * size_t(pairs));
+        copy_pairs(0, n_);
+        out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};  // padding
+    }
+
+    /// The used pairs in [begin, end) to their new places.
+    void copy_pairs(uint32_t begin, uint32_t end) {
+        for (uint32_t k = begin; k < end; ++k) {
+            if (!used_pairs_[k]) continue;
+            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1] is the padding
+                BvhNode node = nodes_[2 * k + j];
+                if (!node.is_leaf()) node.index = 2 * new_pair_[node.index / 2];
+                out_.nodes[2 * new_pair_[k] + j] = node;
             }
+        }
     }
 
     const BvhBuildInput& in_;

@@ -2,7 +2,7 @@
 
 #include <array>
 #include <atomic>
-#include <exception>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -32,25 +32,17 @@ template <int N>
 class CollapsePlan {
    public:
     CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
-        : bvh_(bvh),
-          opt_(opt),
-          cost_(bvh.nodes.size()),
-          plan_(bvh.nodes.size()),
-          range_(bvh.nodes.size()),
-          wide_(bvh.nodes.size()) {}
-
-    /// Whether the tree is large enough for tasks (inside a parallel region).
-    bool parallel() const { return bvh_.nodes.size() >= kParallelNodes; }
-
-    /// Solves the programme for the whole tree. Each node's costs depend only on its
-    /// children's, so the subtrees below the top levels are independent tasks (when
-    /// parallel()); the result does not depend on the threads. Returns after every task.
-    void solve() { solve(0, parallel() ? 0 : kTaskLevels); }
-
-    /// Wide nodes below the one made for binary inner node x (its whole subtree but itself).
-    uint32_t nodes_below(uint32_t x) const { return wide_[x][0]; }
-    /// Whether a binary leaf holds more primitives than a wide leaf reference can.
-    bool oversize_leaf() const { return oversize_.load(std::memory_order_relaxed); }
+        : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
+        // Each node's costs depend only on its children's, so the subtrees below the
+        // top levels are independent tasks; the result does not depend on the threads.
+        if (bvh.nodes.size() < kParallelNodes) {
+            solve(0);
+            return;
+        }
+#pragma omp parallel
+#pragma omp single
+        spawn(0, 1);
+    }
 
     /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).
     struct Child {
@@ -70,9 +62,6 @@ class CollapsePlan {
 
    private:
     using Costs = std::array<double, N + 1>;  ///< [k]: least cost of a subtree in k slots
-    /// [k], k >= 1: wide nodes the subtree emits in k slots (as the plan places it);
-    /// [0]: wide nodes below the node made for it, its children sharing N slots.
-    using NodeCounts = std::array<uint32_t, N + 1>;
     struct Choice {
         std::array<uint8_t, N + 1> left_slots;  ///< [k]: slots of the left child when opened
         std::array<bool, N + 1> open;           ///< [k]: opened into k slots, or kept as one child
@@ -82,30 +71,60 @@ class CollapsePlan {
     /// the subtrees of the first kTaskLevels levels.
     static constexpr size_t kParallelNodes = 1u << 14;
     static constexpr int kTaskLevels = 6;
+    static constexpr uint32_t kTopNodes = 1u << kTaskLevels;  ///< top positions: [1, kTopNodes)
+    /// A node of the top levels: its binary node, and how many of its children are solved.
+    struct Top {
+        uint32_t node = 0;
+        std::atomic<uint32_t> ended{0};
+    };
     struct Range {
         uint32_t first, count;  ///< the subtree's slots; first = kNoNode: not contiguous
     };
-    /// Costs and choices of the subtree of node x (at `level`), children first.
-    void solve(uint32_t x, int level) {
+    /// Costs and choices of the subtree of node x, children first.
+    void solve(uint32_t x) {
         const BvhNode& node = bvh_.nodes[x];
         if (!node.is_leaf()) {
-            if (level < kTaskLevels) {
-#pragma omp task default(shared) firstprivate(level)
-                solve(node.index, level + 1);
-                solve(node.index + 1, level + 1);
-#pragma omp taskwait
-            } else {
-                solve(node.index, level + 1);
-                solve(node.index + 1, level + 1);
-            }
+            solve(node.index);
+            solve(node.index + 1);
         }
         combine(x);
+    }
+
+    /// solve() of node x at position h of the top levels (1: the root, 2h and 2h + 1: its
+    /// children): a task per subtree below them. No task waits for another (libgomp's
+    /// taskwait would idle the thread until that very child ended): the second of two
+    /// siblings to end combines their parent (finish()).
+    void spawn(uint32_t x, uint32_t h) {
+        const BvhNode& node = bvh_.nodes[x];
+        if (h >= kTopNodes || node.is_leaf()) {
+            solve(x);
+            finish(h);
+            return;
+        }
+        top_[h].node = x;
+        top_[h].ended.store(0, std::memory_order_relaxed);
+        const uint32_t left = node.index;
+#pragma omp task default(shared) firstprivate(left, h)
+        spawn(left, 2 * h);
+        spawn(left + 1, 2 * h + 1);
+    }
+
+    /// After the subtree at top position h is solved: its parent is combined by whichever
+    /// of its two children ends second, and so on up.
+    void finish(uint32_t h) {
+        for (; h > 1; h /= 2) {
+            Top& parent = top_[h / 2];
+            if (parent.ended.fetch_add(1, std::memory_order_acq_rel) == 0) return;
+            combine(parent.node);
+        }
     }
 
     /// opened[k]: the least cost of both children sharing k slots of the parent's node, the
     /// left child's share in plan.left_slots[k] (the first best). Branch-free: which share
     /// wins is data-dependent. Two leaves cost the same in any slots, so j = 1 wins.
-    static Costs open_costs(const Costs& left, const Costs& right, bool two_leaves, Choice& plan) {
+    static Costs open_costs(const Costs& left, const Costs& right, bool left_leaf, bool right_leaf,
+                            Choice& plan) {
+        const bool two_leaves = left_leaf && right_leaf;
         constexpr double inf = std::numeric_limits<double>::infinity();
         Costs opened;
         opened.fill(inf);
@@ -113,6 +132,31 @@ class CollapsePlan {
             const double sum = left[1] + right[1];
             if (!(sum < inf)) return opened;
             for (int k = 2; k <= N; ++k) opened[k] = sum, plan.left_slots[k] = 1;
+            return opened;
+        }
+        if (right_leaf) {
+            // right[k - j] is the same for every k: the loop below in one pass over j.
+            double best = inf;
+            int best_j = 0;
+            for (int k = 2; k <= N; ++k) {
+                const double c = left[k - 1] + right[1];
+                const bool lower = c < best;
+                best = lower ? c : best;
+                best_j = lower ? k - 1 : best_j;
+                opened[k] = best;
+                plan.left_slots[k] = uint8_t(best_j);
+            }
+            return opened;
+        }
+        if (left_leaf && non_increasing(right) && std::isfinite(left[1])) {
+            // left[j] is the same for every j and right[k - j] grows with j (rounding is
+            // monotonic), so the loop below would pick j = 1.
+            for (int k = 2; k <= N; ++k) {
+                const double c = left[1] + right[k - 1];
+                const bool finite = c < inf;
+                opened[k] = finite ? c : inf;
+                plan.left_slots[k] = uint8_t(finite ? 1 : 0);
+            }
             return opened;
         }
         for (int k = 2; k <= N; ++k) {
@@ -139,8 +183,6 @@ class CollapsePlan {
         if (node.is_leaf()) {
             range_[x] = {node.index, node.count};
             f.fill(opt_.block_cost * area * double(blocks(node.count)));
-            wide_[x].fill(0);
-            if (node.count > kMaxWideLeafCount) oversize_.store(true, std::memory_order_relaxed);
             return;
         }
         Choice& plan = plan_[x];
@@ -152,8 +194,8 @@ class CollapsePlan {
         range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
         const Costs& left = cost_[node.index];
         const Costs& right = cost_[node.index + 1];
-        const Costs opened = open_costs(
-            left, right, bvh_.nodes[node.index].is_leaf() && bvh_.nodes[node.index + 1].is_leaf(), plan);
+        const Costs opened = open_costs(left, right, bvh_.nodes[node.index].is_leaf(),
+                                        bvh_.nodes[node.index + 1].is_leaf(), plan);
         // As one child, x is a node of its own (its area plus its children in N
         // slots) or, when small enough, a leaf.
         const double as_node = area + opened[N];
@@ -166,27 +208,25 @@ class CollapsePlan {
             plan.open[k] = opened[k] < f[1];
             f[k] = plan.open[k] ? opened[k] : f[1];
         }
-        count_nodes(x, plan);
-    }
-
-    /// wide_[x] from its children's, following the choices just made (what emit() walks).
-    void count_nodes(uint32_t x, const Choice& plan) {
-        const BvhNode& node = bvh_.nodes[x];
-        const NodeCounts& l = wide_[node.index];
-        const NodeCounts& r = wide_[node.index + 1];
-        NodeCounts& w = wide_[x];
-        auto opened = [&](int k) { return l[plan.left_slots[k]] + r[k - plan.left_slots[k]]; };
-        w[0] = opened(N);
-        w[1] = plan.leaf ? 0 : 1 + w[0];
-        for (int k = 2; k <= N; ++k) w[k] = plan.open[k] ? opened(k) : w[1];
     }
 
     static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
 
+    /// c[1] >= c[2] >= ... >= c[N - 1], none NaN.
+    static bool non_increasing(const Costs& c) {
+        bool yes = true;
+        for (int k = 1; k + 1 < N; ++k) yes &= c[k] >= c[k + 1];
+        return yes;
+    }
+
     void emit(uint32_t x, int k, Child out[N], int& n) const {
         const BvhNode& node = bvh_.nodes[x];
         if (node.is_leaf()) {
-            out[n++] = {x, node.index, node.count};  // its count checked by oversize_leaf()
+            if (node.count > kMaxWideLeafCount)
+                throw std::invalid_argument("wide BVH leaves hold at most " +
+                                            std::to_string(kMaxWideLeafCount) +
+                                            " primitives (BvhBuildParams::max_leaf_size)");
+            out[n++] = {x, node.index, node.count};
         } else if (plan_[x].open[k]) {
             const int j = plan_[x].left_slots[k];
             emit(node.index, j, out, n);
@@ -201,8 +241,7 @@ class CollapsePlan {
     BuildArray<Costs> cost_;  ///< [x][k]: least cost of subtree x in k slots
     BuildArray<Choice> plan_;
     BuildArray<Range> range_;
-    BuildArray<NodeCounts> wide_;
-    std::atomic<bool> oversize_{false};
+    std::array<Top, kTopNodes> top_;
 };
 
 /// Child slot `c` of `p`: the box of binary node `box`, a leaf of `count` slots
@@ -230,35 +269,6 @@ BvhWideNode<N> empty_node() {
     return p;
 }
 
-/// Writes the wide node made for binary inner node x at out.nodes[index] and, depth
-/// first, its subtree after it: each inner child's subtree in the next plan.nodes_below()
-/// + 1 places, so large subtrees are written by tasks at places known in advance (the
-/// same array as a serial depth-first emission).
-template <int N>
-void place(const CollapsePlan<N>& plan, const Bvh& bvh, uint32_t x, uint32_t index, bool tasks,
-           BvhWide<N>& out) {
-    // Subtrees of fewer wide nodes are written by the task that reaches them.
-    constexpr uint32_t kTaskNodes = 128;
-    typename CollapsePlan<N>::Child kids[N];
-    const int n = plan.children(x, kids);
-    BvhWideNode<N> p = empty_node<N>();
-    uint32_t next = index + 1;
-    for (int c = 0; c < n; ++c) {
-        set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
-        if (kids[c].count) continue;
-        const uint32_t kid = kids[c].node, at = next;
-        p.child[c] = BvhWide<N>::offset_of(at);
-        next += plan.nodes_below(kid) + 1;
-        if (tasks && plan.nodes_below(kid) >= kTaskNodes) {
-#pragma omp task default(shared) firstprivate(kid, at)
-            place(plan, bvh, kid, at, tasks, out);
-        } else {
-            place(plan, bvh, kid, at, tasks, out);
-        }
-    }
-    out.nodes[index] = p;
-}
-
 }  // namespace
 
 template <int N>
@@ -276,32 +286,32 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     if (opt.merge_leaves_up_to > kMaxWideLeafCount)
         throw std::invalid_argument("wide BVH leaves hold at most " + std::to_string(kMaxWideLeafCount) +
                                     " primitives (WideCollapse::merge_leaves_up_to)");
-    CollapsePlan<N> plan(bvh, opt);
-    // One parallel region for the programme and the emission: the node count is known
-    // once the programme is solved. Errors are thrown after the region.
-    size_t total = 0;
-    std::exception_ptr error;
-#pragma omp parallel if (plan.parallel())
-#pragma omp single
-    {
-        plan.solve();
-        total = size_t(plan.nodes_below(0)) + 1;
-        if (!plan.oversize_leaf() && total <= BvhWide<N>::kMaxNodes) {
-            try {
-                out.nodes.resize(total);  // not filled: place() writes every node once
-            } catch (...) {
-                error = std::current_exception();
-            }
-            if (!error) place(plan, bvh, 0, 0, plan.parallel(), out);
-        }
+    out.nodes.reserve(bvh.nodes.size() / (N - 1) + 1);
+    // Depth-first: (canonical inner node, wide node that must point at it, child slot).
+    struct Pending {
+        uint32_t node;
+        uint32_t parent;
+        int slot;
+    };
+    const CollapsePlan<N> plan(bvh, opt);
+    std::vector<Pending> stack{{0, kNoNode, 0}};
+    while (!stack.empty()) {
+        const Pending it = stack.back();
+        stack.pop_back();
+        const auto index = uint32_t(out.nodes.size());
+        if (it.parent != kNoNode) out.nodes[it.parent].child[it.slot] = BvhWide<N>::offset_of(index);
+        typename CollapsePlan<N>::Child kids[N];
+        const int n = plan.children(it.node, kids);
+        BvhWideNode<N> p = empty_node<N>();
+        for (int c = 0; c < n; ++c) set_child(p, c, bvh.nodes[kids[c].node], kids[c].first, kids[c].count);
+        out.nodes.push_back(p);
+        for (int c = n - 1; c >= 0; --c)
+            if (!kids[c].count) stack.push_back({kids[c].node, index, c});
     }
-    if (error) std::rethrow_exception(error);
-    if (plan.oversize_leaf())
-        throw std::invalid_argument("wide BVH leaves hold at most " + std::to_string(kMaxWideLeafCount) +
-                                    " primitives (BvhBuildParams::max_leaf_size)");
-    if (total > BvhWide<N>::kMaxNodes)
-        throw InputError("scene too large: its wide BVH has " + std::to_string(total) + " nodes, more than the " +
-                         std::to_string(BvhWide<N>::kMaxNodes) + " that 32-bit node offsets reach");
+    if (out.nodes.size() > BvhWide<N>::kMaxNodes)
+        throw InputError("scene too large: its wide BVH has " + std::to_string(out.nodes.size()) +
+                         " nodes, more than the " + std::to_string(BvhWide<N>::kMaxNodes) +
+                         " that 32-bit node offsets reach");
     return out;
 }
 

@@ -54,7 +54,7 @@ static_assert(sizeof(Bvh8Node) % (kMaxWideLeafCount + 1) == 0,
 template <int N>
 struct BvhWide {
     BvhNode root{};
-    std::vector<BvhWideNode<N>, FillLaterAllocator<BvhWideNode<N>, 64>>
+    std::vector<BvhWideNode<N>, AlignedAllocator<BvhWideNode<N>, 64>>
         nodes;  ///< nodes[0]: the root's children
     bool empty = true;
     /// Any-hit traversal visits the hit children farthest entry first, not in slot order
