@@ -313,28 +313,14 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     constexpr double kFarFirstMaxWork = 0.75;
     constexpr size_t kOcclusionSampleRays = 256;
     const std::vector<Ray> rays = occlusion_sample_rays(blocks_, kOcclusionSampleRays);
-    const auto n = int64_t(rays.size());
-    auto work = [&](int64_t i) {
+    uint64_t work[2] = {0, 0};
+    for (int far = 0; far < 2; ++far) {
+        wide8_.occlusion_far_first = far != 0;
         TraversalCounters c;
-        occluded_counted(rays[size_t(i)], c);
-        return c.nodes_visited + c.prims_tested;
-    };
-    // Both threads trace (the worker would otherwise wait through it); integer sums, so
-    // the choice does not depend on the threads. One region: the order is switched
-    // between the loops, after the first loop's barrier.
-    uint64_t slot_work = 0, far_work = 0;
-#pragma omp parallel if (n >= 64)
-    {
-#pragma omp single
-        wide8_.occlusion_far_first = false;
-#pragma omp for reduction(+ : slot_work) schedule(static)
-        for (int64_t i = 0; i < n; ++i) slot_work += work(i);
-#pragma omp single
-        wide8_.occlusion_far_first = true;
-#pragma omp for reduction(+ : far_work) schedule(static)
-        for (int64_t i = 0; i < n; ++i) far_work += work(i);
+        for (const Ray& r : rays) occluded_counted(r, c);
+        work[far] = c.nodes_visited + c.prims_tested;
     }
-    wide8_.occlusion_far_first = double(far_work) < kFarFirstMaxWork * double(slot_work);
+    wide8_.occlusion_far_first = double(work[1]) < kFarFirstMaxWork * double(work[0]);
 }
 
 /// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
