@@ -16,10 +16,7 @@
 #include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
 
-#include <omp.h>
-
 #include <algorithm>
-#include <exception>
 #include <memory>
 #include <vector>
 
@@ -60,20 +57,14 @@ class BinnedBuild {
         refs_ = BuildArray<PrimRef>(n_);
         nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
-        used_pairs_[0] = 1;  // the root and the padding node
-        new_pair_ = BuildArray<uint32_t>(n_);
         if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
-        std::exception_ptr error;
 #pragma omp parallel
-        {
 #pragma omp single
-            {
-                const Range root = init_refs();
-                build(0, Bvh::kFirstPair, root, 0);
-            }  // its barrier waits for every subtree task
-            compact(error);
+        {
+            const Range root = init_refs();
+            build(0, Bvh::kFirstPair, root, 0);
         }
-        if (error) std::rethrow_exception(error);
+        compact();
     }
 
    private:
@@ -335,74 +326,29 @@ class BinnedBuild {
     }
 
     /// Removes the unused pairs of the node regions, keeping the order (depth-first, left
-    /// before right: the order of a serial build that allocates pairs as it goes). Run by
-    /// every thread of the build's region (the worker would otherwise wait through it):
-    /// the pairs are counted, numbered and copied in fixed chunks, integer sums only.
-    void compact(std::exception_ptr& error) {
-        if (nodes_[0].is_leaf() || n_ <= kParallelScanThreshold || omp_get_num_threads() == 1) {
-#pragma omp single
-            try {
-                compact_serial();
-            } catch (...) {
-                error = std::current_exception();
-            }
-            return;
-        }
-        constexpr uint32_t chunks = kScanChunks;
-        auto first = [&](uint32_t c) { return uint32_t(uint64_t(n_) * c / chunks); };
-#pragma omp for schedule(static)
-        for (uint32_t c = 0; c < chunks; ++c) {
-            uint32_t used = 0;
-            for (uint32_t k = first(c); k < first(c + 1); ++k) used += used_pairs_[k];
-            chunk_pairs_[c] = used;
-        }
-#pragma omp single
-        {
-            uint32_t pairs = 0;
-            for (uint32_t c = 0; c < chunks; ++c) chunk_first_[c] = pairs, pairs += chunk_pairs_[c];
-            try {
-                out_.nodes.resize(2 * size_t(pairs));
-                out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};  // padding
-            } catch (...) {
-                error = std::current_exception();
-            }
-        }
-        if (error) return;  // read after the single's barrier: every thread returns
-#pragma omp for schedule(static)
-        for (uint32_t c = 0; c < chunks; ++c) {
-            uint32_t pairs = chunk_first_[c];
-            for (uint32_t k = first(c); k < first(c + 1); ++k) new_pair_[k] = pairs, pairs += used_pairs_[k];
-        }
-#pragma omp for schedule(static)
-        for (uint32_t c = 0; c < chunks; ++c) copy_pairs(first(c), first(c + 1));
-    }
-
-    /// compact() on one thread, in one pass less.
-    void compact_serial() {
+    /// before right: the order of a serial build that allocates pairs as it goes).
+    void compact() {
         if (nodes_[0].is_leaf()) {
             out_.nodes.assign(1, nodes_[0]);
             return;
         }
+        used_pairs_[0] = 1;
+        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
         uint32_t pairs = 0;
         for (uint32_t k = 0; k < n_; ++k) {
-            new_pair_[k] = pairs;
+            new_pair[k] = pairs;
             pairs += used_pairs_[k];
         }
         out_.nodes.resize(2 * size_t(pairs));
-        copy_pairs(0, n_);
-        out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};  // padding
-    }
-
-    /// The used pairs in [begin, end) to their new places.
-    void copy_pairs(uint32_t begin, uint32_t end) {
-        for (uint32_t k = begin; k < end; ++k) {
+        for (uint32_t k = 0; k < n_; ++k) {
             if (!used_pairs_[k]) continue;
-            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1] is the padding
+            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
                 BvhNode node = nodes_[2 * k + j];
-                if (!node.is_leaf()) node.index = 2 * new_pair_[node.index / 2];
-                out_.nodes[2 * new_pair_[k] + j] = node;
+                if (!node.is_leaf()) node.index = 2 * new_pair[node.index / 2];
+                out_.nodes[2 * new_pair[k] + j] = node;
             }
         }
+        out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
     }
 
     const BvhBuildInput& in_;
@@ -412,8 +358,6 @@ class BinnedBuild {
     BuildArray<PrimRef> refs_, scratch_;
     BuildArray<BvhNode> nodes_;
     std::vector<uint8_t> used_pairs_;
-    BuildArray<uint32_t> new_pair_;  ///< [k]: pair k's place after compaction
-    uint32_t chunk_pairs_[kScanChunks] = {}, chunk_first_[kScanChunks] = {};
 };
 
 }  // namespace
