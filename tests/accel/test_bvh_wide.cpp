@@ -470,9 +470,9 @@ bool depth_first_nodes(const BvhWide<N>& t) {
     return next == t.nodes.size();
 }
 
-TEST_CASE("wide collapse of a large tree: the nodes of a serial depth-first emission for 1 to 3 threads") {
-    // 81920 triangles: enough binary nodes for the programme and the emission to run as
-    // tasks, each subtree written at a place computed in advance.
+TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 threads") {
+    // 81920 triangles: enough binary nodes for the programme to run as tasks, each parent
+    // combined by whichever thread ends its second child.
     const Scene scene = scene_from_mesh(make_icosphere(6));
     for (const WideCollapse collapse : {WideCollapse{0, 1.0}, WideCollapse{8, 1.0}}) {
         AcceleratorOptions opt;
