@@ -496,9 +496,12 @@ TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 
             size_t differ = 0;  // member by member: the nodes' padding is never written
             for (size_t i = 0; i < trees[0].nodes.size(); ++i) {
                 const Bvh8Node &a = trees[0].nodes[i], &b = trees[t].nodes[i];
-                differ += std::memcmp(a.lo_x, b.lo_x, sizeof a.lo_x) || std::memcmp(a.hi_x, b.hi_x, sizeof a.hi_x) ||
-                          std::memcmp(a.lo_y, b.lo_y, sizeof a.lo_y) || std::memcmp(a.hi_y, b.hi_y, sizeof a.hi_y) ||
-                          std::memcmp(a.lo_z, b.lo_z, sizeof a.lo_z) || std::memcmp(a.hi_z, b.hi_z, sizeof a.hi_z) ||
+                differ += std::memcmp(a.lo_x, b.lo_x, sizeof a.lo_x) ||
+                          std::memcmp(a.hi_x, b.hi_x, sizeof a.hi_x) ||
+                          std::memcmp(a.lo_y, b.lo_y, sizeof a.lo_y) ||
+                          std::memcmp(a.hi_y, b.hi_y, sizeof a.hi_y) ||
+                          std::memcmp(a.lo_z, b.lo_z, sizeof a.lo_z) ||
+                          std::memcmp(a.hi_z, b.hi_z, sizeof a.hi_z) ||
                           std::memcmp(a.child, b.child, sizeof a.child);
             }
             CHECK(differ == 0);
