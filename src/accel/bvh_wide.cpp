@@ -35,7 +35,7 @@ class CollapsePlan {
         : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
         // Each node's costs depend only on its children's, so the subtrees below the
         // top levels are independent tasks; the result does not depend on the threads.
-        if (bvh.nodes.size() < kParallelNodes) {
+        if (bvh.nodes.size() < opt.parallel_min_nodes) {
             solve(0);
             return;
         }
@@ -67,9 +67,7 @@ class CollapsePlan {
         std::array<bool, N + 1> open;           ///< [k]: opened into k slots, or kept as one child
         bool leaf;                              ///< kept as one child: a leaf, not a node
     };
-    /// Trees with fewer nodes are solved without a parallel region; tasks are made for
-    /// the subtrees of the first kTaskLevels levels.
-    static constexpr size_t kParallelNodes = 1u << 14;
+    /// Tasks are made for the subtrees below the first kTaskLevels levels.
     static constexpr int kTaskLevels = 6;
     static constexpr uint32_t kTopNodes = 1u << kTaskLevels;  ///< top positions: [1, kTopNodes)
     /// A node of the top levels: its binary node, and how many of its children are solved.

@@ -470,9 +470,10 @@ bool depth_first_nodes(const BvhWide<N>& t) {
     return next == t.nodes.size();
 }
 
-TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 threads") {
+TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 threads and serially") {
     // 81920 triangles: enough binary nodes for the programme to run as tasks, each parent
-    // combined by whichever thread ends its second child.
+    // combined by whichever thread ends its second child; the last tree is solved without
+    // tasks.
     const Scene scene = scene_from_mesh(make_icosphere(6));
     for (const WideCollapse collapse : {WideCollapse{0, 1.0}, WideCollapse{8, 1.0}}) {
         AcceleratorOptions opt;
@@ -487,6 +488,9 @@ TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 
             omp_set_num_threads(threads);
             trees.push_back(make_bvh_wide<8>(bvh, collapse));
         }
+        WideCollapse serial = collapse;
+        serial.parallel_min_nodes = bvh.nodes.size() + 1;
+        trees.push_back(make_bvh_wide<8>(bvh, serial));
         omp_set_num_threads(saved);
         INFO("merge ", collapse.merge_leaves_up_to);
         CHECK(depth_first_nodes(trees[0]));
