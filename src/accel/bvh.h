@@ -140,7 +140,8 @@ class BuildArray {
 struct Bvh {
     /// Index of the first sibling pair (nodes[1] is padding).
     static constexpr uint32_t kFirstPair = 2;
-    std::vector<BvhNode, AlignedAllocator<BvhNode, 64>> nodes;
+    /// Not zero-filled when resized: every builder writes each node it keeps.
+    std::vector<BvhNode, FillLaterAllocator<BvhNode, 64>> nodes;
     std::vector<uint32_t> prim_indices;  ///< leaf slot -> index of the primitive given to the builder
 
     bool empty() const { return nodes.empty(); }

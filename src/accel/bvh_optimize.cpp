@@ -265,7 +265,10 @@ class Collapser {
         Bvh out;
         out.prim_indices.reserve(count_[tree_.root()]);
         out.nodes.resize(1);
-        if (!make_leaf_[tree_.root()]) out.nodes.resize(2);
+        if (!make_leaf_[tree_.root()]) {
+            out.nodes.resize(2);
+            out.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};  // padding (resize does not fill)
+        }
         std::vector<std::pair<uint32_t, uint32_t>> stack{{tree_.root(), 0}};  // (tree node, output node)
         while (!stack.empty()) {
             const auto [n, slot] = stack.back();

@@ -1,6 +1,8 @@
 #include "accel/bvh_wide.h"
 
 #include <array>
+#include <atomic>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -33,13 +35,13 @@ class CollapsePlan {
         : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
         // Each node's costs depend only on its children's, so the subtrees below the
         // top levels are independent tasks; the result does not depend on the threads.
-        if (bvh.nodes.size() < kParallelNodes) {
-            solve(0, kTaskLevels);
+        if (bvh.nodes.size() < opt.parallel_min_nodes) {
+            solve(0);
             return;
         }
 #pragma omp parallel
 #pragma omp single
-        solve(0, 0);
+        spawn(0, 1);
     }
 
     /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).
@@ -65,34 +67,62 @@ class CollapsePlan {
         std::array<bool, N + 1> open;           ///< [k]: opened into k slots, or kept as one child
         bool leaf;                              ///< kept as one child: a leaf, not a node
     };
-    /// Trees with fewer nodes are solved without a parallel region; tasks are made for
-    /// the subtrees of the first kTaskLevels levels.
-    static constexpr size_t kParallelNodes = 1u << 14;
+    /// Tasks are made for the subtrees below the first kTaskLevels levels.
     static constexpr int kTaskLevels = 6;
+    static constexpr uint32_t kTopNodes = 1u << kTaskLevels;  ///< top positions: [1, kTopNodes)
+    /// A node of the top levels: its binary node, and how many of its children are solved.
+    struct Top {
+        uint32_t node = 0;
+        std::atomic<uint32_t> ended{0};
+    };
     struct Range {
         uint32_t first, count;  ///< the subtree's slots; first = kNoNode: not contiguous
     };
-    /// Costs and choices of the subtree of node x (at `level`), children first.
-    void solve(uint32_t x, int level) {
+    /// Costs and choices of the subtree of node x, children first.
+    void solve(uint32_t x) {
         const BvhNode& node = bvh_.nodes[x];
         if (!node.is_leaf()) {
-            if (level < kTaskLevels) {
-#pragma omp task default(shared) firstprivate(level)
-                solve(node.index, level + 1);
-                solve(node.index + 1, level + 1);
-#pragma omp taskwait
-            } else {
-                solve(node.index, level + 1);
-                solve(node.index + 1, level + 1);
-            }
+            solve(node.index);
+            solve(node.index + 1);
         }
         combine(x);
+    }
+
+    /// solve() of node x at position h of the top levels (1: the root, 2h and 2h + 1: its
+    /// children): a task per subtree below them. No task waits for another (libgomp's
+    /// taskwait would idle the thread until that very child ended): the second of two
+    /// siblings to end combines their parent (finish()).
+    void spawn(uint32_t x, uint32_t h) {
+        const BvhNode& node = bvh_.nodes[x];
+        if (h >= kTopNodes || node.is_leaf()) {
+            solve(x);
+            finish(h);
+            return;
+        }
+        top_[h].node = x;
+        top_[h].ended.store(0, std::memory_order_relaxed);
+        const uint32_t left = node.index;
+#pragma omp task default(shared) firstprivate(left, h)
+        spawn(left, 2 * h);
+        spawn(left + 1, 2 * h + 1);
+    }
+
+    /// After the subtree at top position h is solved: its parent is combined by whichever
+    /// of its two children ends second, and so on up.
+    void finish(uint32_t h) {
+        for (; h > 1; h /= 2) {
+            Top& parent = top_[h / 2];
+            if (parent.ended.fetch_add(1, std::memory_order_acq_rel) == 0) return;
+            combine(parent.node);
+        }
     }
 
     /// opened[k]: the least cost of both children sharing k slots of the parent's node, the
     /// left child's share in plan.left_slots[k] (the first best). Branch-free: which share
     /// wins is data-dependent. Two leaves cost the same in any slots, so j = 1 wins.
-    static Costs open_costs(const Costs& left, const Costs& right, bool two_leaves, Choice& plan) {
+    static Costs open_costs(const Costs& left, const Costs& right, bool left_leaf, bool right_leaf,
+                            Choice& plan) {
+        const bool two_leaves = left_leaf && right_leaf;
         constexpr double inf = std::numeric_limits<double>::infinity();
         Costs opened;
         opened.fill(inf);
@@ -100,6 +130,31 @@ class CollapsePlan {
             const double sum = left[1] + right[1];
             if (!(sum < inf)) return opened;
             for (int k = 2; k <= N; ++k) opened[k] = sum, plan.left_slots[k] = 1;
+            return opened;
+        }
+        if (right_leaf) {
+            // right[k - j] is the same for every k: the loop below in one pass over j.
+            double best = inf;
+            int best_j = 0;
+            for (int k = 2; k <= N; ++k) {
+                const double c = left[k - 1] + right[1];
+                const bool lower = c < best;
+                best = lower ? c : best;
+                best_j = lower ? k - 1 : best_j;
+                opened[k] = best;
+                plan.left_slots[k] = uint8_t(best_j);
+            }
+            return opened;
+        }
+        if (left_leaf && non_increasing(right) && std::isfinite(left[1])) {
+            // left[j] is the same for every j and right[k - j] grows with j (rounding is
+            // monotonic), so the loop below would pick j = 1.
+            for (int k = 2; k <= N; ++k) {
+                const double c = left[1] + right[k - 1];
+                const bool finite = c < inf;
+                opened[k] = finite ? c : inf;
+                plan.left_slots[k] = uint8_t(finite ? 1 : 0);
+            }
             return opened;
         }
         for (int k = 2; k <= N; ++k) {
@@ -137,8 +192,8 @@ class CollapsePlan {
         range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
         const Costs& left = cost_[node.index];
         const Costs& right = cost_[node.index + 1];
-        const Costs opened = open_costs(
-            left, right, bvh_.nodes[node.index].is_leaf() && bvh_.nodes[node.index + 1].is_leaf(), plan);
+        const Costs opened = open_costs(left, right, bvh_.nodes[node.index].is_leaf(),
+                                        bvh_.nodes[node.index + 1].is_leaf(), plan);
         // As one child, x is a node of its own (its area plus its children in N
         // slots) or, when small enough, a leaf.
         const double as_node = area + opened[N];
@@ -154,6 +209,13 @@ class CollapsePlan {
     }
 
     static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
+
+    /// c[1] >= c[2] >= ... >= c[N - 1], none NaN.
+    static bool non_increasing(const Costs& c) {
+        bool yes = true;
+        for (int k = 1; k + 1 < N; ++k) yes &= c[k] >= c[k + 1];
+        return yes;
+    }
 
     void emit(uint32_t x, int k, Child out[N], int& n) const {
         const BvhNode& node = bvh_.nodes[x];
@@ -177,6 +239,7 @@ class CollapsePlan {
     BuildArray<Costs> cost_;  ///< [x][k]: least cost of subtree x in k slots
     BuildArray<Choice> plan_;
     BuildArray<Range> range_;
+    std::array<Top, kTopNodes> top_;
 };
 
 /// Child slot `c` of `p`: the box of binary node `box`, a leaf of `count` slots

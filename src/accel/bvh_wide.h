@@ -86,6 +86,9 @@ struct WideCollapse {
     uint32_t merge_leaves_up_to = 0;
     /// Cost of testing one leaf block of four primitives.
     double block_cost = 1.0;
+    /// Binary trees with fewer nodes are solved on one thread (a parallel region costs
+    /// more); the result is the same either way.
+    size_t parallel_min_nodes = size_t(1) << 14;
 };
 
 /// Collapses a canonical binary Bvh (slots unchanged; nodes in depth-first order).

@@ -439,6 +439,25 @@ TEST_CASE("the built tree does not depend on the thread count") {
     CHECK(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhPairNode)) == 0);
 }
 
+/// Whether the pairs are in the order of a serial depth-first build that allocates them as
+/// it goes: walking left before right, the k-th inner node reached has its children in pair
+/// k + 1 (nodes 0 and 1 are the root and the padding node).
+bool depth_first_pairs(const Bvh& bvh) {
+    if (bvh.nodes[0].is_leaf()) return bvh.nodes.size() == 1;
+    uint32_t next = Bvh::kFirstPair;
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+        const BvhNode& n = bvh.nodes[stack.back()];
+        stack.pop_back();
+        if (n.is_leaf()) continue;
+        if (n.index != next) return false;
+        next += 2;
+        stack.push_back(n.index + 1);
+        stack.push_back(n.index);
+    }
+    return next == bvh.nodes.size();
+}
+
 TEST_CASE("binned build: the node array and primitive order are identical for 1, 2 and 3 threads") {
     // 81920 triangles: the top levels are binned and partitioned in parallel chunks, the
     // subtrees below are tasks; 20k slivers: long thin boxes, many equal centroid bins.
@@ -455,6 +474,8 @@ TEST_CASE("binned build: the node array and primitive order are identical for 1,
         INFO(m.name);
         REQUIRE(trees[0].nodes.size() > 1);
         CHECK(validate_bvh(trees[0], triangle_boxes(m)).empty());
+        // The compaction (chunked for the icosphere) keeps the serial build's pair order.
+        CHECK(depth_first_pairs(trees[0]));
         for (size_t t = 1; t < trees.size(); ++t) {
             CHECK(trees[0].prim_indices == trees[t].prim_indices);
             REQUIRE(trees[0].nodes.size() == trees[t].nodes.size());

@@ -1,4 +1,5 @@
 #include <doctest/doctest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -6,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <stdexcept>
@@ -449,6 +451,66 @@ TEST_CASE("wide collapse: least SAH cost, as an exhaustive search finds it") {
             }
     }
     CHECK(merged);
+}
+
+/// Whether the nodes are in the order of a serial depth-first emission: walking the inner
+/// children in slot order, the k-th node reached is nodes[k].
+template <int N>
+bool depth_first_nodes(const BvhWide<N>& t) {
+    size_t next = 0;
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+        const size_t index = BvhWide<N>::index_of(stack.back());
+        stack.pop_back();
+        if (index != next++) return false;
+        const BvhWideNode<N>& n = t.nodes[index];
+        for (int c = N - 1; c >= 0; --c)
+            if (n.has_child(c) && !n.leaf_count(c)) stack.push_back(n.child[c]);
+    }
+    return next == t.nodes.size();
+}
+
+TEST_CASE("wide collapse of a large tree: the same depth-first nodes for 1 to 3 threads and serially") {
+    // 81920 triangles: enough binary nodes for the programme to run as tasks, each parent
+    // combined by whichever thread ends its second child; the last tree is solved without
+    // tasks.
+    const Scene scene = scene_from_mesh(make_icosphere(6));
+    for (const WideCollapse collapse : {WideCollapse{0, 1.0}, WideCollapse{8, 1.0}}) {
+        AcceleratorOptions opt;
+        opt.keep_binary_tree = true;
+        opt.flat_loop_max_prims = 0;
+        const Accelerator acc(scene, opt);
+        const Bvh& bvh = acc.bvh();
+        REQUIRE(bvh.nodes.size() > (size_t(1) << 14));
+        const int saved = omp_get_max_threads();
+        std::vector<Bvh8> trees;
+        for (int threads = 1; threads <= 3; ++threads) {
+            omp_set_num_threads(threads);
+            trees.push_back(make_bvh_wide<8>(bvh, collapse));
+        }
+        WideCollapse serial = collapse;
+        serial.parallel_min_nodes = bvh.nodes.size() + 1;
+        trees.push_back(make_bvh_wide<8>(bvh, serial));
+        omp_set_num_threads(saved);
+        INFO("merge ", collapse.merge_leaves_up_to);
+        CHECK(depth_first_nodes(trees[0]));
+        CHECK(compute_wide_bvh_stats(trees[0], 4).leaves > 0);
+        for (size_t t = 1; t < trees.size(); ++t) {
+            REQUIRE(trees[t].nodes.size() == trees[0].nodes.size());
+            size_t differ = 0;  // member by member: the nodes' padding is never written
+            for (size_t i = 0; i < trees[0].nodes.size(); ++i) {
+                const Bvh8Node &a = trees[0].nodes[i], &b = trees[t].nodes[i];
+                differ += std::memcmp(a.lo_x, b.lo_x, sizeof a.lo_x) ||
+                          std::memcmp(a.hi_x, b.hi_x, sizeof a.hi_x) ||
+                          std::memcmp(a.lo_y, b.lo_y, sizeof a.lo_y) ||
+                          std::memcmp(a.hi_y, b.hi_y, sizeof a.hi_y) ||
+                          std::memcmp(a.lo_z, b.lo_z, sizeof a.lo_z) ||
+                          std::memcmp(a.hi_z, b.hi_z, sizeof a.hi_z) ||
+                          std::memcmp(a.child, b.child, sizeof a.child);
+            }
+            CHECK(differ == 0);
+        }
+    }
 }
 
 TEST_CASE("wide leaf references: the largest leaves, clamped leaf sizes, refused oversize leaves") {
