@@ -32,10 +32,10 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_mesh_quantization",      "KHR_draco_mesh_compression",
     "EXT_meshopt_compression"};
 /// More of them: material models and image formats.
-const std::set<std::string> kSupportedRequiredMaterials = {"KHR_materials_unlit",
-                                                           "KHR_materials_pbrSpecularGlossiness",
-                                                           "KHR_materials_specular", "EXT_texture_webp",
-                                                           "KHR_materials_clearcoat", "KHR_materials_sheen"};
+const std::set<std::string> kSupportedRequiredMaterials = {
+    "KHR_materials_unlit",     "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_specular",  "EXT_texture_webp",
+    "KHR_materials_clearcoat", "KHR_materials_sheen"};
 
 bool supported_required(const std::string& name) {
     return kSupportedRequired.count(name) || kSupportedRequiredMaterials.count(name);

@@ -134,7 +134,9 @@ TEST_CASE("occlusion order: automatic picks farthest first in a room and slot or
     CHECK_FALSE(ground_accel.occlusion_far_first());
 }
 
-TEST_CASE("random rays in a room: closest and any hit agree with brute force in both child orders on every SIMD path") {
+TEST_CASE(
+    "random rays in a room: closest and any hit agree with brute force in both child orders on every SIMD "
+    "path") {
     // Rays from inside and around the room in every direction, every other one with a short
     // tmax: node steps with 0, 1, 2 and more hit children, culled stack entries, and rays
     // that empty the stack (the AVX-512 steps' sentinel) without a hit.
@@ -148,11 +150,13 @@ TEST_CASE("random rays in a room: closest and any hit agree with brute force in 
         // side: over the room's bounds for the inner half of them.
         const Bounds3 b = accel.bounds();
         const Vec3 quarter = b.extent() * 0.25f;
-        std::vector<Ray> rays = make_random_rays({b.lo + quarter, b.hi - quarter}, 6000 / kSanitizerDivisor, 907);
+        std::vector<Ray> rays =
+            make_random_rays({b.lo + quarter, b.hi - quarter}, 6000 / kSanitizerDivisor, 907);
         for (size_t i = 0; i < rays.size(); i += 2) rays[i].tmax = 0.2f + 0.002f * float(i % 1000);
         for (SimdPath path : runnable_simd_paths()) {
             force_simd_path(path);
-            INFO("far first ", int(order == OcclusionOrder::far_first), " path ", std::string(simd_path_name(path)));
+            INFO("far first ", int(order == OcclusionOrder::far_first), " path ",
+                 std::string(simd_path_name(path)));
             int wrong_hit = 0, wrong_occluded = 0, hits = 0, free = 0;
             for (const Ray& r : rays) {
                 Ray a = r, b = r;
