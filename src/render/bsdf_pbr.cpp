@@ -145,6 +145,16 @@ Vec3 mapped_normal(int texture, float scale, const SurfaceInteraction& si,
     return dot(ns, si.ng) > 0 ? ns : si.ns;  // a map must not turn the surface away from the viewer's side
 }
 
+/// One channel of a data texture (read linear), or 1 without one.
+float texture_channel(int texture, int channel, const SurfaceInteraction& si,
+                      const std::vector<TextureDesc>& textures) {
+    if (texture < 0) return 1.0f;
+    float alpha = 1.0f;
+    const Rgb c = sample_texture_rgb(textures[size_t(texture)], texcoord(si, textures, texture),
+                                     channel == 3 ? &alpha : nullptr);
+    return channel == 3 ? alpha : c[channel];
+}
+
 bool has_specular_inputs(const MaterialDesc& m) {
     return m.specular != 1.0f || m.specular_texture >= 0 || m.specular_color != Rgb(1.0f) ||
            m.specular_color_texture >= 0;
@@ -153,13 +163,7 @@ bool has_specular_inputs(const MaterialDesc& m) {
 /// KHR_materials_specular: F0 = min(F0(ior) x colour, 1) x weight, F90 = weight.
 void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures) {
-    float weight = m.specular;
-    if (m.specular_texture >= 0) {
-        float alpha = 1.0f;
-        sample_texture_rgb(textures[size_t(m.specular_texture)], texcoord(si, textures, m.specular_texture),
-                           &alpha);
-        weight *= alpha;
-    }
+    float weight = m.specular * texture_channel(m.specular_texture, 3, si, textures);
     Rgb color = m.specular_color;
     if (m.specular_color_texture >= 0)
         color *= sample_texture_rgb(textures[size_t(m.specular_color_texture)],
@@ -169,16 +173,6 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.f0_color = Rgb(std::min(f0.x, 1.0f), std::min(f0.y, 1.0f), std::min(f0.z, 1.0f)) * weight;
     b.f0 = max_component(b.f0_color);
     b.f90 = weight;
-}
-
-/// One channel of a data texture (read linear), or 1 without one.
-float texture_channel(int texture, int channel, const SurfaceInteraction& si,
-                      const std::vector<TextureDesc>& textures) {
-    if (texture < 0) return 1.0f;
-    float alpha = 1.0f;
-    const Rgb c = sample_texture_rgb(textures[size_t(texture)], texcoord(si, textures, texture),
-                                     channel == 3 ? &alpha : nullptr);
-    return channel == 3 ? alpha : c[channel];
 }
 
 /// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.

@@ -44,13 +44,6 @@ double cosine_average(const std::vector<double>& f) {
     return 2 * sum;
 }
 
-/// Linear interpolation position of x in [0, 1] over n equally spaced samples.
-void locate(float x, int n, int* i, float* t) {
-    const float f = std::clamp(x, 0.0f, 1.0f) * float(n - 1);
-    *i = std::min(int(f), n - 2);
-    *t = f - float(*i);
-}
-
 }  // namespace
 
 GgxAlbedoTable::GgxAlbedoTable(int strata) {
@@ -77,8 +70,8 @@ const GgxAlbedoTable& GgxAlbedoTable::get() {
 GgxAlbedo GgxAlbedoTable::at(float mu, float roughness) const {
     int i, j;
     float t, s;
-    locate(roughness, kRoughnessSteps, &i, &t);
-    locate(mu, kMuSteps, &j, &s);
+    albedo_table_cell(roughness, kRoughnessSteps, &i, &t);
+    albedo_table_cell(mu, kMuSteps, &j, &s);
     auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
     auto lerp2 = [&](float GgxAlbedo::*f) {
         const float row0 = (1 - s) * entry(i, j).*f + s * entry(i, j + 1).*f;
@@ -91,7 +84,7 @@ GgxAlbedo GgxAlbedoTable::at(float mu, float roughness) const {
 GgxAlbedo GgxAlbedoTable::average(float roughness) const {
     int i;
     float t;
-    locate(roughness, kRoughnessSteps, &i, &t);
+    albedo_table_cell(roughness, kRoughnessSteps, &i, &t);
     const GgxAlbedo a = avg_[size_t(i)], b = avg_[size_t(i) + 1];
     return {(1 - t) * a.e + t * b.e, (1 - t) * a.e_schlick + t * b.e_schlick};
 }

@@ -3,9 +3,18 @@
 /// energy compensation of Kulla and Conty ("Revisiting Physically Based
 /// Shading at Imageworks", SIGGRAPH 2017 course). Tabulated once per process
 /// by numerical integration (nothing copied), then looked up bilinearly.
+#include <algorithm>
 #include <vector>
 
 namespace sahara {
+
+/// Cell i and linear weight t of x in [0, 1] over n equally spaced table samples
+/// (the albedo tables' lookup: GGX here, sheen in render/sheen.cpp).
+inline void albedo_table_cell(float x, int n, int* i, float* t) {
+    const float f = std::clamp(x, 0.0f, 1.0f) * float(n - 1);
+    *i = std::min(int(f), n - 2);
+    *t = f - float(*i);
+}
 
 /// GGX alpha never goes below this in the glTF material: alpha = roughness^2 = 0
 /// would be a delta lobe, and 1e-3 already reflects like a mirror.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "math/sampling.h"
+#include "render/ggx_albedo.h"
 
 namespace sahara {
 
@@ -18,12 +19,6 @@ float sheen_l(float x, float alpha) {
     const float a = mix(25.3245f, 21.5473f), b = mix(3.32435f, 3.82987f), c = mix(0.16801f, 0.19823f);
     const float d = mix(-1.27393f, -1.97760f), e = mix(-4.85967f, -4.32054f);
     return a / (1.0f + b * std::pow(x, c)) + d * x + e;
-}
-
-void locate(float x, int n, int* i, float* t) {
-    const float f = std::clamp(x, 0.0f, 1.0f) * float(n - 1);
-    *i = std::min(int(f), n - 2);
-    *t = f - float(*i);
 }
 
 /// E(mu) = integral of sheen_lobe over the hemisphere, on a midpoint grid in
@@ -92,8 +87,8 @@ const SheenAlbedoTable& SheenAlbedoTable::get() {
 float SheenAlbedoTable::at(float mu, float roughness) const {
     int i, j;
     float t, s;
-    locate(roughness, kRoughnessSteps, &i, &t);
-    locate(std::sqrt(std::max(mu, 0.0f)), kMuSteps, &j, &s);
+    albedo_table_cell(roughness, kRoughnessSteps, &i, &t);
+    albedo_table_cell(std::sqrt(std::max(mu, 0.0f)), kMuSteps, &j, &s);
     auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
     const float row0 = (1 - s) * entry(i, j) + s * entry(i, j + 1);
     const float row1 = (1 - s) * entry(i + 1, j) + s * entry(i + 1, j + 1);
