@@ -5,7 +5,10 @@
 /// (the triangle clipped to the child's side). Spatial splits are tried only where the
 /// object split's children overlap by a noticeable share of the scene's area (alpha),
 /// and only while the total reference count stays within params.sbvh_reference_budget
-/// times the primitive count. A crossing reference goes whole to one side instead when
+/// times the primitive count: the root gets the budget's extra references, and each split
+/// passes what it leaves unused to its children in proportion to their reference counts
+/// (a shared counter would give the extra references to whichever task asked first, and
+/// the tree would depend on thread timing). A crossing reference goes whole to one side instead when
 /// that is cheaper by the SAH ("reference unsplitting").
 ///
 /// The result is an ordinary Bvh whose prim_indices may name a primitive more than
@@ -13,6 +16,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "accel/bvh_sbvh.h"
@@ -95,6 +99,39 @@ Bounds3 clip_triangle_to_slab(const Vec3 v[3], int axis, float lo, float hi) {
 
 namespace {
 
+/// Rewrites `bvh` with its pairs in depth-first order (left subtree first, as a serial
+/// build allocates them) and its slots in the order of the leaves, so that every
+/// subtree's slots are contiguous. The parallel build hands out pairs and slots in the
+/// order tasks happen to finish, and the wide collapse merges only leaves whose slots
+/// are contiguous: without this, the tree at two threads depended on timing.
+void renumber_depth_first(Bvh& bvh) {
+    if (bvh.nodes.size() <= 1) return;  // a leaf root's slots are one range already
+    decltype(bvh.nodes) nodes(bvh.nodes.size());
+    std::vector<uint32_t> slots;
+    slots.reserve(bvh.prim_indices.size());
+    nodes[1] = bvh.nodes[1];  // padding
+    uint32_t next_pair = Bvh::kFirstPair;
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 0}};  // (old node, its new place)
+    while (!stack.empty()) {
+        const auto [old_id, new_id] = stack.back();
+        stack.pop_back();
+        BvhNode node = bvh.nodes[old_id];
+        if (node.is_leaf()) {
+            const auto first = bvh.prim_indices.begin() + std::ptrdiff_t(node.index);
+            node.index = uint32_t(slots.size());
+            slots.insert(slots.end(), first, first + std::ptrdiff_t(node.count));
+        } else {
+            stack.push_back({node.index + 1, next_pair + 1});
+            stack.push_back({node.index, next_pair});
+            node.index = next_pair;
+            next_pair += 2;
+        }
+        nodes[new_id] = node;
+    }
+    bvh.nodes = std::move(nodes);
+    bvh.prim_indices = std::move(slots);
+}
+
 class SbvhBuild {
    public:
     SbvhBuild(const BvhBuildInput& input, const BvhBuildParams& params, Bvh& out)
@@ -112,16 +149,16 @@ class SbvhBuild {
         root_area_ = root.surface_area();
         budget_ =
             std::max<size_t>(n, size_t(double(n) * double(std::max(params_.sbvh_reference_budget, 1.0f))));
-        ref_count_ = n;
         out_.prim_indices.resize(budget_);
         out_.nodes.resize(2 * budget_);
         node_count_ = Bvh::kFirstPair;
 #pragma omp parallel
 #pragma omp single
-        build_node(0, std::move(refs), 0);
+        build_node(0, std::move(refs), 0, budget_ - n);
         out_.nodes.resize(out_.nodes[0].is_leaf() ? 1 : node_count_.load());
         if (out_.nodes.size() > 1) out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
         out_.prim_indices.resize(slot_count_.load());
+        renumber_depth_first(out_);
     }
 
    private:
@@ -255,7 +292,8 @@ class SbvhBuild {
         node.count = n;
     }
 
-    void build_node(uint32_t node_id, std::vector<Ref> refs, int depth) {
+    /// Builds the subtree of `refs` at node_id; it may add up to `extra` references.
+    void build_node(uint32_t node_id, std::vector<Ref> refs, int depth, size_t extra) {
         Bounds3 box, cents;
         for (const Ref& r : refs) {
             box.extend(r.box);
@@ -264,29 +302,33 @@ class SbvhBuild {
         BvhNode& node = out_.nodes[node_id];
         node.set_box(box);
         std::vector<Ref> left, right;
-        if (!split(refs, box, cents, depth, left, right)) {
+        const size_t n = refs.size();
+        if (!split(refs, box, cents, depth, extra, left, right)) {
             make_leaf(node, refs);
             return;
         }
         refs = std::vector<Ref>();  // the parent's references are no longer needed
+        const size_t unused = extra - (left.size() + right.size() - n);
+        const size_t left_extra =
+            size_t(double(unused) * double(left.size()) / double(left.size() + right.size()));
         const uint32_t first_child = node_count_.fetch_add(2);
         node.index = first_child;
         node.count = 0;
         if (left.size() + right.size() > params_.parallel_threshold) {
             auto* mine = new std::vector<Ref>(std::move(left));
-#pragma omp task default(shared) firstprivate(first_child, mine, depth)
+#pragma omp task default(shared) firstprivate(first_child, mine, depth, left_extra)
             {
-                build_node(first_child, std::move(*mine), depth + 1);
+                build_node(first_child, std::move(*mine), depth + 1, left_extra);
                 delete mine;
             }
         } else {
-            build_node(first_child, std::move(left), depth + 1);
+            build_node(first_child, std::move(left), depth + 1, left_extra);
         }
-        build_node(first_child + 1, std::move(right), depth + 1);
+        build_node(first_child + 1, std::move(right), depth + 1, unused - left_extra);
     }
 
     /// Chooses leaf (false) or a split of `refs` into `left` and `right` (true).
-    bool split(std::vector<Ref>& refs, const Bounds3& box, const Bounds3& cents, int depth,
+    bool split(std::vector<Ref>& refs, const Bounds3& box, const Bounds3& cents, int depth, size_t extra,
                std::vector<Ref>& left, std::vector<Ref>& right) {
         const auto n = uint32_t(refs.size());
         if (n <= 1) return false;
@@ -303,7 +345,7 @@ class SbvhBuild {
         if (may_be_leaf &&
             params_.intersection_cost * blocked(n) * area <= params_.traversal_cost * area + best)
             return false;
-        if (spatial.cost < object.cost && spatial_partition(refs, spatial, left, right)) return true;
+        if (spatial.cost < object.cost && spatial_partition(refs, spatial, extra, left, right)) return true;
         if (object.axis >= 0) {
             object_partition(refs, object, cents, left, right);
             return true;
@@ -334,32 +376,27 @@ class SbvhBuild {
         return true;
     }
 
-    bool spatial_partition(const std::vector<Ref>& refs, const SpatialSplit& s, std::vector<Ref>& left,
-                           std::vector<Ref>& right);
+    bool spatial_partition(const std::vector<Ref>& refs, const SpatialSplit& s, size_t extra,
+                           std::vector<Ref>& left, std::vector<Ref>& right);
 
     const BvhBuildInput& in_;
     BvhBuildParams params_;
     Bvh& out_;
     float root_area_ = 0.0f;
     size_t budget_ = 0;
-    std::atomic<size_t> ref_count_{0};
     std::atomic<uint32_t> node_count_{0};
     std::atomic<uint32_t> slot_count_{0};
 };
 
 /// Splits `refs` at the plane: references on one side go there, crossing ones go whole
 /// to one side where the SAH prefers that (unsplitting), otherwise both sides get their
-/// clipped part. The duplicates are reserved from the budget first; false (nothing
-/// changed) when the budget has no room or a side would be empty.
-bool SbvhBuild::spatial_partition(const std::vector<Ref>& refs, const SpatialSplit& s, std::vector<Ref>& left,
-                                  std::vector<Ref>& right) {
+/// clipped part. False (nothing changed) when the duplicates the split wants exceed the
+/// subtree's `extra` references or a side would be empty.
+bool SbvhBuild::spatial_partition(const std::vector<Ref>& refs, const SpatialSplit& s, size_t extra,
+                                  std::vector<Ref>& left, std::vector<Ref>& right) {
     const size_t n = refs.size();
     const size_t wanted = s.n_left + s.n_right > n ? s.n_left + s.n_right - n : 0;
-    const size_t before = ref_count_.fetch_add(wanted);
-    if (before + wanted > budget_) {
-        ref_count_.fetch_sub(wanted);
-        return false;
-    }
+    if (wanted > extra) return false;
     size_t duplicates = 0;
     const float a_left = s.left.surface_area(), a_right = s.right.surface_area();
     const float n_left = blocked(s.n_left), n_right = blocked(s.n_right);
@@ -390,9 +427,7 @@ bool SbvhBuild::spatial_partition(const std::vector<Ref>& refs, const SpatialSpl
             right.push_back(r);
         }
     }
-    ref_count_.fetch_sub(wanted - duplicates);
     if (!left.empty() && !right.empty()) return true;
-    ref_count_.fetch_sub(duplicates);
     left.clear();
     right.clear();
     return false;

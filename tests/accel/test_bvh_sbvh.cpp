@@ -5,9 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <omp.h>
 
 #include "accel/bvh_sbvh.h"
 #include "mesh_fixtures.h"
@@ -184,6 +188,46 @@ TEST_CASE("sbvh trees agree with brute force on nearest hits and occlusion") {
             INFO(m.name, " ", bvh_layout_name(layout));
             CHECK(disagreements(acc, rays) == 0);
         }
+    }
+}
+
+TEST_CASE("sbvh builds the same tree at 1 to 3 threads with contiguous slots under every node") {
+    // Small task threshold and a tight budget: subtrees finish in a different order at
+    // every run, and the extra references run out on the way down.
+    const TriangleMesh room = make_room(4, 600);
+    const TriangleInput in = boxes_of(room);
+    BvhBuildParams params;
+    params.parallel_threshold = 32;
+    params.sbvh_reference_budget = 1.1f;
+    const int saved = omp_get_max_threads();
+    std::vector<Bvh> trees;
+    for (int run = 0; run < 6; ++run) {
+        omp_set_num_threads(1 + run % 3);
+        trees.push_back(
+            build_bvh({in.boxes, in.centers, room.positions, room.indices}, BvhBuilder::sbvh, params));
+    }
+    omp_set_num_threads(saved);
+    const Bvh& first = trees[0];
+    REQUIRE(first.prim_indices.size() > room.triangle_count());
+    CHECK(check_split_tree(first, room, 1.1f) == "");
+    // Each subtree's slots are one range: the wide collapse merges only such leaves.
+    std::vector<std::pair<uint32_t, uint32_t>> range(first.nodes.size());  // first slot, count
+    const auto slots_of = [&](auto&& self, uint32_t id) -> std::pair<uint32_t, uint32_t> {
+        const BvhNode& node = first.nodes[id];
+        if (node.is_leaf()) return {node.index, node.count};
+        const auto l = self(self, node.index), r = self(self, node.index + 1);
+        if (l.first == ~0u || r.first != l.first + l.second) return {~0u, 0};
+        return {l.first, l.second + r.second};
+    };
+    CHECK(slots_of(slots_of, 0) == std::pair<uint32_t, uint32_t>{0, uint32_t(first.prim_indices.size())});
+    for (size_t t = 1; t < trees.size(); ++t) {
+        INFO("run ", t);
+        CHECK(trees[t].prim_indices == first.prim_indices);
+        REQUIRE(trees[t].nodes.size() == first.nodes.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < first.nodes.size(); ++i)
+            differ += std::memcmp(&trees[t].nodes[i], &first.nodes[i], sizeof(BvhNode)) != 0;
+        CHECK(differ == 0);
     }
 }
 
