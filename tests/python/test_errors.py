@@ -33,6 +33,7 @@ def test_a_dict_gets_the_same_message_as_a_file(workshop, tmp_path):
     (lambda d: d.pop("camera"), "camera"),
     (lambda d: d.update(colour=1), "colour"),
     (lambda d: d["materials"]["red"].update(type="plastic"), r"materials\.red\.type"),
+    (lambda d: d["materials"]["red"].update(type="unlit"), r"materials\.red\.albedo: unknown key .*color"),
     (lambda d: d["objects"][0].update(center=[0, 1]), r"objects\[0\]\.center"),
     (lambda d: d["objects"][0].update(center=[0, float("nan"), 0]), r"objects\[0\]\.center"),
     (lambda d: d["objects"][0].update(material="missing"), r"objects\[0\]\.material"),
