@@ -37,6 +37,10 @@ constexpr float kUniformHemispherePdf = 0.5f * kInvPi;
 
 }  // namespace
 
+float coat_fresnel(float clearcoat, float cos_coat) {
+    return clearcoat * fresnel_schlick(Rgb(kCoatF0), cos_coat).x;
+}
+
 LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
     const BsdfLayers& l = b.layers;
     LayerWeights w;
@@ -44,7 +48,7 @@ LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
     if (l.clearcoat > 0) {
         const Vec3 wo_c = CoatFrame(l).to_coat(wo);
         if (wo_c.z > 0) {
-            w.coat_fresnel = l.clearcoat * fresnel_schlick(Rgb(kCoatF0), wo_c.z).x;
+            w.coat_fresnel = coat_fresnel(l.clearcoat, wo_c.z);
             coat_albedo = w.coat_fresnel * GgxAlbedoTable::get().at(wo_c.z, l.coat_roughness).e;
         }
     }

@@ -95,7 +95,7 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     if (m.type == MaterialType::emissive)
         return si.front_face ? eval_color(m.radiance, scene.textures, si.p, si.uv) : Rgb(0.0f);
     Rgb radiance = m.type == MaterialType::lambertian ? m.emission
-                   : m.type == MaterialType::pbr      ? pbr_emission(m, si, scene.textures)
+                   : m.type == MaterialType::pbr      ? pbr_emission(m, si, scene.textures, -ray.dir)
                                                       : Rgb(0.0f);
     if (depth >= max_depth) return radiance;  // the next ray (shadow or secondary) would exceed max_depth
     const Vec3 wo = -ray.dir;
