@@ -58,9 +58,10 @@ LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
         const float e = SheenAlbedoTable::get().at(wo.z, l.sheen_roughness);
         sheen_albedo = std::min(e, 1.0f);
         w.sheen_scale = through_coat / std::max(e, 1.0f);
+        w.sheen_albedo = through_coat * sheen_albedo;
     }
     w.base_scale = through_coat * (1.0f - max_component(l.sheen) * sheen_albedo);
-    const float coat = coat_albedo, sheen = mean(l.sheen) * sheen_albedo * through_coat;
+    const float coat = coat_albedo, sheen = mean(l.sheen) * w.sheen_albedo;
     const float base = w.base_scale * pbr_lobe_weights(b, wo).total;
     const float sum = coat + sheen + base;
     if (!(sum > 0)) return w;

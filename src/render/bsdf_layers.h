@@ -31,6 +31,7 @@ struct LayerWeights {
     float sheen_scale =
         0;  ///< what multiplies the sheen colour x sheen lobe: (1 - c E_coat) / max(1, E_sheen)
     float coat_fresnel = 0;  ///< c F(mu_o) at the coat normal
+    float sheen_albedo = 0;  ///< what the sheen lobe of colour 1 reflects in all, under the coat
 };
 
 LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo);
