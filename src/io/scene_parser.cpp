@@ -233,9 +233,12 @@ std::filesystem::path ParseContext::resolve_existing(const JsonValue& where) con
     if (name.empty()) where.fail_expected("a file name");
     std::filesystem::path path = base / name;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        where.fail("file not found: " + path.string() + " (paths are relative to the scene file)");
-    return path;
+    if (std::filesystem::is_regular_file(path, ec)) return path;
+    if (std::filesystem::path(name).is_absolute()) where.fail("file not found: " + name);
+    // Named outright: a dict from Python has no file, and its paths resolve against the cwd.
+    const std::filesystem::path dir = base.empty() ? std::filesystem::current_path(ec)
+                                                   : std::filesystem::absolute(base, ec).lexically_normal();
+    where.fail("file not found: " + path.string() + " (relative paths resolve against " + dir.string() + ")");
 }
 
 int ParseContext::texture(const JsonValue& where, bool srgb) {

@@ -1,5 +1,8 @@
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <string>
 
 #include "scene_parser_test_util.h"
@@ -180,6 +183,18 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
         CAPTURE(c.json);
         check_contains(error_of(c.json), c.fragments);
     }
+}
+
+TEST_CASE("scene parser: a missing file names the directory relative paths resolve against") {
+    const fs::path scratch = fs::temp_directory_path() / ("sahara_parser_test_" + std::to_string(::getpid()));
+    check_contains(error_of(with_objects(R"([{"type": "mesh", "file": "meshes/none.obj"}])")),
+                   {"objects[0].file: file not found: ",
+                    "meshes/none.obj (relative paths resolve against " + scratch.string() + ")"});
+    const std::string absolute =
+        error_of(with_objects(R"([{"type": "mesh", "file": "/nonexistent/none.obj"}])"));
+    const std::string expected = "objects[0].file: file not found: /nonexistent/none.obj";
+    REQUIRE(absolute.size() >= expected.size());
+    CHECK(absolute.substr(absolute.size() - expected.size()) == expected);  // no hint about relative paths
 }
 
 TEST_CASE("scene parser: broken JSON reports line and column") {
