@@ -54,8 +54,8 @@ struct ColorSource {
     Vec3 checker_offset{0, 0, 0};
 };
 
-/// unlit: glTF KHR_materials_unlit, the albedo shown as it is to camera rays,
-/// invisible to every other ray (render/integrator.cpp).
+/// unlit: glTF KHR_materials_unlit or the scene file's "unlit", the albedo shown
+/// as it is to camera rays, invisible to every other ray (render/integrator.cpp).
 enum class MaterialType : uint8_t { lambertian, metal, dielectric, emissive, pbr, unlit };
 
 /// pbr only: the layers KHR_materials_clearcoat and KHR_materials_sheen put over

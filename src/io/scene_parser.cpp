@@ -156,17 +156,23 @@ ColorSource parse_color_source(const JsonValue& v, ParseContext& ctx) {
     return c;
 }
 
+/// "alpha" and "alpha_cutoff" of the lambertian and unlit materials.
+void parse_cutout(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
+    if (auto v = o.get("alpha")) parse_alpha(*v, ctx, m);
+    if (auto v = o.get("alpha_cutoff")) m.alpha_cutoff = v->number_f(NumberRange::closed(0, 1));
+}
+
 MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext& ctx) {
     MaterialDesc m;
     m.name = name;
-    m.type =
-        MaterialType(o.require("type", "\"lambertian\", \"metal\", \"dielectric\", \"emissive\" or \"pbr\"")
-                         .one_of({"lambertian", "metal", "dielectric", "emissive", "pbr"}));
+    // The names in MaterialType's order.
+    m.type = MaterialType(
+        o.require("type", "\"lambertian\", \"metal\", \"dielectric\", \"emissive\", \"pbr\" or \"unlit\"")
+            .one_of({"lambertian", "metal", "dielectric", "emissive", "pbr", "unlit"}));
     switch (m.type) {
         case MaterialType::lambertian:
             if (auto v = o.get("albedo")) m.albedo = parse_color_source(*v, ctx);
-            if (auto v = o.get("alpha")) parse_alpha(*v, ctx, m);
-            if (auto v = o.get("alpha_cutoff")) m.alpha_cutoff = v->number_f(NumberRange::closed(0, 1));
+            parse_cutout(o, ctx, m);
             break;
         case MaterialType::metal:
             if (auto v = o.get("albedo")) m.albedo = parse_color_source(*v, ctx);
@@ -184,7 +190,10 @@ MaterialDesc parse_material(const std::string& name, JsonObject o, ParseContext&
         case MaterialType::pbr:
             parse_pbr_material(o, ctx, m);
             break;
-        case MaterialType::unlit:  // glTF files only (KHR_materials_unlit): not among the names above
+        case MaterialType::unlit:
+            m.albedo.color = Rgb(1.0f);  // glTF's default base colour, as for KHR_materials_unlit
+            if (auto v = o.get("color")) m.albedo = parse_color_source(*v, ctx);
+            parse_cutout(o, ctx, m);
             break;
     }
     o.finish();
@@ -224,9 +233,12 @@ std::filesystem::path ParseContext::resolve_existing(const JsonValue& where) con
     if (name.empty()) where.fail_expected("a file name");
     std::filesystem::path path = base / name;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        where.fail("file not found: " + path.string() + " (paths are relative to the scene file)");
-    return path;
+    if (std::filesystem::is_regular_file(path, ec)) return path;
+    if (std::filesystem::path(name).is_absolute()) where.fail("file not found: " + name);
+    // Named outright: a dict from Python has no file, and its paths resolve against the cwd.
+    const std::filesystem::path dir = base.empty() ? std::filesystem::current_path(ec)
+                                                   : std::filesystem::absolute(base, ec).lexically_normal();
+    where.fail("file not found: " + path.string() + " (relative paths resolve against " + dir.string() + ")");
 }
 
 int ParseContext::texture(const JsonValue& where, bool srgb) {

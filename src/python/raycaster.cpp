@@ -215,7 +215,7 @@ void bind_raycaster(py::module_& m) {
     py::class_<CastMesh>(m, "RayCaster", R"doc(
 Rays cast into one triangle mesh through sahara's watertight 8-wide BVH.
 
-RayCaster(vertices, triangles, threads=None): vertices an (N, 3) float32 or float64 array,
+RayCaster(vertices, triangles, *, threads=None): vertices an (N, 3) float32 or float64 array,
 triangles an (M, 3) integer array of vertex indices (counter-clockwise is the
 front). The BVH is built once, in float32; the caster keeps a float32/uint32
 copy of the mesh for normals and for the `vertices`/`triangles` views.
@@ -229,7 +229,9 @@ KeyboardInterrupt on Ctrl-C. Large incoherent batches are traced in a sorted
 order whose buffers (72 bytes per ray) the caster keeps for its next batch, up to
 128 MB.)doc")
         .def(py::init(&mesh_from_arrays), py::arg("vertices"), py::arg("triangles"), py::kw_only(),
-             py::arg("threads") = py::none())
+             py::arg("threads") = py::none(),
+             "Builds the BVH over vertices (N, 3) and triangles (M, 3) once; threads (keyword only) is "
+             "the default thread count of the queries.")
         .def_static("from_file", &mesh_from_file, py::arg("path"), py::kw_only(),
                     py::arg("threads") = py::none(),
                     "A caster over every mesh of an OBJ or glTF file, merged; triangle ids count in the "

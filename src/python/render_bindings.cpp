@@ -314,12 +314,20 @@ py::object bvh_stats(const PyScene& ps, const py::object& builder, const py::obj
 
 }  // namespace
 
-void bind_errors(py::module_& m) { py::register_exception<InputError>(m, "InputError", PyExc_ValueError); }
+void bind_errors(py::module_& m) {
+    py::register_exception<InputError>(m, "InputError", PyExc_ValueError).attr("__doc__") =
+        "Bad scene input (a ValueError): the command line's message, naming the file (<dict> for a "
+        "dict), the key path and what was expected, e.g. '<dict>: objects[2].radius: expected a number "
+        "> 0, got -1'. Missing or unreadable files and unsupported image extensions raise it too.";
+}
 
 void bind_render(py::module_& m) {
     py::class_<PyScene>(m, "Scene",
                         "A scene loaded and built once (path, dict or None), rendered many times.")
-        .def(py::init<const py::object&>(), py::arg("scene") = py::none())
+        .def(py::init<const py::object&>(), py::arg("scene") = py::none(),
+             "Loads and builds the scene once: a scene file (.json), a model (.obj, .gltf, .glb, framed "
+             "as `sahara view` frames it), a dict in the scene format, or None for the built-in default "
+             "scene. Raises InputError for bad scene input.")
         .def(
             "_render",
             [](PyScene& ps, const py::object& spp, const py::object& width, const py::object& height,
@@ -332,23 +340,37 @@ void bind_render(py::module_& m) {
             py::arg("height") = py::none(), py::arg("seed") = py::none(), py::arg("max_depth") = py::none(),
             py::arg("threads") = py::none(), py::arg("integrator") = py::none(), py::arg("time") = py::none(),
             py::arg("progress") = false)
-        .def("info", [](const PyScene& ps) { return python_from_json(ps.info()); })
+        .def(
+            "info", [](const PyScene& ps) { return python_from_json(ps.info()); },
+            "What `sahara info --json` reports as a dict: Scene, Objects, Materials (counts by type and "
+            "one entry per material), Textures, Lights, Bounds, Memory, Features, and Time (Load and "
+            "Build seconds).")
         .def("bvh_stats", &bvh_stats, py::kw_only(), py::arg("builder") = py::none(),
              py::arg("layout") = py::none(), py::arg("width") = py::none(), py::arg("height") = py::none(),
-             py::arg("threads") = py::none())
-        .def_property_readonly("source", [](const PyScene& ps) { return ps.scene().source; })
-        .def_property_readonly("settings", [](const PyScene& ps) {
-            const RenderSettings& r = ps.settings();
-            py::dict d;
-            d["width"] = r.width;
-            d["height"] = r.height;
-            d["spp"] = r.spp;
-            d["max_depth"] = r.max_depth;
-            d["seed"] = r.seed;
-            d["exposure"] = r.exposure;
-            d["tonemap"] = std::string(tonemap_name(r.tonemap));
-            return d;
-        });
+             py::arg("threads") = py::none(),
+             "The BVH report of `sahara bvh FILE --json` as a dict (nodes, leaves, SAH cost, bytes, "
+             "build time, the mean work of primary, diffuse and shadow rays). builder: 'auto', "
+             "'binned', 'sweep', 'reinsert' or 'sbvh'; layout: 'wide8' or 'pairs'; the primary rays are "
+             "a width x height grid (default 1024 x 1024) through the scene's camera.")
+        .def_property_readonly(
+            "source", [](const PyScene& ps) { return ps.scene().source; },
+            "The scene's file name ('<dict>' for a dict, '<default>' for the built-in scene).")
+        .def_property_readonly(
+            "settings",
+            [](const PyScene& ps) {
+                const RenderSettings& r = ps.settings();
+                py::dict d;
+                d["width"] = r.width;
+                d["height"] = r.height;
+                d["spp"] = r.spp;
+                d["max_depth"] = r.max_depth;
+                d["seed"] = r.seed;
+                d["exposure"] = r.exposure;
+                d["tonemap"] = std::string(tonemap_name(r.tonemap));
+                return d;
+            },
+            "The scene's own render settings as a dict: what each render starts from before its "
+            "keywords.");
     m.def("_read_image", &read_array, py::arg("path"));
     m.def("_write_image", &write_array, py::arg("path"), py::arg("array"), py::kw_only(),
           py::arg("exposure") = 0.0f, py::arg("tonemap") = "clamp");

@@ -37,6 +37,10 @@ constexpr float kUniformHemispherePdf = 0.5f * kInvPi;
 
 }  // namespace
 
+float coat_fresnel(float clearcoat, float cos_coat) {
+    return clearcoat * fresnel_schlick(Rgb(kCoatF0), cos_coat).x;
+}
+
 LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
     const BsdfLayers& l = b.layers;
     LayerWeights w;
@@ -44,7 +48,7 @@ LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
     if (l.clearcoat > 0) {
         const Vec3 wo_c = CoatFrame(l).to_coat(wo);
         if (wo_c.z > 0) {
-            w.coat_fresnel = l.clearcoat * fresnel_schlick(Rgb(kCoatF0), wo_c.z).x;
+            w.coat_fresnel = coat_fresnel(l.clearcoat, wo_c.z);
             coat_albedo = w.coat_fresnel * GgxAlbedoTable::get().at(wo_c.z, l.coat_roughness).e;
         }
     }
@@ -54,9 +58,10 @@ LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo) {
         const float e = SheenAlbedoTable::get().at(wo.z, l.sheen_roughness);
         sheen_albedo = std::min(e, 1.0f);
         w.sheen_scale = through_coat / std::max(e, 1.0f);
+        w.sheen_albedo = through_coat * sheen_albedo;
     }
     w.base_scale = through_coat * (1.0f - max_component(l.sheen) * sheen_albedo);
-    const float coat = coat_albedo, sheen = mean(l.sheen) * sheen_albedo * through_coat;
+    const float coat = coat_albedo, sheen = mean(l.sheen) * w.sheen_albedo;
     const float base = w.base_scale * pbr_lobe_weights(b, wo).total;
     const float sum = coat + sheen + base;
     if (!(sum > 0)) return w;

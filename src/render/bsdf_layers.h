@@ -31,9 +31,15 @@ struct LayerWeights {
     float sheen_scale =
         0;  ///< what multiplies the sheen colour x sheen lobe: (1 - c E_coat) / max(1, E_sheen)
     float coat_fresnel = 0;  ///< c F(mu_o) at the coat normal
+    float sheen_albedo = 0;  ///< what the sheen lobe of colour 1 reflects in all, under the coat
 };
 
 LayerWeights pbr_layer_weights(const Bsdf& b, const Vec3& wo);
+
+/// clearcoat x F(cos_coat): the part of the light the coat reflects at cos_coat to
+/// its normal (Schlick, ior 1.5), which is also the part of the base's emission it
+/// keeps from leaving that way.
+float coat_fresnel(float clearcoat, float cos_coat);
 
 /// eval_pbr of a material with b.layers.on: f cos and the mixture's density.
 Rgb eval_pbr_layered(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);

@@ -175,13 +175,27 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.f90 = weight;
 }
 
+/// The coat's weight at si: clearcoat x its texture's R.
+float coat_weight(const PbrLayersDesc& d, const SurfaceInteraction& si,
+                  const std::vector<TextureDesc>& textures) {
+    return std::clamp(d.clearcoat * texture_channel(d.clearcoat_texture, 0, si, textures), 0.0f, 1.0f);
+}
+
+/// The coat's normal at si (world). Without its own normal map the coat follows
+/// the interpolated normal, not the base's normal map (as the extension says): a
+/// smooth lacquer over bumps.
+Vec3 coat_normal(const PbrLayersDesc& d, const SurfaceInteraction& si,
+                 const std::vector<TextureDesc>& textures) {
+    return d.clearcoat_normal_texture >= 0
+               ? mapped_normal(d.clearcoat_normal_texture, d.clearcoat_normal_scale, si, textures)
+               : si.ns;
+}
+
 /// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.
-/// Without its own normal map the coat follows the interpolated normal, not
-/// the base's normal map (as the extension says): a smooth lacquer over bumps.
 void set_pbr_layers(Bsdf& b, const PbrLayersDesc& d, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures) {
     BsdfLayers& l = b.layers;
-    l.clearcoat = std::clamp(d.clearcoat * texture_channel(d.clearcoat_texture, 0, si, textures), 0.0f, 1.0f);
+    l.clearcoat = coat_weight(d, si, textures);
     l.coat_roughness = std::clamp(
         d.clearcoat_roughness * texture_channel(d.clearcoat_roughness_texture, 1, si, textures), 0.0f, 1.0f);
     l.coat_alpha = pbr_alpha(l.coat_roughness);
@@ -194,12 +208,8 @@ void set_pbr_layers(Bsdf& b, const PbrLayersDesc& d, const SurfaceInteraction& s
     l.sheen_roughness = std::clamp(
         d.sheen_roughness * texture_channel(d.sheen_roughness_texture, 3, si, textures), 0.0f, 1.0f);
     l.sheen_alpha = sheen_alpha(l.sheen_roughness);
-    const bool own_normal = d.clearcoat_normal_texture >= 0;
-    if (l.clearcoat > 0 && (own_normal || !(b.frame.n == si.ns))) {
-        const Vec3 n = own_normal
-                           ? mapped_normal(d.clearcoat_normal_texture, d.clearcoat_normal_scale, si, textures)
-                           : si.ns;
-        l.coat_normal = normalize(b.frame.to_local(n));
+    if (l.clearcoat > 0 && (d.clearcoat_normal_texture >= 0 || !(b.frame.n == si.ns))) {
+        l.coat_normal = normalize(b.frame.to_local(coat_normal(d, si, textures)));
         l.coat_frame = true;
     }
     l.on = l.clearcoat > 0 || max_component(l.sheen) > 0;
@@ -214,8 +224,11 @@ Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
 }
 
 Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
-                 const std::vector<TextureDesc>& textures) {
-    return eval_color(m.radiance, textures, si.p, texcoord(si, textures, m.radiance.texture));
+                 const std::vector<TextureDesc>& textures, const Vec3& wo) {
+    const Rgb le = eval_color(m.radiance, textures, si.p, texcoord(si, textures, m.radiance.texture));
+    if (!(m.layers.clearcoat > 0) || !(max_component(le) > 0)) return le;  // uncoated: one test
+    const float cos_coat = std::abs(dot(coat_normal(m.layers, si, textures), normalize(wo)));
+    return le * (1.0f - coat_fresnel(coat_weight(m.layers, si, textures), cos_coat));
 }
 
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,

@@ -28,9 +28,14 @@ namespace sahara {
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
                    const std::vector<TextureDesc>& textures);
 
-/// Emitted radiance (factor x texture x strength), from either side.
+/// Radiance emitted (factor x texture x strength, from either side) towards wo,
+/// any length, away from the surface. A clearcoat over the emission lets
+/// 1 - clearcoat F(|n_coat . wo|) of it through, as KHR_materials_clearcoat says;
+/// a sheen keeps all of it (KHR_materials_sheen layers a BRDF and says nothing of
+/// emission). Every integrator and light sampling read the emission here, so a
+/// light seen and a light sampled agree.
 Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
-                 const std::vector<TextureDesc>& textures);
+                 const std::vector<TextureDesc>& textures, const Vec3& wo);
 
 /// The lobes' weights at one wo: the probabilities sample_pbr uses.
 struct PbrLobeWeights {

@@ -126,7 +126,7 @@ Rgb hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const Surfa
 template <Strategy S>
 Rgb pbr_hit_emission(const Scene& scene, const Ray& ray, const Hit& hit, const SurfaceInteraction& si,
                      const MaterialDesc& mat, const PrevVertex& prev) {
-    const Rgb le = pbr_emission(mat, si, scene.textures);
+    const Rgb le = pbr_emission(mat, si, scene.textures, -ray.dir);
     if constexpr (S == Strategy::mis || S == Strategy::light_only) {
         if (si.front_face && !prev.delta && max_component(le) > 0) {
             const uint32_t e = emitter_of_hit(scene, hit);

@@ -168,13 +168,14 @@ bool sample_area_light(const Scene& scene, const Emitter& e, const Vec3& p, floa
     ls.wi = d / ls.distance;
     if (dot(nl, ls.wi) >= 0) return false;  // only the front side emits
     const MaterialDesc& m = scene.materials[material_of(scene, e)];
-    if (m.radiance.kind == ColorSource::Kind::constant) {
+    const bool coated = m.type == MaterialType::pbr && m.layers.clearcoat > 0;
+    if (m.radiance.kind == ColorSource::Kind::constant && !coated) {
         ls.li = m.radiance.color;
     } else {
-        // Textured emission: let the scene compute uv exactly as for a hit.
+        // Textured or coated emission: let the scene compute the point exactly as for a hit.
         const Ray r{p, d, 0.0f, 2.0f, time};
         const SurfaceInteraction si = scene.interact(r, hit_of(scene, e, bary));
-        ls.li = m.type == MaterialType::pbr ? pbr_emission(m, si, scene.textures)
+        ls.li = m.type == MaterialType::pbr ? pbr_emission(m, si, scene.textures, -ls.wi)
                                             : eval_color(m.radiance, scene.textures, si.p, si.uv);
     }
     ls.pdf *= pdf_solid;

@@ -3,6 +3,7 @@
 #include "geometry/spawn.h"
 #include "render/background.h"
 #include "render/bsdf.h"
+#include "render/bsdf_layers.h"
 #include "render/bsdf_pbr.h"
 #include "render/integrator.h"
 #include "render/lights.h"
@@ -58,18 +59,29 @@ Rgb branch(const Scene& scene, const SurfaceInteraction& si, const Vec3& dir, bo
 }
 
 /// The glTF material as a preview: its diffuse base lit like Lambert, plus a
-/// mirror reflection weighted by the specular colour (roughness ignored).
+/// mirror reflection weighted by the specular colour (roughness ignored). The
+/// layers weigh as in the path tracer (bsdf_layers.h): the base scaled by what
+/// they let through, the sheen a diffuse term of its albedo, the clearcoat a
+/// mirror about the coat's normal weighted by clearcoat x F.
 Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const MaterialDesc& m, const Vec3& wo,
                 float time, int depth, int max_depth, float weight) {
     const Bsdf b = make_bsdf(m, si, scene.textures);
-    const Rgb diffuse = b.albedo * (1.0f - b.metallic);
+    const LayerWeights layers = b.layers.on ? pbr_layer_weights(b, b.frame.to_local(wo)) : LayerWeights{};
+    const Rgb diffuse =
+        b.albedo * ((1.0f - b.metallic) * layers.base_scale) + b.layers.sheen * layers.sheen_albedo;
     Rgb radiance =
         diffuse * eval_background(scene.background, si.ns) + direct_lights(scene, si, diffuse, time);
-    const Rgb f = fresnel_schlick(b.albedo * b.metallic + b.f0_color * (1.0f - b.metallic),
-                                  1.0f - (1.0f - b.metallic) * (1.0f - b.f90), dot(wo, si.ns));
-    const Vec3 wr = reflect(wo, si.ns);
-    if (dot(wr, si.ng) > 0)
-        radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));
+    const auto mirror = [&](const Vec3& n, const Rgb& f) {
+        const Vec3 wr = reflect(wo, n);
+        if (dot(wr, si.ng) > 0)
+            radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));
+    };
+    mirror(si.ns, fresnel_schlick(b.albedo * b.metallic + b.f0_color * (1.0f - b.metallic),
+                                  1.0f - (1.0f - b.metallic) * (1.0f - b.f90), dot(wo, si.ns)) *
+                      layers.base_scale);
+    if (layers.coat_fresnel > 0)
+        mirror(b.layers.coat_frame ? b.frame.to_world(b.layers.coat_normal) : b.frame.n,
+               Rgb(layers.coat_fresnel));
     return radiance;
 }
 
@@ -95,7 +107,7 @@ Rgb trace(const Scene& scene, Ray ray, int depth, int max_depth, float weight) {
     if (m.type == MaterialType::emissive)
         return si.front_face ? eval_color(m.radiance, scene.textures, si.p, si.uv) : Rgb(0.0f);
     Rgb radiance = m.type == MaterialType::lambertian ? m.emission
-                   : m.type == MaterialType::pbr      ? pbr_emission(m, si, scene.textures)
+                   : m.type == MaterialType::pbr      ? pbr_emission(m, si, scene.textures, -ray.dir)
                                                       : Rgb(0.0f);
     if (depth >= max_depth) return radiance;  // the next ray (shadow or secondary) would exceed max_depth
     const Vec3 wo = -ray.dir;

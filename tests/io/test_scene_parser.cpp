@@ -450,6 +450,37 @@ TEST_CASE("scene parser: directions of any finite length give unit vectors") {
     CHECK(s.lights[0].direction.z == doctest::Approx(std::sqrt(0.5)));
 }
 
+TEST_CASE("scene parser: an unlit material takes a colour source and the cut-out keys") {
+    ScratchDir scratch;
+    FakeLoaders fake;
+    const SceneDesc s = parse_scene_json(
+        R"({"camera": {"position": [0, 0, 0], "look_at": [0, 1, 0]},
+            "materials": {
+              "sign":  {"type": "unlit", "color": [0.2, 0.4, 0.6]},
+              "white": {"type": "unlit"},
+              "photo": {"type": "unlit", "color": {"texture": "textures/wood.png"},
+                        "alpha": {"texture": "textures/leaf.png"}, "alpha_cutoff": 0.3},
+              "tiles": {"type": "unlit", "color": {"checker": {"scale": 2}}, "alpha": 0.5}},
+            "objects": []})",
+        scratch.dir / "unlit.json", fake.loaders());
+    REQUIRE(s.materials.size() == 5);
+    for (size_t i = 1; i < 5; ++i) CHECK(s.materials[i].type == MaterialType::unlit);
+    CHECK(s.materials[1].albedo.kind == ColorSource::Kind::constant);
+    CHECK(s.materials[1].albedo.color == Rgb(0.2f, 0.4f, 0.6f));
+    CHECK(s.materials[2].albedo.color == Rgb(1.0f));  // glTF's default base colour
+    CHECK(s.materials[3].albedo.kind == ColorSource::Kind::texture);
+    CHECK(s.materials[3].albedo.texture == 0);
+    CHECK(s.materials[3].alpha_texture == 1);
+    CHECK(s.materials[3].alpha_cutoff == 0.3f);
+    REQUIRE(fake.images.size() == 2);
+    CHECK(fake.images[0] == std::make_pair(std::string("wood.png"), true));   // colour: sRGB
+    CHECK(fake.images[1] == std::make_pair(std::string("leaf.png"), false));  // alpha: linear
+    CHECK(s.materials[4].albedo.kind == ColorSource::Kind::checker);
+    CHECK(s.materials[4].albedo.checker_scale == 2.0f);
+    CHECK(s.materials[4].alpha == 0.5f);
+    CHECK(!s.materials[4].alpha_cutoff);
+}
+
 TEST_CASE("a model joining a scene with textures has every texture slot renumbered") {
     SceneDesc scene;
     scene.textures.resize(3);  // the scene's own textures come first

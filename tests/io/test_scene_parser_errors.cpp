@@ -1,5 +1,8 @@
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <string>
 
 #include "scene_parser_test_util.h"
@@ -86,7 +89,19 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
          {"materials.default: the name \"default\" is reserved"}},
         {with_objects("[]", R"({"m": {"type": "metal", "alpha": 0.5}})"), {"materials.m.alpha: unknown key"}},
         {with_objects("[]", R"({"m": {"type": "plastic"}})"),
-         {"materials.m.type: expected one of \"lambertian\", \"metal\""}},
+         {"materials.m.type: expected one of \"lambertian\", \"metal\"", "\"pbr\", \"unlit\""}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "albedo": [1, 0, 0]}})"),
+         {"materials.m.albedo: unknown key", "allowed here: type, color, alpha, alpha_cutoff"}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "color": [1, 0, 0], "emission": [1, 1, 1]}})"),
+         {"materials.m.emission: unknown key"}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "color": [0.5, 2, 0]}})"),
+         {"materials.m.color[1]: expected a number in [0, 1], got 2"}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "color": "red"}})"),
+         {"materials.m.color: expected [r, g, b]"}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "color": {"texture": "textures/nope.png"}}})"),
+         {"materials.m.color.texture: file not found:", "textures/nope.png"}},
+        {with_objects("[]", R"({"m": {"type": "unlit", "alpha_cutoff": -1}})"),
+         {"materials.m.alpha_cutoff: expected a number in [0, 1], got -1"}},
         {with_objects("[]", R"({"m": {"albedo": [1, 1, 1]}})"), {"materials.m: missing key \"type\""}},
         {with_objects("[]", R"({"m": {"type": "lambertian", "albedo": [0.5, 1.5, 0]}})"),
          {"materials.m.albedo[1]: expected a number in [0, 1], got 1.5"}},
@@ -168,6 +183,18 @@ TEST_CASE("scene parser: bad input names file, JSON path and expectation") {
         CAPTURE(c.json);
         check_contains(error_of(c.json), c.fragments);
     }
+}
+
+TEST_CASE("scene parser: a missing file names the directory relative paths resolve against") {
+    const fs::path scratch = fs::temp_directory_path() / ("sahara_parser_test_" + std::to_string(::getpid()));
+    check_contains(error_of(with_objects(R"([{"type": "mesh", "file": "meshes/none.obj"}])")),
+                   {"objects[0].file: file not found: ",
+                    "meshes/none.obj (relative paths resolve against " + scratch.string() + ")"});
+    const std::string absolute =
+        error_of(with_objects(R"([{"type": "mesh", "file": "/nonexistent/none.obj"}])"));
+    const std::string expected = "objects[0].file: file not found: /nonexistent/none.obj";
+    REQUIRE(absolute.size() >= expected.size());
+    CHECK(absolute.substr(absolute.size() - expected.size()) == expected);  // no hint about relative paths
 }
 
 TEST_CASE("scene parser: broken JSON reports line and column") {

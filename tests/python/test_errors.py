@@ -33,6 +33,7 @@ def test_a_dict_gets_the_same_message_as_a_file(workshop, tmp_path):
     (lambda d: d.pop("camera"), "camera"),
     (lambda d: d.update(colour=1), "colour"),
     (lambda d: d["materials"]["red"].update(type="plastic"), r"materials\.red\.type"),
+    (lambda d: d["materials"]["red"].update(type="unlit"), r"materials\.red\.albedo: unknown key .*color"),
     (lambda d: d["objects"][0].update(center=[0, 1]), r"objects\[0\]\.center"),
     (lambda d: d["objects"][0].update(center=[0, float("nan"), 0]), r"objects\[0\]\.center"),
     (lambda d: d["objects"][0].update(material="missing"), r"objects\[0\]\.material"),
@@ -152,3 +153,17 @@ def test_an_image_larger_than_the_command_line_allows_is_refused_before_any_work
     huge = np.broadcast_to(np.float32(0), (40000, 2, 3))  # no memory behind it
     with pytest.raises(ValueError, match="1..32768"):
         sahara.write_image(tmp_path / "x.png", huge)
+
+
+def test_a_missing_file_in_a_dict_names_the_directory_it_was_looked_for_in(workshop, tmp_path, monkeypatch):
+    """A dict has no scene file: the message names the current directory, where relative paths resolve."""
+    monkeypatch.chdir(tmp_path)
+    workshop["objects"].append({"type": "mesh", "file": "meshes/none.obj"})
+    with pytest.raises(sahara.InputError) as e:
+        sahara.Scene(workshop)
+    assert str(e.value).endswith(f"objects[2].file: file not found: meshes/none.obj "
+                                 f"(relative paths resolve against {tmp_path.resolve()})")
+    workshop["objects"][2]["file"] = str(tmp_path / "none.obj")
+    with pytest.raises(sahara.InputError) as e:
+        sahara.Scene(workshop)
+    assert str(e.value).endswith(f"file not found: {tmp_path / 'none.obj'}")

@@ -23,6 +23,15 @@ def test_render_returns_linear_float32_image(workshop):
     assert img.stats["spp"] == 4 and img.stats["complete"]
 
 
+def test_an_unlit_material_in_a_dict_shows_exactly_its_colour(workshop):
+    """The dict goes through the scene-file parser: `unlit` works there as in a file."""
+    workshop["materials"]["sign"] = {"type": "unlit", "color": [0.25, 0.5, 0.75]}
+    workshop["objects"][0]["material"] = "sign"
+    img = sahara.render(workshop, width=8, height=8, spp=2)
+    assert np.allclose(img[4, 4], [0.25, 0.5, 0.75], rtol=1e-6, atol=0)
+    assert sahara.Scene(workshop).info()["Materials"]["unlit"] == 1
+
+
 def test_keywords_override_the_scene(workshop):
     img = sahara.render(workshop, width=10, height=7, spp=1, max_depth=2)
     assert img.shape == (7, 10, 3)

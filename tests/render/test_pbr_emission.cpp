@@ -2,6 +2,9 @@
 // picks them as it picks emissive materials, and MIS weighs what BSDF sampling finds.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
+#include "render/lights.h"
 #include "render_test_util.h"
 
 using namespace sahara;
@@ -37,7 +40,78 @@ MaterialDesc glowing_pbr(Rgb radiance) {
     return m;
 }
 
+/// What one ray sees with `integrator` and max_depth 1: emission only, no bounce.
+Rgb seen(const SceneDesc& d, IntegratorType integrator, const Ray& ray) {
+    SceneDesc copy = d;
+    copy.render.integrator = integrator;
+    const Scene scene = build_scene(copy);
+    Sampler sampler(3, SamplerType::independent);
+    sampler.start(0, 0, 0);
+    return estimate_radiance(scene, ray, sampler, 1);
+}
+
+/// KHR_materials_clearcoat's attenuation of the emission, written out: 1 - c (0.04 + 0.96 (1 - cos)^5).
+float through_coat(float clearcoat, float cos) {
+    return 1.0f - clearcoat * (0.04f + 0.96f * std::pow(1.0f - cos, 5.0f));
+}
+
+/// A camera ray from below onto the lamp's centre at cos `cos` to its normal.
+Ray onto_lamp(float cos) {
+    const Vec3 dir(std::sqrt(1.0f - cos * cos), 0.0f, cos);
+    return {Vec3(0, 0, 1) - dir * 0.6f, dir, 0.0f, kInfinity, 0.0f};
+}
+
 }  // namespace
+
+TEST_CASE("pbr emission: a clearcoat darkens the emission under it by its Fresnel and a sheen does not") {
+    const Rgb le(20.0f, 10.0f, 5.0f);
+    for (float cos : {1.0f, 0.1f}) {  // head-on and grazing
+        CAPTURE(cos);
+        const Ray ray = onto_lamp(cos);
+        for (IntegratorType integrator : {IntegratorType::path, IntegratorType::whitted}) {
+            CAPTURE(int(integrator));
+            MaterialDesc lamp = glowing_pbr(le);
+            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+            lamp.layers.clearcoat = 0.8f;
+            const Rgb coated = seen(panel_scene(lamp), integrator, ray);
+            for (int c = 0; c < 3; ++c)
+                CHECK(coated[c] == doctest::Approx(le[c] * through_coat(0.8f, cos)).epsilon(1e-5));
+            lamp.layers.clearcoat = 0.0f;
+            lamp.layers.clearcoat_roughness = 0.7f;  // a coat of weight 0 is no coat, whatever its roughness
+            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+            lamp.layers.sheen_color = Rgb(1.0f);  // KHR_materials_sheen leaves emission alone
+            lamp.layers.sheen_roughness = 0.5f;
+            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+        }
+    }
+    CHECK(through_coat(0.8f, 0.1f) < 0.52f);  // the grazing view is the one that shows the coat
+}
+
+TEST_CASE("pbr emission: light sampling gets from a coated lamp the radiance a camera ray sees") {
+    MaterialDesc lamp = glowing_pbr(Rgb(20.0f, 10.0f, 5.0f));
+    lamp.layers.clearcoat = 1.0f;
+    const Scene scene = build_scene(panel_scene(lamp));
+    Sampler sampler(5, SamplerType::independent);
+    sampler.start(0, 0, 0);
+    int lamp_samples = 0;
+    // Points on the floor from under the lamp to far beside it (grazing views of the lamp).
+    for (float x : {0.0f, 0.5f, 2.0f, 6.0f}) {
+        const Vec3 p(x, 0.3f, 0.0f);
+        for (int i = 0; i < 64; ++i) {
+            LightSample ls;
+            if (!sample_light(scene, p, 0.0f, sampler.next_1d(), sampler.next_2d(), ls)) continue;
+            ++lamp_samples;
+            const float cos = std::abs(ls.wi.z);  // the lamp's normal is -z
+            CHECK(ls.li.x == doctest::Approx(20.0f * through_coat(1.0f, cos)).epsilon(1e-5));
+            // The camera ray along the sample's direction sees the same.
+            Sampler unused(3, SamplerType::independent);
+            unused.start(0, 0, 0);
+            const Rgb camera = estimate_radiance(scene, Ray{p, ls.wi, 1e-4f, kInfinity, 0.0f}, unused, 1);
+            CHECK(camera.x == doctest::Approx(ls.li.x).epsilon(1e-4));
+        }
+    }
+    CHECK(lamp_samples > 100);
+}
 
 TEST_CASE("pbr emission: a glowing pbr quad lights the scene like an emissive quad of equal radiance") {
     const Scene pbr = build_scene(panel_scene(glowing_pbr(Rgb(20.0f, 10.0f, 5.0f))));
