@@ -118,6 +118,14 @@ struct MaterialDesc {
     bool double_sided = true;         ///< false: back faces are invisible
     bool thin_walled = false;         ///< transmission without refraction (no volume behind the surface)
     PbrLayersDesc layers;             ///< clearcoat and sheen
+    /// KHR_materials_anisotropy: GGX roughness stretched along a direction in
+    /// the tangent plane (render/bsdf_pbr.cpp); strength in [0, 1], 0 leaves
+    /// the material isotropic. The rotation (radians) turns the direction
+    /// counter-clockwise from the tangent; the texture's RG is a direction in
+    /// tangent space ([0, 1] -> [-1, 1]) and its B scales the strength.
+    float anisotropy = 0.0f;
+    float anisotropy_rotation = 0.0f;
+    int anisotropy_texture = -1;
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
@@ -144,6 +152,7 @@ void for_each_texture_slot(Material& m, F&& f) {
     f("clearcoat normal map", m.layers.clearcoat_normal_texture);
     f("sheen colour", m.layers.sheen_color_texture);
     f("sheen roughness", m.layers.sheen_roughness_texture);
+    f("anisotropy", m.anisotropy_texture);
     f("alpha", m.alpha_texture);
 }
 

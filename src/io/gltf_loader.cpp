@@ -35,7 +35,8 @@ const std::set<std::string> kSupportedRequired = {
 const std::set<std::string> kSupportedRequiredMaterials = {
     "KHR_materials_unlit",     "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_specular",  "EXT_texture_webp",
-    "KHR_materials_clearcoat", "KHR_materials_sheen"};
+    "KHR_materials_clearcoat", "KHR_materials_sheen",
+    "KHR_materials_anisotropy"};
 
 bool supported_required(const std::string& name) {
     return kSupportedRequired.count(name) || kSupportedRequiredMaterials.count(name);

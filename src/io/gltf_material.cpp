@@ -1,5 +1,5 @@
 // glTF materials -> MaterialDesc of type pbr (every core input and the
-// transmission, ior, volume, emissive-strength, clearcoat and sheen extensions), textures ->
+// transmission, ior, volume, emissive-strength, clearcoat, sheen and anisotropy extensions), textures ->
 // TextureDesc with the uv convention of scene_desc.h, images decoded through
 // OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
@@ -235,6 +235,9 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
         } else if (name == "KHR_materials_sheen") {
             set_sheen(out.layers, value, ext);
             out.extensions.push_back(name);
+        } else if (name == "KHR_materials_anisotropy") {
+            set_anisotropy(out, value, ext);
+            out.extensions.push_back(name);
         } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
@@ -283,6 +286,24 @@ void Materials::set_sheen(PbrLayersDesc& out, const tinygltf::Value& ext, const 
     out.sheen_roughness = std::clamp(float(number(ext, "sheenRoughnessFactor", 0.0)), 0.0f, 1.0f);
     if (auto info = texture_info(ext, "sheenRoughnessTexture"))
         out.sheen_roughness_texture = texture(*info, false, element + ".sheenRoughnessTexture");
+}
+
+/// KHR_materials_anisotropy: strength (factor x texture B), rotation (radians)
+/// and direction (texture RG). The direction texture is data: read linear.
+/// A strength outside [0, 1] is clamped with a warning; a value that is not a
+/// number is refused.
+void Materials::set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element) {
+    for (const char* key : {"anisotropyStrength", "anisotropyRotation"})
+        if (ext.Has(key) && !ext.Get(key).IsNumber())
+            throw input_error(src_.file, element + "." + key, "must be a number");
+    const float strength = float(number(ext, "anisotropyStrength", 0.0));
+    out.anisotropy = std::clamp(strength, 0.0f, 1.0f);
+    if (out.anisotropy != strength)
+        log_warning(src_.file + ": " + element + ".anisotropyStrength: " + std::to_string(strength) +
+                    " is outside [0, 1], " + std::to_string(out.anisotropy) + " used");
+    out.anisotropy_rotation = float(number(ext, "anisotropyRotation", 0.0));
+    if (auto info = texture_info(ext, "anisotropyTexture"))
+        out.anisotropy_texture = texture(*info, false, element + ".anisotropyTexture");
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).

@@ -49,6 +49,7 @@ class PrimitiveReader {
         n_ = pos_.size() / 3;
         nrm_ = optional_attribute(prim_.attributes, "NORMAL", element_ + ".attributes", 3);
         tan_ = optional_attribute(prim_.attributes, "TANGENT", element_ + ".attributes", 4);
+        check_tangent_signs();
         apply_morph_targets(weights);
         TriangleMesh out;
         for (size_t i = 0; i < n_; ++i) out.positions.emplace_back(vec3(pos_, 3, i));
@@ -81,6 +82,18 @@ class PrimitiveReader {
                               "has " + std::to_string(v.size() / size_t(components)) +
                                   " elements, POSITION has " + std::to_string(n_));
         return v;
+    }
+
+    /// TANGENT's w is the bitangent's sign: glTF requires +1 or -1 (read_accessor
+    /// has already refused non-finite values).
+    void check_tangent_signs() const {
+        for (size_t i = 0; i < tan_.size() / 4; ++i) {
+            const double w = tan_[4 * i + 3];
+            if (std::abs(std::abs(w) - 1.0) > 1e-3)
+                throw input_error(
+                    src_.file, element_ + ".attributes.TANGENT",
+                    "element " + std::to_string(i) + " has w = " + std::to_string(w) + ", must be 1 or -1");
+        }
     }
 
     /// Each target adds weight x its POSITION, NORMAL and TANGENT (xyz) deltas.

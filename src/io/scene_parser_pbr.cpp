@@ -89,6 +89,8 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     if (auto v = o.get("double_sided")) m.double_sided = v->boolean();
     parse_alpha_mode(o, ctx, m);
     parse_pbr_layers(o, m.layers);
+    if (auto v = o.get("anisotropy")) m.anisotropy = v->number_f(unit);
+    if (auto v = o.get("anisotropy_rotation")) m.anisotropy_rotation = v->number_f();
 }
 
 }  // namespace sahara

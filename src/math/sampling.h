@@ -21,6 +21,8 @@ struct Frame {
         s = Vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
         t = Vec3(b, sign + n.y * n.y * a, -n.y);
     }
+    /// A frame whose first axis is `ss` (unit, orthogonal to the unit `nn`).
+    Frame(const Vec3& nn, const Vec3& ss) : s(ss), t(cross(nn, ss)), n(nn) {}
     Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
     Vec3 to_local(const Vec3& v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
 };

@@ -68,7 +68,7 @@ bool attenuates(const MaterialDesc& m) {
 }
 
 /// One material's line: text and JSON say the same things.
-/// pbr's clearcoat and sheen, when it has them.
+/// pbr's clearcoat, sheen and anisotropy, when it has them.
 void describe_layers(std::vector<std::string>& parts, nlohmann::json& value, const MaterialDesc& m) {
     const PbrLayersDesc& l = m.layers;
     const bool pbr = m.type == MaterialType::pbr;
@@ -83,6 +83,11 @@ void describe_layers(std::vector<std::string>& parts, nlohmann::json& value, con
         parts.push_back("sheen [" + number_text(l.sheen_color.x) + ", " + number_text(l.sheen_color.y) +
                         ", " + number_text(l.sheen_color.z) + "] (roughness " +
                         number_text(l.sheen_roughness) + ")");
+    const bool anisotropic = pbr && m.anisotropy > 0.0f;
+    value["anisotropy"] = anisotropic ? m.anisotropy : 0.0f;
+    if (anisotropic)
+        parts.push_back("anisotropy " + number_text(m.anisotropy) + " (rotation " +
+                        number_text(m.anisotropy_rotation) + ")");
 }
 
 void describe_material(StatsReport& s, const std::string& label, const MaterialDesc& m) {

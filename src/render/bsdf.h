@@ -32,12 +32,16 @@ struct BsdfLayers {
 struct Bsdf {
     BsdfKind kind = BsdfKind::none;
     Rgb albedo{0.0f};            ///< Lambertian reflectance, the metal's F0, or pbr's base colour
-    float alpha = 0;             ///< GGX roughness parameter (= roughness^2)
+    float alpha = 0;             ///< GGX roughness parameter (= roughness^2); pbr anisotropic: along frame.s
     float eta = 1;               ///< ior on the far side / ior on the side of wo (dielectric)
     Frame frame{Vec3(0, 0, 1)};  ///< around the shading normal
     Vec3 ng;                     ///< geometric normal on the side of wo
     // pbr only (render/bsdf_pbr.h)
     float roughness = 0;  ///< perceptual roughness, for the albedo tables
+    /// KHR_materials_anisotropy: frame.s is the anisotropy direction, `alpha`
+    /// the roughness along it and alpha_y the roughness across it.
+    bool anisotropic = false;
+    float alpha_y = 0;
     float metallic = 0;
     float f0 = 0.04f;     ///< dielectric layer's reflectance at normal incidence (largest channel)
     Rgb f0_color{0.04f};  ///< the same per channel (KHR_materials_specular colours it)

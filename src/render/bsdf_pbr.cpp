@@ -28,6 +28,25 @@ Rgb multiscatter_fresnel(const Rgb& f_avg, float e_avg) {
 /// Hemispherical average of Schlick's Fresnel: F0 + (F90 - F0) / 21.
 float schlick_average(float f0, float f90) { return f0 + (f90 - f0) / 21.0f; }
 
+/// The GGX functions of ggx.h for this material: anisotropic only where
+/// KHR_materials_anisotropy made it so, so that isotropic materials keep their arithmetic.
+float ggx_d(const Bsdf& b, const Vec3& wm) {
+    return b.anisotropic ? ggx_d(wm, b.alpha, b.alpha_y) : ggx_d(wm, b.alpha);
+}
+float ggx_lambda(const Bsdf& b, const Vec3& w) {
+    return b.anisotropic ? ggx_lambda(w, b.alpha, b.alpha_y) : ggx_lambda(w, b.alpha);
+}
+Vec3 sample_ggx_vndf(const Bsdf& b, const Vec3& wo, Vec2 u) {
+    return sample_ggx_vndf(wo, b.alpha, b.anisotropic ? b.alpha_y : b.alpha, u);
+}
+float ggx_vndf_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wm) {
+    return b.anisotropic ? ggx_vndf_pdf(wo, wm, b.alpha, b.alpha_y) : ggx_vndf_pdf(wo, wm, b.alpha);
+}
+float ggx_reflection_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+    return b.anisotropic ? ggx_reflection_pdf(wo, wi, b.alpha, b.alpha_y)
+                         : ggx_reflection_pdf(wo, wi, b.alpha);
+}
+
 /// Everything the lobes need that depends on the material only, from the tables.
 struct PbrTerms {
     float e_avg = 1, one_minus_e_avg = 0;
@@ -72,9 +91,9 @@ float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
 /// Single-scattering GGX reflection, f cos.
 Rgb eval_specular(const Bsdf& b, const PbrTerms& t, const Vec3& wo, const Vec3& wi) {
     const Vec3 wm = normalize(wo + wi);
-    const float lo = ggx_lambda(wo, b.alpha), li = ggx_lambda(wi, b.alpha);
+    const float lo = ggx_lambda(b, wo), li = ggx_lambda(b, wi);
     const float g2 = 1.0f / (1.0f + lo + li);
-    return fresnel_schlick(t.f0, t.f90, std::abs(dot(wo, wm))) * (ggx_d(wm, b.alpha) * g2 / (4.0f * wo.z));
+    return fresnel_schlick(t.f0, t.f90, std::abs(dot(wo, wm))) * (ggx_d(b, wm) * g2 / (4.0f * wo.z));
 }
 
 /// The half vector of a refraction from wo (outside, +z) to wi (below), facing +z.
@@ -88,24 +107,24 @@ Vec3 refraction_half_vector(const Vec3& wo, const Vec3& wi, float eta) {
 /// the light leaves on the far side without bending.
 Rgb eval_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     *pdf = 0;
-    const float lo = ggx_lambda(wo, b.alpha), li = ggx_lambda(wi, b.alpha);
+    const float lo = ggx_lambda(b, wo), li = ggx_lambda(b, wi);
     const Rgb tint = b.albedo * ((1.0f - b.metallic) * b.transmission);
     if (b.thin) {
         const Vec3 wr(wi.x, wi.y, -wi.z);
         const Vec3 wm = normalize(wo + wr);
-        *pdf = ggx_reflection_pdf(wo, wr, b.alpha);
+        *pdf = ggx_reflection_pdf(b, wo, wr);
         const float fresnel_t = 1.0f - fresnel_schlick(Rgb(b.f0), b.f90, dot(wo, wm)).x;
-        return tint * (fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) / (4.0f * wo.z));
+        return tint * (fresnel_t * ggx_d(b, wm) / (1.0f + lo + li) / (4.0f * wo.z));
     }
     const Vec3 wm = refraction_half_vector(wo, wi, b.eta);
     const float o_m = dot(wo, wm), i_m = dot(wi, wm);
     if (o_m <= 0 || i_m >= 0) return Rgb(0.0f);  // not a refraction through this microfacet
     const float denom = (i_m + o_m / b.eta) * (i_m + o_m / b.eta);
     const float fresnel_t = 1.0f - b.f90 * fresnel_dielectric(o_m, b.eta);
-    *pdf = ggx_vndf_pdf(wo, wm, b.alpha) * std::abs(i_m) / denom;
+    *pdf = ggx_vndf_pdf(b, wo, wm) * std::abs(i_m) / denom;
     // Radiance is compressed by eta^2 entering the denser side, as for `dielectric`.
-    const float f = fresnel_t * ggx_d(wm, b.alpha) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) /
-                    (b.eta * b.eta);
+    const float f =
+        fresnel_t * ggx_d(b, wm) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) / (b.eta * b.eta);
     return tint * f;
 }
 
@@ -189,6 +208,64 @@ Vec3 coat_normal(const PbrLayersDesc& d, const SurfaceInteraction& si,
     return d.clearcoat_normal_texture >= 0
                ? mapped_normal(d.clearcoat_normal_texture, d.clearcoat_normal_scale, si, textures)
                : si.ns;
+/// The tangent the anisotropy direction is measured from, orthogonal to the
+/// front-side normal n: the mesh's (glTF TANGENT, or generated from the UVs as
+/// for normal maps), else, on surfaces without one (analytic shapes), the
+/// direction around the scene's z axis (a sphere's increasing u), or x where
+/// the surface faces along z. Zero if none can be built.
+Vec3 anisotropy_tangent(const SurfaceInteraction& si, const Vec3& n) {
+    Vec3 t = si.tangent;
+    if (length_squared(t) <= 0) {
+        t = cross(Vec3(0, 0, 1), n);
+        if (length_squared(t) <= 1e-8f) t = Vec3(1, 0, 0);
+    }
+    t = t - n * dot(n, t);
+    return length_squared(t) > 1e-12f ? normalize(t) : Vec3(0.0f);
+}
+
+/// KHR_materials_anisotropy: the direction (texture RG in [-1, 1] on the tangent
+/// and bitangent, else the tangent) turned by the rotation, and the strength
+/// (factor x texture B). The frame's first axis becomes that direction, with
+/// alpha_t = mix(alpha, 1, strength^2) along it and alpha across it. A
+/// strength of 0 leaves the material isotropic.
+///
+/// The albedo tables (multiple-scattering compensation, the base's and the
+/// layers' scaling) stay at the material's roughness, the smaller alpha: its
+/// albedo is at least the anisotropic lobe's, so they never add energy. Strong
+/// anisotropy on a smooth material thus loses part of what it scatters more
+/// than once. Tables read at the geometric mean of the two alphas, or at the
+/// alpha projected on the viewing direction, create energy at some angles.
+void set_anisotropy(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                    const std::vector<TextureDesc>& textures) {
+    float strength = m.anisotropy;
+    float dx = 1.0f, dy = 0.0f;
+    if (m.anisotropy_texture >= 0) {
+        const Rgb c = sample_texture_rgb(textures[size_t(m.anisotropy_texture)],
+                                         texcoord(si, textures, m.anisotropy_texture));
+        const float x = 2.0f * c.x - 1.0f, y = 2.0f * c.y - 1.0f;
+        if (x * x + y * y > 1e-8f) {
+            dx = x;
+            dy = y;
+        }
+        strength *= c.z;
+    }
+    strength = std::clamp(strength, 0.0f, 1.0f);
+    if (!(strength > 0)) return;
+    const float cr = std::cos(m.anisotropy_rotation), sr = std::sin(m.anisotropy_rotation);
+    const float rx = cr * dx - sr * dy, ry = sr * dx + cr * dy;
+    // The tangent frame is built on the front side, as for normal maps.
+    const Vec3 n_front = si.front_face ? si.ns : -si.ns;
+    const Vec3 t = anisotropy_tangent(si, n_front);
+    if (length_squared(t) <= 0) return;
+    const Vec3 bt = cross(n_front, t) * si.tangent_sign;
+    const Vec3 n = b.frame.n;  // possibly bent by a normal map
+    const Vec3 d = t * rx + bt * ry;
+    const Vec3 d_plane = d - n * dot(n, d);
+    if (length_squared(d_plane) <= 1e-12f) return;
+    b.frame = Frame(n, normalize(d_plane));
+    b.anisotropic = true;
+    b.alpha_y = b.alpha;
+    b.alpha = b.alpha + (1.0f - b.alpha) * (strength * strength);
 }
 
 /// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.
@@ -257,6 +334,7 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.thin = m.thin_walled;
     b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
+    if (m.anisotropy > 0) set_anisotropy(b, m, si, textures);
     if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);
 }
 
@@ -306,21 +384,21 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
                                                        (1.0f - dielectric_albedo(b, t, ei)) / base_avg
                                                  : 0.0f;
     f += t.diffuse * (diffuse_scale * cos_pi);
-    *pdf = p.specular * ggx_reflection_pdf(wo, wi, b.alpha) + p.cosine * cos_pi;
+    *pdf = p.specular * ggx_reflection_pdf(b, wo, wi) + p.cosine * cos_pi;
     return f;
 }
 
 bool sample_pbr_base_direction(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, Vec3* wi) {
     const PbrLobeWeights p = pbr_lobe_weights(b, wo);
     if (u_lobe < p.specular) {
-        *wi = reflect(wo, sample_ggx_vndf(wo, b.alpha, u));
+        *wi = reflect(wo, sample_ggx_vndf(b, wo, u));
         return wi->z > 0;
     }
     if (u_lobe < p.specular + p.cosine) {
         *wi = sample_cosine_hemisphere(u);
         return true;
     }
-    return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(wo, b.alpha, u), wi);
+    return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(b, wo, u), wi);
 }
 
 bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s) {

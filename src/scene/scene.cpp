@@ -168,11 +168,12 @@ void interact_triangle(const TriangleSoup& soup, uint32_t i, const Hit& hit, Sur
     si.material = soup.material[i];
 }
 
-/// Whether a mesh uses a normal-mapped material (and so needs tangents).
-bool uses_normal_map(const SceneDesc& desc, const TriangleMesh& m) {
+/// Whether a mesh uses a material that needs tangents (normal-mapped or anisotropic).
+bool needs_tangents(const SceneDesc& desc, const TriangleMesh& m) {
     auto mapped = [&](uint32_t id) {
-        return id < desc.materials.size() && (desc.materials[id].normal_texture >= 0 ||
-                                              desc.materials[id].layers.clearcoat_normal_texture >= 0);
+        if (id >= desc.materials.size()) return false;
+        const MaterialDesc& d = desc.materials[id];
+        return d.normal_texture >= 0 || d.layers.clearcoat_normal_texture >= 0 || d.anisotropy > 0;
     };
     if (m.material_ids.empty()) return mapped(m.material);
     return std::any_of(m.material_ids.begin(), m.material_ids.end(), mapped);
@@ -190,7 +191,7 @@ void append_attribute(std::vector<T>& out, const std::vector<T>& values, size_t 
 }
 
 /// The meshes' second UV set, vertex colours and tangents, merged in the order
-/// build_scene merges positions (tangents generated where a normal map needs them).
+/// build_scene merges positions (tangents generated where a material needs them).
 void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
     bool any_uv1 = false, any_colors = false, any_alphas = false, any_tangents = false;
     std::vector<std::vector<std::array<float, 4>>> tangents(desc.meshes.size());
@@ -201,7 +202,7 @@ void merge_material_inputs(const SceneDesc& desc, TriangleSoup& soup) {
         any_alphas |= !m.color_alphas.empty();
         if (m.tangents.size() == m.positions.size() && !m.tangents.empty())
             tangents[k] = m.tangents;
-        else if (uses_normal_map(desc, m))
+        else if (needs_tangents(desc, m))
             tangents[k] = generate_tangents(m);
         any_tangents |= !tangents[k].empty();
     }

@@ -192,3 +192,26 @@ TEST_CASE("info: an OBJ with vertex colours says its lambertian material uses th
     CHECK(red["type"] == "metal");
     CHECK(red["vertex_colors"] == true);
 }
+
+TEST_CASE("info: a glTF anisotropic material lists the extension and its direction texture") {
+    const fs::path dir = gltf::scratch("info_anisotropy");
+    const json material = {{"name", "brushed"},
+                           {"extensions",
+                            {{"KHR_materials_anisotropy",
+                              {{"anisotropyStrength", 0.5},
+                               {"anisotropyRotation", 1},
+                               {"anisotropyTexture", {{"index", 1}}}}}}}};
+    const std::string file = write_gltf(dir, material).string();
+    const json j = scene_info(file).to_json();
+    const json& m = j["Materials"]["[0] brushed"];
+    CHECK(m["textures"].contains("anisotropy"));
+    CHECK(m["anisotropy"].get<double>() == doctest::Approx(0.5));
+    CHECK(contains(m["extensions"], "KHR_materials_anisotropy"));
+    CHECK_FALSE(j.contains("Ignored inputs"));
+    TempDir run("info_anisotropy_text");
+    const CliRun r = run_sahara("info " + file, run);
+    CHECK(r.code == 0);
+    for (const char* text :
+         {"textures: anisotropy", "anisotropy 0.5 (rotation 1)", "extensions: KHR_materials_anisotropy"})
+        CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
+}

@@ -119,3 +119,21 @@ TEST_CASE("scene parser: pbr clearcoat and sheen keys") {
     check_contains(bad(R"({"type": "pbr", "sheen_roughness": "rough"})"), {"materials.m.sheen_roughness"});
     check_contains(bad(R"({"type": "lambertian", "clearcoat": 1})"), {"clearcoat"});  // pbr only
 }
+
+TEST_CASE("scene parser: pbr anisotropy keys") {
+    const MaterialDesc plain = parse_one(R"({"type": "pbr"})");
+    CHECK(plain.anisotropy == 0.0f);
+    CHECK(plain.anisotropy_rotation == 0.0f);
+    const MaterialDesc m = parse_one(R"({"type": "pbr", "anisotropy": 0.6, "anisotropy_rotation": 1.25})");
+    CHECK(m.anisotropy == 0.6f);
+    CHECK(m.anisotropy_rotation == 1.25f);
+    CHECK(m.anisotropy_texture == -1);
+    const auto bad = [](const std::string& material) {
+        return error_of(with_objects("[]", R"({"m": )" + material + "}"));
+    };
+    check_contains(bad(R"({"type": "pbr", "anisotropy": 1.5})"), {"materials.m.anisotropy", "[0, 1]"});
+    check_contains(bad(R"({"type": "pbr", "anisotropy": -0.1})"), {"materials.m.anisotropy"});
+    check_contains(bad(R"({"type": "pbr", "anisotropy_rotation": "left"})"),
+                   {"materials.m.anisotropy_rotation"});
+    check_contains(bad(R"({"type": "metal", "anisotropy": 0.5})"), {"anisotropy"});  // pbr only
+}

@@ -188,3 +188,37 @@ TEST_CASE("pbr inputs: emission adds to what the surface reflects") {
         CHECK(within(s, m.radiance.color + Rgb(sky), 4, 0.01f));
     }
 }
+
+TEST_CASE(
+    "pbr inputs: the anisotropy texture gives the direction in the tangent frame and scales the strength") {
+    // RG (0.5, 1): the direction (0, 1), the bitangent; B 0.5 halves the strength.
+    const std::vector<TextureDesc> textures = {strip({Rgb(0.5f, 1.0f, 0.5f)})};
+    MaterialDesc m = white_pbr();
+    m.roughness = 0.5f;
+    m.anisotropy = 0.8f;
+    m.anisotropy_texture = 0;
+    SurfaceInteraction si = flat_hit();
+    si.tangent = Vec3(1, 0, 0);
+    Bsdf b = make_bsdf(m, si, textures);
+    REQUIRE(b.anisotropic);
+    CHECK(dot(b.frame.s, Vec3(0, 1, 0)) == doctest::Approx(1.0f));
+    CHECK(b.alpha_y == doctest::Approx(0.25f));
+    CHECK(b.alpha == doctest::Approx(0.25f + 0.75f * 0.4f * 0.4f));
+    m.anisotropy_rotation = 0.5f * kPi;  // turns the bitangent to -tangent
+    b = make_bsdf(m, si, textures);
+    CHECK(dot(b.frame.s, Vec3(-1, 0, 0)) == doctest::Approx(1.0f));
+}
+
+TEST_CASE("pbr inputs: an anisotropic mesh without tangents gets them at scene build") {
+    SceneDesc d = empty_scene(Rgb(0.0f));
+    MaterialDesc m = white_pbr();
+    m.anisotropy = 0.5f;
+    d.materials.push_back(m);
+    d.meshes.push_back(square());
+    const Scene scene = build_scene(d);
+    REQUIRE(scene.triangles.tangents.size() == 4);
+    Ray ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0.0f, kInfinity, 0.0f};
+    Hit hit;
+    REQUIRE(scene.intersect(ray, hit));
+    CHECK(scene.interact(ray, hit).tangent.x == doctest::Approx(1.0f));
+}
