@@ -108,14 +108,16 @@ std::optional<std::vector<Mat4>> gpu_instances(const Source& src, const tinygltf
     const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
     if (ext == node.extensions.end()) return std::nullopt;
     const std::string element = node_element + ".extensions.EXT_mesh_gpu_instancing";
-    if (!ext->second.IsObject() || !ext->second.Has("attributes") ||
-        !ext->second.Get("attributes").IsObject())
-        throw input_error(src.file, element + ".attributes", "missing or not an object");
-    InstancingReader reader(src, ext->second.Get("attributes"), element + ".attributes");
+    const char* none = "has none of TRANSLATION, ROTATION and SCALE";
+    // tinygltf drops an empty JSON object: missing and empty attributes look alike.
+    if (!ext->second.IsObject() || !ext->second.Has("attributes"))
+        throw input_error(src.file, element + ".attributes", none);
+    const tinygltf::Value& attributes = ext->second.Get("attributes");
+    if (!attributes.IsObject()) throw input_error(src.file, element + ".attributes", "is not an object");
+    InstancingReader reader(src, attributes, element + ".attributes");
     const std::vector<double> t = reader.read(kTranslation), r = reader.read(kRotation),
                               s = reader.read(kScale);
-    if (reader.count() == 0)
-        throw input_error(src.file, element + ".attributes", "gives none of TRANSLATION, ROTATION, SCALE");
+    if (reader.count() == 0) throw input_error(src.file, element + ".attributes", none);
     std::vector<Mat4> out(reader.count());
     for (size_t k = 0; k < out.size(); ++k) {
         Mat4& m = out[k];
