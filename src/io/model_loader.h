@@ -18,8 +18,9 @@ struct LoadedModel {
     std::vector<TextureDesc> textures;
     std::vector<LightDesc> lights;    ///< KHR_lights_punctual
     std::vector<CameraDesc> cameras;  ///< glTF cameras, world space
-    /// glTF meshes that several nodes draw: each one prototype (mesh indices into
-    /// `meshes`, in the mesh's own space) placed by one instance per node.
+    /// glTF meshes that several nodes draw, or that an EXT_mesh_gpu_instancing node
+    /// draws: each one prototype (mesh indices into `meshes`, in the mesh's own
+    /// space) placed by one instance per node or per entry.
     std::vector<PrototypeDesc> prototypes;
     std::vector<InstanceDesc> instances;
     size_t dropped_degenerate = 0;  ///< zero-area triangles removed
