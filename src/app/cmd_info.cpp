@@ -40,19 +40,18 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-/// A scene file, or a model wrapped into a scene description.
-SceneDesc load_input(const std::optional<std::string>& input) {
+/// A scene file, or a model wrapped into a scene description (its material
+/// variants, if any, in `variants`).
+SceneDesc load_input(const std::optional<std::string>& input, std::vector<std::string>& variants) {
     if (!input) return default_scene();
     const FileKind kind = file_kind(*input);
     if (kind == FileKind::scene) return parse_scene_file(*input);
     if (is_model_kind(kind)) {
         LoadedModel m = load_model(*input);
+        variants = std::move(m.variants);
         SceneDesc d;
         d.source = *input;
-        d.meshes = std::move(m.meshes);
-        d.materials = std::move(m.materials);
-        d.textures = std::move(m.textures);
-        d.lights = std::move(m.lights);
+        merge_loaded_model(d, std::move(m), std::nullopt);
         return d;
     }
     throw input_error(*input, "", "unknown file type (expected .json, .obj, .gltf or .glb)");
@@ -62,12 +61,19 @@ SceneDesc load_input(const std::optional<std::string>& input) {
 
 StatsReport scene_info(const std::optional<std::string>& input) {
     auto t = Clock::now();
-    const SceneDesc desc = load_input(input);
+    std::vector<std::string> variants;
+    const SceneDesc desc = load_input(input, variants);
     const double load = seconds_since(t);
     t = Clock::now();
     const Scene scene = build_scene(desc);
     const double build = seconds_since(t);
     StatsReport s = describe_scene(desc, scene);
+    if (!variants.empty()) {
+        std::string names;
+        for (const std::string& v : variants) names += (names.empty() ? "" : ", ") + v;
+        s.add("Material variants", "KHR_materials_variants", names + " (the default materials are rendered)",
+              variants);
+    }
     s.add_seconds("Time", "Load", load);
     s.add_seconds("Time", "Build", build);
     return s;

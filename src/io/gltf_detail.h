@@ -103,6 +103,11 @@ std::optional<TriangleMesh> read_primitive(const Source& src, size_t mesh, size_
 void apply_skin(const Source& src, const tinygltf::Primitive& prim, const std::string& element,
                 const std::vector<Mat4>& joint_matrices, TriangleMesh& mesh);
 
+/// EXT_mesh_gpu_instancing on `node`: one node-space matrix (T x R x S) per
+/// instance, or nothing if the node does not use the extension.
+std::optional<std::vector<Mat4>> gpu_instances(const Source& src, const tinygltf::Node& node,
+                                               const std::string& node_element);
+
 /// Walks the default scene (node transforms, then `world_from_model`) into
 /// meshes, cameras and lights of `out`; drops zero-area triangles.
 void build_scene(const Source& src, const Mat4& world_from_model, SharedMeshes shared, LoadedModel& out);

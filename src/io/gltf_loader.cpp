@@ -30,7 +30,8 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_materials_transmission", "KHR_materials_ior",
     "KHR_materials_volume",       "KHR_lights_punctual",
     "KHR_mesh_quantization",      "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression"};
+    "EXT_meshopt_compression",    "EXT_mesh_gpu_instancing",
+    "KHR_materials_variants"};
 /// More of them: material models and image formats.
 const std::set<std::string> kSupportedRequiredMaterials = {
     "KHR_materials_unlit",     "KHR_materials_pbrSpecularGlossiness",
@@ -181,6 +182,20 @@ void parse(Source& src, const std::vector<unsigned char>& bytes) {
     if (!ok) throw input_error(src.file, "", "malformed glTF: " + first_line(err));
 }
 
+/// The names of the file's KHR_materials_variants ("variant N" where a name is missing).
+std::vector<std::string> variant_names(const tinygltf::Model& model) {
+    std::vector<std::string> out;
+    auto ext = model.extensions.find("KHR_materials_variants");
+    if (ext == model.extensions.end() || !ext->second.Has("variants")) return out;
+    const tinygltf::Value& list = ext->second.Get("variants");
+    for (size_t i = 0; list.IsArray() && i < list.ArrayLen(); ++i) {
+        const tinygltf::Value& v = list.Get(int(i));
+        out.push_back(v.Has("name") && v.Get("name").IsString() ? v.Get("name").Get<std::string>()
+                                                                : "variant " + std::to_string(i));
+    }
+    return out;
+}
+
 }  // namespace
 
 LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared) {
@@ -196,6 +211,7 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     gltf::decode_draco_primitives(src);
     LoadedModel out;
     gltf::build_scene(src, world_from_model, shared, out);
+    out.variants = variant_names(src.model);
     if (out.dropped_degenerate > 0)
         log_info(src.file + ": dropped " + std::to_string(out.dropped_degenerate) + " zero-area triangles");
     return out;

@@ -26,7 +26,9 @@ class SceneBuilder {
 
     /// Node world matrices first (skins need their joints' matrices), then the meshes:
     /// a mesh that several unskinned nodes draw (with the same morph weights) is
-    /// loaded once, as a prototype, and each node places an instance of it.
+    /// loaded once, as a prototype, and each node places an instance of it. A node
+    /// with EXT_mesh_gpu_instancing always places instances: its count is the
+    /// author's promise of many copies, which copying would multiply in memory.
     void build(SharedMeshes shared) {
         for (int root : roots()) walk(root);
         std::map<InstanceKey, int> uses;
@@ -34,8 +36,10 @@ class SceneBuilder {
             if (auto key = instance_key(node); key && shared == SharedMeshes::instance) ++uses[*key];
         for (const auto& [node, world] : drawn_) {
             const std::optional<InstanceKey> key = instance_key(node);
-            if (key && uses[*key] > 1 && add_instance(*key, world)) continue;
-            add_mesh(node, world);
+            if (auto it = gpu_instances_.find(node); it != gpu_instances_.end())
+                add_gpu_instances(node, key, world, it->second);
+            else if (!(key && uses[*key] > 1 && add_instance(*key, world)))
+                add_mesh(node, world);
         }
     }
 
@@ -77,6 +81,8 @@ class SceneBuilder {
             const Mat4 world = parent * local_matrix(node, element);
             node_world_[index] = world;
             if (node.mesh >= 0) drawn_.emplace_back(index, world);
+            if (auto local = gpu_instances(src_, node, element); local && node.mesh >= 0)
+                gpu_instances_[index] = std::move(*local);
             if (node.camera >= 0) add_camera(node.camera, world, element);
             if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end())
                 add_light(it->second, world, element);
@@ -174,6 +180,23 @@ class SceneBuilder {
         }
         if (it->second >= 0) out_.instances.push_back({uint32_t(it->second), world});
         return true;
+    }
+
+    /// One instance per EXT_mesh_gpu_instancing entry, at the node's world matrix x the
+    /// entry's; entries whose matrix cannot be inverted are copied, like add_instance's
+    /// callers do. A skinned node ignores its own transform, so its instances would
+    /// coincide: it is drawn once.
+    void add_gpu_instances(int node_index, const std::optional<InstanceKey>& key, const Mat4& world,
+                           const std::vector<Mat4>& local) {
+        if (!key) {
+            if (m_.nodes[size_t(node_index)].skin >= 0)
+                log_warning(src_.file + ": " + indexed("nodes", size_t(node_index)) +
+                            ": EXT_mesh_gpu_instancing on a skinned node, drawn once");
+            add_mesh(node_index, world);
+            return;
+        }
+        for (const Mat4& m : local)
+            if (const Mat4 w = world * m; !add_instance(*key, w)) add_mesh(node_index, w);
     }
 
     void add_mesh(int node_index, const Mat4& world) {
@@ -325,8 +348,9 @@ class SceneBuilder {
     LoadedModel& out_;
     Materials materials_;
     std::vector<bool> visited_;
-    std::map<int, Mat4> node_world_;           ///< world matrix of every node in the scene
-    std::vector<std::pair<int, Mat4>> drawn_;  ///< nodes with a mesh, in walk order
+    std::map<int, Mat4> node_world_;                  ///< world matrix of every node in the scene
+    std::vector<std::pair<int, Mat4>> drawn_;         ///< nodes with a mesh, in walk order
+    std::map<int, std::vector<Mat4>> gpu_instances_;  ///< EXT_mesh_gpu_instancing matrices per node
     std::map<std::tuple<int, int, std::vector<double>>, std::optional<TriangleMesh>> primitives_;
     std::map<InstanceKey, int> prototype_of_;  ///< prototype index per shared mesh; -1: no triangles
 };

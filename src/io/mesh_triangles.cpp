@@ -30,7 +30,9 @@ TriangleMesh read_obj_triangles(const std::filesystem::path& file) {
 
 TriangleMesh read_mesh_triangles(const std::filesystem::path& file) {
     if (file_kind(file) != FileKind::gltf) return read_obj_triangles(file);
-    return merge_meshes(load_model(file), file.string());
+    LoadedModel model = load_model(file);
+    bake_instances(model);
+    return merge_meshes(model, file.string());
 }
 
 }  // namespace sahara

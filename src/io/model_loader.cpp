@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "io/files.h"
+#include "io/mesh_utils.h"
 
 namespace sahara {
 
@@ -16,6 +17,25 @@ LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from
                 file.string(), "",
                 "unknown model format '" + file.extension().string() + "' (expected .obj, .gltf or .glb)");
     }
+}
+
+void bake_instances(LoadedModel& model) {
+    if (model.instances.empty() && model.prototypes.empty()) return;
+    std::vector<bool> in_prototype(model.meshes.size(), false);
+    for (const PrototypeDesc& p : model.prototypes)
+        for (uint32_t m : p.meshes) in_prototype[m] = true;
+    std::vector<TriangleMesh> meshes;
+    for (size_t m = 0; m < model.meshes.size(); ++m)
+        if (!in_prototype[m]) meshes.push_back(std::move(model.meshes[m]));
+    for (const InstanceDesc& in : model.instances)
+        for (uint32_t m : model.prototypes[in.prototype].meshes) {
+            TriangleMesh copy = model.meshes[m];
+            transform_mesh(copy, in.world_from_object);
+            meshes.push_back(std::move(copy));
+        }
+    model.meshes = std::move(meshes);
+    model.prototypes.clear();
+    model.instances.clear();
 }
 
 }  // namespace sahara

@@ -2,6 +2,7 @@
 /// Loads a downloaded model (.obj with its .mtl, .gltf, .glb) into plain scene
 /// data. Loaders never build acceleration structures.
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "math/transform.h"
@@ -17,17 +18,26 @@ struct LoadedModel {
     std::vector<TextureDesc> textures;
     std::vector<LightDesc> lights;    ///< KHR_lights_punctual
     std::vector<CameraDesc> cameras;  ///< glTF cameras, world space
-    /// glTF meshes that several nodes draw: each one prototype (mesh indices into
-    /// `meshes`, in the mesh's own space) placed by one instance per node.
+    /// glTF meshes that several nodes draw, or that an EXT_mesh_gpu_instancing node
+    /// draws: each one prototype (mesh indices into `meshes`, in the mesh's own
+    /// space) placed by one instance per node or per entry.
     std::vector<PrototypeDesc> prototypes;
     std::vector<InstanceDesc> instances;
     size_t dropped_degenerate = 0;  ///< zero-area triangles removed
+    /// KHR_materials_variants names, for `sahara info`; every primitive keeps its default material.
+    std::vector<std::string> variants;
 };
 
 /// What a loader does with a glTF mesh that several nodes draw: copy it per node
 /// (every consumer of plain meshes), or load it once as a prototype placed by
-/// LoadedModel::instances (scene files, which the renderer instances).
+/// LoadedModel::instances (scene files, which the renderer instances). Nodes with
+/// EXT_mesh_gpu_instancing give instances either way; consumers that need every
+/// triangle in world space call bake_instances.
 enum class SharedMeshes : uint8_t { copy, instance };
+
+/// Replaces the model's prototypes and instances by world-space copies of the
+/// prototypes' meshes, one per instance, in instance order after the other meshes.
+void bake_instances(LoadedModel& model);
 
 /// Picks the loader by extension. Throws InputError naming the file and element.
 /// `world_from_model` is applied to positions/normals (and glTF node transforms before it).

@@ -6,6 +6,7 @@
 #include "base/log.h"
 #include "math/bounds.h"
 #include "io/image_io.h"
+#include "io/mesh_utils.h"
 #include "io/scene_parser.h"
 #include "io/studio_environment.h"
 
@@ -13,10 +14,27 @@ namespace sahara {
 
 namespace {
 
+/// World bounds: the plain meshes' points, and each instance's prototype box
+/// (in its own space) with its corners carried to the world.
 Bounds3 model_bounds(const LoadedModel& model) {
     Bounds3 b;
-    for (const TriangleMesh& m : model.meshes)
-        for (const Vec3& p : m.positions) b.extend(p);
+    std::vector<bool> in_prototype(model.meshes.size(), false);
+    std::vector<Bounds3> prototype_box(model.prototypes.size());
+    for (size_t p = 0; p < model.prototypes.size(); ++p)
+        for (uint32_t m : model.prototypes[p].meshes) {
+            in_prototype[m] = true;
+            prototype_box[p].extend(mesh_bounds(model.meshes[m]));
+        }
+    for (size_t m = 0; m < model.meshes.size(); ++m)
+        if (!in_prototype[m])
+            for (const Vec3& p : model.meshes[m].positions) b.extend(p);
+    for (const InstanceDesc& in : model.instances) {
+        const Bounds3& box = prototype_box[in.prototype];
+        for (int corner = 0; corner < 8; ++corner)
+            b.extend(in.world_from_object.apply_point({corner & 1 ? box.hi.x : box.lo.x,
+                                                       corner & 2 ? box.hi.y : box.lo.y,
+                                                       corner & 4 ? box.hi.z : box.lo.z}));
+    }
     return b;
 }
 

@@ -124,7 +124,8 @@ std::unique_ptr<CastMesh> mesh_from_file(const std::filesystem::path& path, cons
     const int n = threads_arg(threads, 0);
     py::gil_scoped_release release;
     const ThreadsInScope build_threads(n);
-    const LoadedModel model = load_model(path);
+    LoadedModel model = load_model(path);
+    bake_instances(model);  // triangle ids count every drawn triangle
     std::vector<Vec3> positions;
     std::vector<uint32_t> indices;
     for (const TriangleMesh& m : model.meshes) {

@@ -176,3 +176,32 @@ TEST_CASE("glTF EXT_meshopt_compression corrupt data is an InputError naming the
     }
     CHECK(refused > 0);
 }
+
+TEST_CASE("glTF EXT_meshopt_compression carries EXT_mesh_gpu_instancing rotations (QUATERNION filter)") {
+    const fs::path dir = scratch("meshopt_instancing");
+    const float h = std::sqrt(0.5f);
+    const std::vector<float> quats = {0, 0, h, h, 0.5f, 0.5f, 0.5f, 0.5f, 0, 1, 0, 0};
+    std::vector<int16_t> packed(quats.size());
+    meshopt_encodeFilterQuat(packed.data(), 3, 8, 16, quats.data());
+    const std::vector<float> moves = {0, 0, 0, 3, 0, 0, 0, 3, 0};
+    MeshoptDoc m;
+    m.d.j["extensionsRequired"] = {kExt, "EXT_mesh_gpu_instancing"};
+    const int rot =
+        m.accessor(encode_vertices(packed, 8), 3, 8, "ATTRIBUTES", "QUATERNION", 5122, "VEC4", true);
+    const int move = m.accessor(encode_vertices(moves, 12), 3, 12, "ATTRIBUTES", "NONE", 5126, "VEC3");
+    const int pos = m.accessor(encode_vertices(kTriangle, 12), 3, 12, "ATTRIBUTES", "NONE", 5126, "VEC3");
+    m.d.node({{"mesh", m.d.mesh(pos)},
+              {"extensions",
+               {{"EXT_mesh_gpu_instancing", {{"attributes", {{"ROTATION", rot}, {"TRANSLATION", move}}}}}}}});
+    const LoadedModel model = load_gltf(m.write(dir / "instanced.gltf"));
+    REQUIRE(model.instances.size() == 3);
+    for (size_t k = 0; k < 3; ++k) {
+        const Mat4 want =
+            Mat4::translate({moves[3 * k], moves[3 * k + 1], moves[3 * k + 2]}) *
+            Mat4::rotate_quaternion(quats[4 * k], quats[4 * k + 1], quats[4 * k + 2], quats[4 * k + 3]);
+        for (size_t r = 0; r < 3; ++r)
+            for (size_t c = 0; c < 4; ++c)
+                CHECK(model.instances[k].world_from_object.m[r][c] ==
+                      doctest::Approx(want.m[r][c]).epsilon(1e-3));
+    }
+}
