@@ -208,6 +208,8 @@ Vec3 coat_normal(const PbrLayersDesc& d, const SurfaceInteraction& si,
     return d.clearcoat_normal_texture >= 0
                ? mapped_normal(d.clearcoat_normal_texture, d.clearcoat_normal_scale, si, textures)
                : si.ns;
+}
+
 /// The tangent the anisotropy direction is measured from, orthogonal to the
 /// front-side normal n: the mesh's (glTF TANGENT, or generated from the UVs as
 /// for normal maps), else, on surfaces without one (analytic shapes), the
