@@ -97,16 +97,16 @@ __attribute__((always_inline)) inline int intersect_triangle_block4_simd(const T
     int mask = ~(mixed | exact_zero) & 0xF;
     // No branch on the sign test: whether any lane passes it is a coin toss for the predictor.
     const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
-    const __m128 t_scaled =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, rz[0])), _mm_mul_ps(v, _mm_mul_ps(sz, rz[1]))),
-                   _mm_mul_ps(w, _mm_mul_ps(sz, rz[2])));
+    const __m128 t_scaled = _mm_mul_ps(
+        sz, _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, rz[0]), _mm_mul_ps(v, rz[1])), _mm_mul_ps(w, rz[2])));
     const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
     const __m128 abs_det = _mm_xor_ps(det, sign);
     const __m128 t_signed = _mm_xor_ps(t_scaled, sign);
-    // NaN lanes fail the ordered comparisons.
-    __m128 ok = _mm_cmpneq_ps(det, zero);
-    ok = _mm_and_ps(ok, _mm_cmpgt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmin), abs_det)));
-    ok = _mm_and_ps(ok, _mm_cmplt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmax), abs_det)));
+    // No test of det != 0 (the scalar test's): the lanes left in `mask` have u, v, w
+    // non-zero with one sign bit, and such a sum is never 0. NaN lanes fail the ordered
+    // comparisons.
+    const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmin), abs_det)),
+                                 _mm_cmplt_ps(t_signed, _mm_mul_ps(_mm_set1_ps(tmax), abs_det)));
     mask &= _mm_movemask_ps(ok);
     int result = 0;
     if (mask) {
@@ -169,15 +169,15 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
     const int mixed = _mm256_movemask_ps(_mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w)));
     int mask = ~(mixed | exact_zero) & 0xFF;
     const __m256 det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-    const __m256 t_scaled = _mm256_add_ps(
-        _mm256_add_ps(_mm256_mul_ps(u, _mm256_mul_ps(sz, rz[0])), _mm256_mul_ps(v, _mm256_mul_ps(sz, rz[1]))),
-        _mm256_mul_ps(w, _mm256_mul_ps(sz, rz[2])));
+    const __m256 t_scaled =
+        _mm256_mul_ps(sz, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(u, rz[0]), _mm256_mul_ps(v, rz[1])),
+                                        _mm256_mul_ps(w, rz[2])));
     const __m256 sign = _mm256_and_ps(det, _mm256_set1_ps(-0.0f));
     const __m256 abs_det = _mm256_xor_ps(det, sign);
     const __m256 t_signed = _mm256_xor_ps(t_scaled, sign);
-    __m256 ok = _mm256_cmp_ps(det, zero, _CMP_NEQ_UQ);
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ));
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
+    const __m256 ok =
+        _mm256_and_ps(_mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmin), abs_det), _CMP_GT_OQ),
+                      _mm256_cmp_ps(t_signed, _mm256_mul_ps(_mm256_set1_ps(tmax), abs_det), _CMP_LT_OQ));
     mask &= _mm256_movemask_ps(ok);
     int result = 0;
     if (mask) {

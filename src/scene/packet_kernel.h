@@ -204,10 +204,9 @@ template <int kIsa>
     }
     F x[3], y[3], z[3];
     for (int v = 0; v < 3; ++v) {
-        const F rz = splat<kIsa>(b.p[v][c.kz][l]) - s.oz;
-        x[v] = (splat<kIsa>(b.p[v][c.kx][l]) - s.ox) - s.sx * rz;
-        y[v] = (splat<kIsa>(b.p[v][c.ky][l]) - s.oy) - s.sy * rz;
-        z[v] = s.sz * rz;
+        z[v] = splat<kIsa>(b.p[v][c.kz][l]) - s.oz;
+        x[v] = (splat<kIsa>(b.p[v][c.kx][l]) - s.ox) - s.sx * z[v];
+        y[v] = (splat<kIsa>(b.p[v][c.ky][l]) - s.oy) - s.sy * z[v];
     }
     const F u = x[2] * y[1] - y[2] * x[1];
     const F v = x[0] * y[2] - y[0] * x[2];
@@ -217,12 +216,12 @@ template <int kIsa>
     const I any_neg = (u < zero) | (v < zero) | (w < zero);
     const I any_pos = (u > zero) | (v > zero) | (w > zero);
     const F det = (u + v) + w;
-    const F t_scaled = (u * z[0] + v * z[1]) + w * z[2];
+    const F t_scaled = s.sz * ((u * z[0] + v * z[1]) + w * z[2]);  // as TriangleVerts::intersect
     const I sign = std::bit_cast<I>(det) & int32_t(0x80000000u);
     const F abs_det = std::bit_cast<F>(std::bit_cast<I>(det) ^ sign);
     const F t_signed = std::bit_cast<F>(std::bit_cast<I>(t_scaled) ^ sign);
-    const I ok =
-        ~(any_neg & any_pos) & (det != zero) & (t_signed > s.tmin * abs_det) & (t_signed < s.tmax * abs_det);
+    // det != 0 needs no test: the lanes kept have u, v, w non-zero and of one sign.
+    const I ok = ~(any_neg & any_pos) & (t_signed > s.tmin * abs_det) & (t_signed < s.tmax * abs_det);
     const uint32_t bits = mask_of<kIsa>(ok) & mask & ~exact_zero;
     const uint32_t id = b.slot[l];  // a triangle lane holds its primitive id
     if (bits) {

@@ -5,6 +5,7 @@
 // point and the table that emits its forms (trace_form_table), so an edit elsewhere in
 // the accelerator cannot change the code GCC makes for the hot loop, and with it the
 // loop's speed. Include only from those files.
+#include <new>
 #include <tuple>
 #include <type_traits>
 #include <utility>
@@ -28,17 +29,23 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
     // many never reach one (shadow rays that are not blocked, camera rays from outside that
     // miss).
     BvhRay br(ray);
-    TriangleRay tr;
+    // Storage only: TriangleRay's member defaults would be stores that every ray pays
+    // before its first node and that many never read.
+    union LazyTriangleRay {
+        LazyTriangleRay() {}
+        TriangleRay tr;
+    } lazy;
     bool tr_ready = false;
     auto triangle_ray = [&]() __attribute__((always_inline))->const TriangleRay& {
         if (!tr_ready) {
             // Closest-hit rays are mostly bounces, occlusion rays mostly head for a light.
             // Only the AVX-512 body takes 1 / d[kz] from the box test's inverse direction:
             // the AVX2 body divides, which is faster there.
-            tr = kAnyHit ? TriangleRay(ray) : TriangleRay::scattered(ray, kAvx512 ? br.inv_dir : nullptr);
+            new (&lazy.tr) TriangleRay(kAnyHit ? TriangleRay(ray)
+                                               : TriangleRay::scattered(ray, kAvx512 ? br.inv_dir : nullptr));
             tr_ready = true;
         }
-        return tr;
+        return lazy.tr;
     };
     if constexpr (!kAnyHit)
         if (bounds_.contains(ray.origin)) triangle_ray();

@@ -1,9 +1,11 @@
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 
+#include "accel/simd_path.h"
 #include "scene/accelerator.h"
 #include "base/error.h"
 #include "io/mesh_triangles.h"
@@ -16,6 +18,11 @@ using namespace sahara;
 using namespace sahara::test;
 
 namespace {
+
+/// Restores automatic SIMD path selection when a test ends.
+struct SimdPathGuard {
+    ~SimdPathGuard() { force_simd_path(best_simd_path()); }
+};
 
 bool hit_triangle(const Ray& r, const Vec3& a, const Vec3& b, const Vec3& c, ShapeHit& h) {
     const std::optional<ShapeHit> hit = TriangleVerts::of(a, b, c).intersect(r);
@@ -137,6 +144,97 @@ TEST_CASE("watertight: brute-force triangle loop, rays through vertices of a clo
         if (!any) ++escapes;
     }
     CHECK(escapes == 0);
+}
+
+namespace {
+
+/// A closed fan: `n` triangles around `center`, their outer vertices on a ring of radius
+/// `r` with a little height, so that the fan is not planar and no edge lies along an axis;
+/// beyond it, a ring of small triangles (lateral distance 3 r and more) that gives the
+/// tree inner nodes, so that the fan's triangles sit in leaves below them.
+TriangleMesh fan_mesh(Vec3 center, float r, int n) {
+    TriangleMesh m;
+    m.name = "fan";
+    m.positions.push_back(center);
+    for (int i = 0; i < n; ++i) {
+        const float a = 6.2831853f * (float(i) + 0.137f * float(i % 3)) / float(n);
+        m.positions.push_back(center +
+                              Vec3(r * std::cos(a), r * std::sin(a), 0.05f * r * float((i * 5) % 3 - 1)));
+    }
+    for (int i = 0; i < n; ++i)
+        m.indices.insert(m.indices.end(), {0u, uint32_t(1 + i), uint32_t(1 + (i + 1) % n)});
+    for (int k = 0; k < 64; ++k) {
+        const float a = 6.2831853f * float(k) / 64.0f, d = r * (3.0f + float(k % 4));
+        const uint32_t base = uint32_t(m.positions.size());
+        const Vec3 p = center + Vec3(d * std::cos(a), d * std::sin(a), 0.0f);
+        m.positions.insert(m.positions.end(),
+                           {p, p + Vec3(0.2f * r, 0, 0), p + Vec3(0, 0.2f * r, 0.01f * r)});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    return m;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "watertight: rays at the shared edges and the centre of a fan hit it on every SIMD path, near and far") {
+    struct Placement {
+        Vec3 center;
+        float radius;
+    };
+    // Near the world origin, some thousands away, and a few hundred thousand away (where a
+    // float's spacing is 1/32), the fan scaled so that it spans many of those steps.
+    const Placement placements[] = {{{0.3f, -0.2f, 0.1f}, 1.0f},
+                                    {{1000.5f, -2000.25f, 500.0f}, 1.0f},
+                                    {{-3.0e5f, 1.0e5f, 2.0e5f}, 64.0f}};
+    SimdPathGuard guard;
+    int rays = 0, lost = 0, lost_occlusion = 0, lost_scalar = 0;
+    for (const int n : {4, 7})
+        for (const Placement& pl : placements) {
+            const TriangleMesh m = fan_mesh(pl.center, pl.radius, n);
+            Scene scene = scene_from_mesh(m);
+            std::vector<TriangleVerts> fan;
+            for (int i = 0; i < n; ++i)
+                fan.push_back(TriangleVerts::of(m.positions[0], m.positions[size_t(1 + i)],
+                                                m.positions[size_t(1 + (i + 1) % n)]));
+            // The shared vertex exactly, and points of the shared (inner) edges, rounded to float.
+            std::vector<Vec3> targets = {m.positions[0]};
+            for (int i = 0; i < n; ++i)
+                for (int k = 1; k < 10; ++k)
+                    targets.push_back(m.positions[0] +
+                                      (m.positions[size_t(1 + i)] - m.positions[0]) * (0.1f * float(k)));
+            for (SimdPath path : runnable_simd_paths()) {
+                force_simd_path(path);
+                const Accelerator acc(scene);
+                // Origins above the fan (within 60 degrees of its axis), from two radii
+                // to ten thousand radii away.
+                for (const float dist : {2.0f, 50.0f, 1.0e4f})
+                    for (int o = 0; o < 6; ++o) {
+                        const float a = 1.1f * float(o), tilt = 0.15f * float(o % 4);
+                        const Vec3 origin =
+                            pl.center + Vec3(std::sin(tilt) * std::cos(a), std::sin(tilt) * std::sin(a),
+                                             o % 2 ? std::cos(tilt) : -std::cos(tilt)) *
+                                            (dist * pl.radius);
+                        for (const Vec3& target : targets) {
+                            ++rays;
+                            const Ray r{origin, target - origin};
+                            Ray closest = r;
+                            Hit h;
+                            if (!acc.intersect(closest, h) || prim_index(h.prim) >= uint32_t(n)) ++lost;
+                            if (!acc.occluded(Ray{origin, target - origin, 0.0f, 1.5f})) ++lost_occlusion;
+                            const TriangleRay tr(r);
+                            bool any = false;
+                            for (const TriangleVerts& t : fan)
+                                any |= t.intersect(tr, r.tmin, r.tmax).has_value();
+                            if (!any) ++lost_scalar;
+                        }
+                    }
+            }
+        }
+    CHECK(rays > 2000);
+    CHECK(lost == 0);
+    CHECK(lost_occlusion == 0);
+    CHECK(lost_scalar == 0);
 }
 
 TEST_CASE("geometric normal, shading normal and uv interpolation") {
