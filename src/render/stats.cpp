@@ -70,6 +70,15 @@ SceneMemory estimate_scene_memory(const Scene& scene) {
     if (scene.background.image) m.textures += uint64_t(scene.background.image->rgba.size()) * sizeof(float);
     const uint64_t bounded = scene.spheres.size() + scene.triangles.size() + scene.boxes.size();
     m.bvh_estimate = bounded * (2 * 32 + 4);
+    // Instanced meshes count once, however many instances place them; they share the
+    // scene's textures. Their trees are built, so their size is known, not estimated.
+    for (const Scene* p : scene.prototypes()) {
+        const SceneMemory pm = estimate_scene_memory(*p);
+        m.spheres += pm.spheres;
+        m.triangles += pm.triangles;
+        m.other_geometry += pm.other_geometry;
+    }
+    m.bvh_estimate += scene.instance_level_bytes();
     return m;
 }
 

@@ -38,7 +38,8 @@ class StatsReport {
 struct SceneMemory {
     uint64_t spheres = 0, triangles = 0, other_geometry = 0, textures = 0;
     /// Estimate for a binary BVH: about 2 nodes of 32 bytes per primitive plus
-    /// a 4-byte index each, until the accelerator reports its own size.
+    /// a 4-byte index each, until the accelerator reports its own size; plus the
+    /// instance level's trees and records (built, so measured).
     uint64_t bvh_estimate = 0;
     uint64_t total() const { return spheres + triangles + other_geometry + textures + bvh_estimate; }
 };

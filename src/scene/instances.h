@@ -58,6 +58,7 @@ class InstanceSet {
     /// The top-level tree (its leaves hold instance indices), for reports.
     const Bvh& top_level() const { return top_; }
     size_t prototype_count() const { return prototypes_.size(); }
+    const Scene& prototype(size_t i) const { return prototypes_[i]; }
     /// Triangles stored once per prototype (what memory holds)...
     size_t unique_triangle_count() const;
     /// ... and as drawn (what a flattened scene would hold).

@@ -34,6 +34,15 @@ void Scene::build_accelerator() {
     if (instances_) bounds_.extend(instances_->bounds());
 }
 
+std::vector<const Scene*> Scene::prototypes() const {
+    std::vector<const Scene*> out;
+    for (size_t i = 0; instances_ && i < instances_->prototype_count(); ++i)
+        out.push_back(&instances_->prototype(i));
+    return out;
+}
+
+size_t Scene::instance_level_bytes() const { return instances_ ? instances_->bytes() : 0; }
+
 void Scene::set_instances(std::unique_ptr<InstanceSet> instances) { instances_ = std::move(instances); }
 
 namespace {

@@ -174,6 +174,10 @@ class Scene {
     const Accelerator* accelerator() const { return accel_.get(); }
     /// The instance level; null for scenes without instances (the flat tree alone).
     const InstanceSet* instances() const { return instances_.get(); }
+    /// For memory reports: the bottom-level scenes the instances place (each once;
+    /// none without instances) and the bytes of the instance level's trees and records.
+    std::vector<const Scene*> prototypes() const;
+    size_t instance_level_bytes() const;
     /// Adds the instance level; call before build_accelerator() (bounds include it).
     void set_instances(std::unique_ptr<InstanceSet> instances);
     /// Emitter id of triangle `triangle` of the prototype that `instance` places

@@ -9,6 +9,7 @@
 #include "mesh_fixtures.h"
 #include "render/film.h"
 #include "render/renderer.h"
+#include "render/stats.h"
 #include "scene/instances.h"
 #include "scene/scene.h"
 
@@ -126,6 +127,30 @@ TEST_CASE("instances: an instanced mesh renders the same pixels as the same mesh
             CHECK(differing_fraction(a, b, 1e-3) < 0.01);
             CHECK(differing_fraction(a, b, 0.05) < 0.005);
         }
+}
+
+TEST_CASE("instances: the memory estimate counts an instanced mesh once and its trees") {
+    const TriangleMesh ball = make_icosphere(2);
+    SceneDesc one = camera_scene(8, 8), many = camera_scene(8, 8);
+    for (SceneDesc* d : {&one, &many}) {
+        d->meshes.push_back(ball);
+        d->prototypes.push_back({"ball", {0}});
+    }
+    one.instances.push_back({0, Mat4::translate({0, 0, 0})});
+    for (int k = 0; k < 50; ++k) many.instances.push_back({0, Mat4::translate({double(k), 0, 0})});
+    const SceneDesc flat_desc = [&] {
+        SceneDesc d = camera_scene(8, 8);
+        d.meshes.push_back(ball);
+        return d;
+    }();
+    const Scene a = build_scene(one), b = build_scene(many), flat = build_scene(flat_desc);
+    const SceneMemory ma = estimate_scene_memory(a), mb = estimate_scene_memory(b),
+                      mf = estimate_scene_memory(flat);
+    REQUIRE(mf.triangles > 0);
+    CHECK(ma.triangles == mf.triangles);  // the prototype's arrays, once
+    CHECK(mb.triangles == mf.triangles);
+    CHECK(ma.bvh_estimate > 0);
+    CHECK(mb.bvh_estimate > ma.bvh_estimate);  // the top-level tree and the records grow
 }
 
 TEST_CASE("instances: shading normals follow the inverse transpose under non-uniform scale") {
