@@ -7,7 +7,7 @@
 #include <cmath>
 #include <vector>
 
-#include "bsdf_test_util.h"
+#include "pbr_test_util.h"
 #include "render/bsdf_pbr.h"
 #include "render/film.h"
 #include "render/renderer.h"
@@ -30,14 +30,6 @@ Bsdf bsdf_with_tangent(const MaterialDesc& m) {
     si.ng = si.ns = Vec3(0, 0, 1);
     si.tangent = Vec3(1, 0, 0);
     return make_bsdf(m, si, {});
-}
-
-Stat directional_albedo(const Bsdf& b, const Vec3& wo, int n) {
-    return sample_stats(n, 5, [&](Sampler& s) {
-        BsdfSample bs;
-        const Vec2 u = s.next_2d();
-        return sample_pbr(b, wo, u, s.next_1d(), bs) ? bs.weight : Rgb(0.0f);
-    });
 }
 
 /// Anisotropic materials over the roughnesses and strengths the tests cover.
@@ -167,19 +159,7 @@ TEST_CASE("anisotropic pbr sampler follows the pdf eval_pbr reports (chi-square)
         for (float cos_o : {0.8f, 0.3f}) {
             const Bsdf b = bsdf_with_tangent(m);
             const Vec3 wo = direction(cos_o, 1.0f);
-            auto sample = [&](Sampler& s, Vec3& wi) {
-                BsdfSample bs;
-                const Vec2 u = s.next_2d();
-                if (!sample_pbr(b, wo, u, s.next_1d(), bs)) return false;
-                wi = bs.wi;
-                return true;
-            };
-            auto pdf = [&](const Vec3& wi) {
-                float p = 0;
-                eval_pbr(b, wo, wi, &p);
-                return p;
-            };
-            const double z = chi2_deviate(n, sample, pdf);
+            const double z = pbr_chi2_deviate(n, b, wo);
             INFO("metallic " << m.metallic << " transmission " << m.transmission << " cos_o " << cos_o
                              << " deviate " << z);
             CHECK(z < 3.5);
@@ -187,43 +167,22 @@ TEST_CASE("anisotropic pbr sampler follows the pdf eval_pbr reports (chi-square)
 }
 
 TEST_CASE("anisotropic pdfs integrate to one and pbr to its sampler's success rate") {
-    constexpr int kN = 400;
     for (const auto& [ax, ay] : {std::pair{0.1f, 0.6f}, std::pair{0.8f, 0.2f}})
         for (float cos_o : {0.9f, 0.3f}) {
             const Vec3 wo = direction(cos_o, 0.5f);
-            double sum = 0;
-            for (int i = 0; i < kN; ++i)
-                for (int j = 0; j < kN; ++j) {
-                    const Vec3 wm = direction((float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN);
-                    sum += double(ggx_vndf_pdf(wo, wm, ax, ay));
-                }
-            CHECK(sum * (2 * double(kPi)) / (double(kN) * kN) == doctest::Approx(1.0).epsilon(0.01));
+            const double sum =
+                upper_hemisphere_integral([&](const Vec3& wm) { return ggx_vndf_pdf(wo, wm, ax, ay); });
+            CHECK(sum == doctest::Approx(1.0).epsilon(0.01));
         }
     for (float transmission : {0.0f, 1.0f}) {
         MaterialDesc m = anisotropic(pbr(Rgb(0.7f), 0.3f, 0.4f), 0.9f, 0.2f);
         m.transmission = transmission;
         const Bsdf b = bsdf_with_tangent(m);
         const Vec3 wo = direction(0.6f, 0.3f);
-        double integral = 0;
-        for (int i = 0; i < 2 * kN; ++i)
-            for (int j = 0; j < kN; ++j) {
-                float p = 0;
-                eval_pbr(b, wo, direction(-1.0f + (float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN),
-                         &p);
-                integral += double(p);
-            }
-        integral *= 4 * double(kPi) / (2.0 * kN * kN);
-        Sampler s(3, SamplerType::independent);
-        s.start(0, 0, 0);
-        int ok = 0;
-        const int n = 100000;
-        for (int k = 0; k < n; ++k) {
-            BsdfSample bs;
-            const Vec2 u = s.next_2d();
-            ok += sample_pbr(b, wo, u, s.next_1d(), bs) ? 1 : 0;
-        }
+        const double integral = pbr_pdf_integral(b, wo);
+        const double success = pbr_sample_success_rate(b, wo, 100000);
         INFO("transmission " << transmission);
-        CHECK(integral == doctest::Approx(double(ok) / n).epsilon(0.01));
+        CHECK(integral == doctest::Approx(success).epsilon(0.01));
         CHECK(integral <= 1.01);
     }
 }

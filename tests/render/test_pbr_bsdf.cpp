@@ -5,7 +5,7 @@
 
 #include "render/bsdf_pbr.h"
 #include "render/ggx_albedo.h"
-#include "bsdf_test_util.h"
+#include "pbr_test_util.h"
 #include "render_test_util.h"
 
 using namespace sahara;
@@ -42,36 +42,19 @@ TEST_CASE("pbr sampler follows the pdf eval_pbr reports (chi-square)") {
     for (const Case& c : cases) {
         const Bsdf b = bsdf_of(c.m);
         const Vec3 wo = direction(c.cos_o, 1.0f);
-        auto sample = [&](Sampler& s, Vec3& wi) {
-            BsdfSample bs;
-            const Vec2 u = s.next_2d();
-            if (!sample_pbr(b, wo, u, s.next_1d(), bs)) return false;
-            wi = bs.wi;
-            return true;
-        };
-        auto pdf = [&](const Vec3& wi) {
-            float p = 0;
-            eval_pbr(b, wo, wi, &p);
-            return p;
-        };
-        const double z = chi2_deviate(n, sample, pdf);
+        const double z = pbr_chi2_deviate(n, b, wo);
         INFO("metallic " << c.m.metallic << " roughness " << c.m.roughness << " deviate " << z);
         CHECK(z < 3.5);
     }
 }
 
 TEST_CASE("pdfs integrate to one: visible normals exactly, pbr to its sampler's success rate") {
-    constexpr int kN = 400;  // stratified (cos theta, phi) grid
     for (float alpha : {0.1f, 0.4f, 1.0f})
         for (float cos_o : {0.9f, 0.3f}) {
             const Vec3 wo = direction(cos_o, 0.0f);
-            double sum = 0;
-            for (int i = 0; i < kN; ++i)
-                for (int j = 0; j < kN; ++j) {
-                    const Vec3 wm = direction((float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN);
-                    sum += double(ggx_vndf_pdf(wo, wm, alpha));
-                }
-            CHECK(sum * (2 * double(kPi)) / (double(kN) * kN) == doctest::Approx(1.0).epsilon(0.01));
+            const double sum =
+                upper_hemisphere_integral([&](const Vec3& wm) { return ggx_vndf_pdf(wo, wm, alpha); });
+            CHECK(sum == doctest::Approx(1.0).epsilon(0.01));
         }
     for (float roughness : {0.3f, 0.7f})
         for (float transmission : {0.0f, 1.0f}) {
@@ -79,26 +62,10 @@ TEST_CASE("pdfs integrate to one: visible normals exactly, pbr to its sampler's 
             m.transmission = transmission;
             const Bsdf b = bsdf_of(m);
             const Vec3 wo = direction(0.6f, 0.0f);
-            double integral = 0;
-            for (int i = 0; i < 2 * kN; ++i)
-                for (int j = 0; j < kN; ++j) {
-                    float p = 0;
-                    eval_pbr(b, wo,
-                             direction(-1.0f + (float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN), &p);
-                    integral += double(p);
-                }
-            integral *= 4 * double(kPi) / (2.0 * kN * kN);
-            Sampler s(3, SamplerType::independent);
-            s.start(0, 0, 0);
-            int ok = 0;
-            const int n = 100000;
-            for (int k = 0; k < n; ++k) {
-                BsdfSample bs;
-                const Vec2 u = s.next_2d();
-                ok += sample_pbr(b, wo, u, s.next_1d(), bs) ? 1 : 0;
-            }
+            const double integral = pbr_pdf_integral(b, wo);
+            const double success = pbr_sample_success_rate(b, wo, 100000);
             INFO("roughness " << roughness << " transmission " << transmission);
-            CHECK(integral == doctest::Approx(double(ok) / n).epsilon(0.01));
+            CHECK(integral == doctest::Approx(success).epsilon(0.01));
             CHECK(integral <= 1.01);
         }
 }

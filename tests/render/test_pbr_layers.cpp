@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "bsdf_test_util.h"
+#include "pbr_test_util.h"
 #include "render/bsdf_layers.h"
 #include "render/bsdf_pbr.h"
 #include "render/ggx_albedo.h"
@@ -38,16 +38,6 @@ Bsdf tilted_coat(const MaterialDesc& m, float tilt) {
     b.layers.coat_normal = Vec3(std::sin(tilt), 0.0f, std::cos(tilt));
     b.layers.coat_frame = true;
     return b;
-}
-
-/// Directional albedo at wo by importance sampling: mean and standard error of
-/// the sample weights (a failed sample counts zero).
-Stat directional_albedo(const Bsdf& b, const Vec3& wo, int n) {
-    return sample_stats(n, 5, [&](Sampler& s) {
-        BsdfSample bs;
-        const Vec2 u = s.next_2d();
-        return sample_pbr(b, wo, u, s.next_1d(), bs) ? bs.weight : Rgb(0.0f);
-    });
 }
 
 /// The layered materials the tests run over: coats and sheens of every
@@ -160,39 +150,18 @@ TEST_CASE("pbr layers: the sampler follows the pdf eval_pbr reports (chi-square)
         {bsdf_of(glass), 0.7f, "coat over glass"}};
     for (const Case& c : cases) {
         const Vec3 wo = direction(c.cos_o, 1.0f);
-        auto sample = [&](Sampler& s, Vec3& wi) {
-            BsdfSample bs;
-            const Vec2 u = s.next_2d();
-            if (!sample_pbr(c.b, wo, u, s.next_1d(), bs)) return false;
-            wi = bs.wi;
-            return true;
-        };
-        auto pdf = [&](const Vec3& wi) {
-            float p = 0;
-            eval_pbr(c.b, wo, wi, &p);
-            return p;
-        };
-        const double z = chi2_deviate(n, sample, pdf);
+        const double z = pbr_chi2_deviate(n, c.b, wo);
         INFO(std::string(c.what) << ": deviate " << z);
         CHECK(z < 3.5);
     }
 }
 
 TEST_CASE("pbr layers: pdfs integrate to the sampler's success rate and samples carry f / pdf") {
-    constexpr int kN = 400;  // stratified (cos theta, phi) grid over the sphere
     const MaterialDesc red = pbr(Rgb(0.7f, 0.2f, 0.2f), 0.3f, 0.5f);
     for (const Bsdf& b : {bsdf_of(coated(red, 1.0f, 0.4f)), bsdf_of(sheened(red, Rgb(0.8f), 0.6f)),
                           bsdf_of(coated(sheened(red, Rgb(0.8f), 0.2f), 0.6f, 0.6f))}) {
         const Vec3 wo = direction(0.6f, 0.0f);
-        double integral = 0;
-        for (int i = 0; i < 2 * kN; ++i)
-            for (int j = 0; j < kN; ++j) {
-                float p = 0;
-                eval_pbr(b, wo, direction(-1.0f + (float(i) + 0.5f) / kN, 2 * kPi * (float(j) + 0.5f) / kN),
-                         &p);
-                integral += double(p);
-            }
-        integral *= 4 * double(kPi) / (2.0 * kN * kN);
+        const double integral = pbr_pdf_integral(b, wo);
         Sampler s(3, SamplerType::independent);
         s.start(0, 0, 0);
         int ok = 0;
