@@ -143,19 +143,26 @@ TEST_CASE("pbr inputs: generated tangents follow u and flip their sign on mirror
     CHECK(generate_tangents(mesh).empty());
 }
 
-TEST_CASE("pbr inputs: a normal-mapped mesh without tangents gets them at scene build") {
-    SceneDesc d = empty_scene(Rgb(0.0f));
-    MaterialDesc m = white_pbr();
-    m.normal_texture = 0;
-    d.textures.push_back(strip({Rgb(0.5f, 0.5f, 1.0f)}));
-    d.materials.push_back(m);
-    d.meshes.push_back(square());
-    const Scene scene = build_scene(d);
-    REQUIRE(scene.triangles.tangents.size() == 4);
-    Ray ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0.0f, kInfinity, 0.0f};
-    Hit hit;
-    REQUIRE(scene.intersect(ray, hit));
-    CHECK(scene.interact(ray, hit).tangent.x == doctest::Approx(1.0f));
+TEST_CASE("pbr inputs: a normal-mapped or anisotropic mesh without tangents gets them at scene build") {
+    for (const bool normal_mapped : {true, false}) {
+        SceneDesc d = empty_scene(Rgb(0.0f));
+        MaterialDesc m = white_pbr();
+        if (normal_mapped) {
+            m.normal_texture = 0;
+            d.textures.push_back(strip({Rgb(0.5f, 0.5f, 1.0f)}));
+        } else {
+            m.anisotropy = 0.5f;
+        }
+        d.materials.push_back(m);
+        d.meshes.push_back(square());
+        const Scene scene = build_scene(d);
+        CAPTURE(normal_mapped);
+        REQUIRE(scene.triangles.tangents.size() == 4);
+        Ray ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0.0f, kInfinity, 0.0f};
+        Hit hit;
+        REQUIRE(scene.intersect(ray, hit));
+        CHECK(scene.interact(ray, hit).tangent.x == doctest::Approx(1.0f));
+    }
 }
 
 TEST_CASE("pbr inputs: one-sided materials are invisible from behind, for hits and shadows") {
@@ -207,18 +214,4 @@ TEST_CASE(
     m.anisotropy_rotation = 0.5f * kPi;  // turns the bitangent to -tangent
     b = make_bsdf(m, si, textures);
     CHECK(dot(b.frame.s, Vec3(-1, 0, 0)) == doctest::Approx(1.0f));
-}
-
-TEST_CASE("pbr inputs: an anisotropic mesh without tangents gets them at scene build") {
-    SceneDesc d = empty_scene(Rgb(0.0f));
-    MaterialDesc m = white_pbr();
-    m.anisotropy = 0.5f;
-    d.materials.push_back(m);
-    d.meshes.push_back(square());
-    const Scene scene = build_scene(d);
-    REQUIRE(scene.triangles.tangents.size() == 4);
-    Ray ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 0.0f, kInfinity, 0.0f};
-    Hit hit;
-    REQUIRE(scene.intersect(ray, hit));
-    CHECK(scene.interact(ray, hit).tangent.x == doctest::Approx(1.0f));
 }
