@@ -77,6 +77,17 @@ inline Stat sample_stats(int n, uint64_t seed, const std::function<Rgb(Sampler&)
     return {Rgb(mean), Rgb(se)};
 }
 
+/// One estimate_radiance sample along `ray` in the scene built from `d` with
+/// `integrator`: the exact value wherever the path is deterministic (emission
+/// seen directly, mirrors, pass-through surfaces).
+inline Rgb radiance_along(SceneDesc d, IntegratorType integrator, const Ray& ray, int max_depth) {
+    d.render.integrator = integrator;
+    const Scene scene = build_scene(d);
+    Sampler sampler(3, SamplerType::independent);
+    sampler.start(0, 0, 0);
+    return estimate_radiance(scene, ray, sampler, max_depth);
+}
+
 /// Statistics of estimate_radiance along one ray.
 inline Stat radiance_stats(const Scene& scene, const Ray& ray, int n, int max_depth, uint64_t seed = 1) {
     return sample_stats(n, seed, [&](Sampler& s) { return estimate_radiance(scene, ray, s, max_depth); });

@@ -40,16 +40,6 @@ MaterialDesc glowing_pbr(Rgb radiance) {
     return m;
 }
 
-/// What one ray sees with `integrator` and max_depth 1: emission only, no bounce.
-Rgb seen(const SceneDesc& d, IntegratorType integrator, const Ray& ray) {
-    SceneDesc copy = d;
-    copy.render.integrator = integrator;
-    const Scene scene = build_scene(copy);
-    Sampler sampler(3, SamplerType::independent);
-    sampler.start(0, 0, 0);
-    return estimate_radiance(scene, ray, sampler, 1);
-}
-
 /// KHR_materials_clearcoat's attenuation of the emission, written out: 1 - c (0.04 + 0.96 (1 - cos)^5).
 float through_coat(float clearcoat, float cos) {
     return 1.0f - clearcoat * (0.04f + 0.96f * std::pow(1.0f - cos, 5.0f));
@@ -71,17 +61,17 @@ TEST_CASE("pbr emission: a clearcoat darkens the emission under it by its Fresne
         for (IntegratorType integrator : {IntegratorType::path, IntegratorType::whitted}) {
             CAPTURE(int(integrator));
             MaterialDesc lamp = glowing_pbr(le);
-            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+            CHECK(radiance_along(panel_scene(lamp), integrator, ray, 1) == le);
             lamp.layers.clearcoat = 0.8f;
-            const Rgb coated = seen(panel_scene(lamp), integrator, ray);
+            const Rgb coated = radiance_along(panel_scene(lamp), integrator, ray, 1);
             for (int c = 0; c < 3; ++c)
                 CHECK(coated[c] == doctest::Approx(le[c] * through_coat(0.8f, cos)).epsilon(1e-5));
             lamp.layers.clearcoat = 0.0f;
             lamp.layers.clearcoat_roughness = 0.7f;  // a coat of weight 0 is no coat, whatever its roughness
-            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+            CHECK(radiance_along(panel_scene(lamp), integrator, ray, 1) == le);
             lamp.layers.sheen_color = Rgb(1.0f);  // KHR_materials_sheen leaves emission alone
             lamp.layers.sheen_roughness = 0.5f;
-            CHECK(seen(panel_scene(lamp), integrator, ray) == le);
+            CHECK(radiance_along(panel_scene(lamp), integrator, ray, 1) == le);
         }
     }
     CHECK(through_coat(0.8f, 0.1f) < 0.52f);  // the grazing view is the one that shows the coat

@@ -6,6 +6,7 @@
 
 #include "render/bsdf_pbr.h"
 #include "render/ggx_albedo.h"
+#include "bsdf_test_util.h"
 #include "render_test_util.h"
 
 using namespace sahara;
@@ -14,25 +15,10 @@ using namespace sahara::test;
 namespace {
 
 MaterialDesc specular_pbr(Rgb base, float roughness, float strength, Rgb color) {
-    MaterialDesc m;
-    m.type = MaterialType::pbr;
-    m.albedo.color = base;
-    m.metallic = 0;
-    m.roughness = roughness;
+    MaterialDesc m = pbr(base, 0.0f, roughness);
     m.specular = strength;
     m.specular_color = color;
     return m;
-}
-
-Bsdf bsdf_of(const MaterialDesc& m) {
-    SurfaceInteraction si;
-    si.ng = si.ns = Vec3(0, 0, 1);
-    return make_bsdf(m, si, {});
-}
-
-Vec3 direction(float cos_theta, float phi) {
-    const float s = std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta));
-    return {s * std::cos(phi), s * std::sin(phi), cos_theta};
 }
 
 Stat furnace(const MaterialDesc& m, float x) {

@@ -68,13 +68,9 @@ const Ray kDown{Vec3(0.25f, 0.1f, 5), Vec3(0, 0, -1)};
 /// reflection and the way from there to (-1.5, 0, 2) both cross the quad.
 const Ray kBeside{Vec3(3, 0, 1), normalize(Vec3(-1.5f, 0, -1))};
 
+/// What one ray sees at the scene's own max_depth.
 Rgb radiance(const SceneDesc& d, IntegratorType integrator, const Ray& ray) {
-    SceneDesc copy = d;
-    copy.render.integrator = integrator;
-    const Scene scene = build_scene(copy);
-    Sampler sampler(3, SamplerType::independent);
-    sampler.start(0, 0, 0);
-    return estimate_radiance(scene, ray, sampler, copy.render.max_depth);
+    return radiance_along(d, integrator, ray, d.render.max_depth);
 }
 
 }  // namespace
