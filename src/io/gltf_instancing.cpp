@@ -1,5 +1,6 @@
 // EXT_mesh_gpu_instancing: per-instance TRANSLATION, ROTATION and SCALE
-// accessors on a node, read into one node-space matrix per instance.
+// accessors on a node, read into one node-space matrix per instance; custom
+// attributes (`_ID`, ...) only count the instances.
 #include <cmath>
 #include <optional>
 
@@ -47,13 +48,8 @@ class InstancingReader {
     std::vector<double> read(const Attribute& a) {
         if (!attributes_.Has(a.name)) return {};
         const std::string element = element_ + "." + a.name;
-        const tinygltf::Value& v = attributes_.Get(a.name);
-        if (!v.IsInt()) throw input_error(src_.file, element, "must be an accessor index");
-        const int index = v.GetNumberAsInt();
-        const auto& accessors = src_.model.accessors;
-        if (index < 0 || size_t(index) >= accessors.size())
-            throw input_error(src_.file, element, "accessor " + std::to_string(index) + " does not exist");
-        const tinygltf::Accessor& acc = accessors[size_t(index)];
+        const int index = accessor_index(element, attributes_.Get(a.name));
+        const tinygltf::Accessor& acc = src_.model.accessors[size_t(index)];
         const int want = a.components == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4;
         if (acc.type != want)
             throw input_error(
@@ -65,12 +61,7 @@ class InstancingReader {
                                   std::to_string(acc.componentType) +
                                   (a.components == 4 ? ", expected float or normalized byte or short"
                                                      : ", expected float, byte or short"));
-        if (acc.count == 0) throw input_error(src_.file, element, "has no instances (count 0)");
-        if (count_ && acc.count != *count_)
-            throw input_error(src_.file, element,
-                              "has " + std::to_string(acc.count) + " instances, another attribute has " +
-                                  std::to_string(*count_));
-        count_ = acc.count;
+        take_count(element, acc.count);
         try {
             return read_accessor(src_, index, element, a.components);
         } catch (const InputError& e) {
@@ -79,6 +70,15 @@ class InstancingReader {
             throw input_error(src_.file, element,
                               what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what);
         }
+    }
+
+    /// Any other attribute (the specification's custom ones, such as `_ID`): not
+    /// rendered, but its accessor must exist and its count sets or must match the
+    /// instance count like the transforms'.
+    void check_other(const std::string& name) {
+        const std::string element = element_ + "." + name;
+        take_count(element,
+                   src_.model.accessors[size_t(accessor_index(element, attributes_.Get(name)))].count);
     }
 
     size_t count() const { return count_.value_or(0); }
@@ -95,6 +95,24 @@ class InstancingReader {
     }
 
    private:
+    int accessor_index(const std::string& element, const tinygltf::Value& v) const {
+        if (!v.IsInt()) throw input_error(src_.file, element, "must be an accessor index");
+        const int index = v.GetNumberAsInt();
+        if (index < 0 || size_t(index) >= src_.model.accessors.size())
+            throw input_error(src_.file, element, "accessor " + std::to_string(index) + " does not exist");
+        return index;
+    }
+
+    /// All the node's attributes give one value per instance (the specification's "must").
+    void take_count(const std::string& element, size_t count) {
+        if (count == 0) throw input_error(src_.file, element, "has no instances (count 0)");
+        if (count_ && count != *count_)
+            throw input_error(src_.file, element,
+                              "has " + std::to_string(count) + " instances, another attribute has " +
+                                  std::to_string(*count_));
+        count_ = count;
+    }
+
     const Source& src_;
     const tinygltf::Value& attributes_;
     std::string element_;
@@ -108,7 +126,7 @@ std::optional<std::vector<Mat4>> gpu_instances(const Source& src, const tinygltf
     const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
     if (ext == node.extensions.end()) return std::nullopt;
     const std::string element = node_element + ".extensions.EXT_mesh_gpu_instancing";
-    const char* none = "has none of TRANSLATION, ROTATION and SCALE";
+    const char* none = "has no attributes";
     // tinygltf drops an empty JSON object: missing and empty attributes look alike.
     if (!ext->second.IsObject() || !ext->second.Has("attributes"))
         throw input_error(src.file, element + ".attributes", none);
@@ -117,6 +135,11 @@ std::optional<std::vector<Mat4>> gpu_instances(const Source& src, const tinygltf
     InstancingReader reader(src, attributes, element + ".attributes");
     const std::vector<double> t = reader.read(kTranslation), r = reader.read(kRotation),
                               s = reader.read(kScale);
+    // Every attribute is optional: a node with only custom ones draws its count of
+    // instances at the identity (each at the node's own transform).
+    for (const std::string& name : attributes.Keys())
+        if (name != kTranslation.name && name != kRotation.name && name != kScale.name)
+            reader.check_other(name);
     if (reader.count() == 0) throw input_error(src.file, element + ".attributes", none);
     std::vector<Mat4> out(reader.count());
     for (size_t k = 0; k < out.size(); ++k) {

@@ -166,3 +166,33 @@ TEST_CASE("glTF KHR_draco_mesh_compression corrupt bitstreams are InputErrors na
     }
     CHECK(refused >= good.size() - 1);  // at least every truncation
 }
+
+TEST_CASE("glTF KHR_draco_mesh_compression prototype placed by EXT_mesh_gpu_instancing") {
+    const fs::path dir = scratch("draco_instancing");
+    const GridMesh g = grid_mesh();
+    const LoadedModel plain = load_gltf(plain_grid_doc(g).write(dir / "plain.gltf"));
+    const std::vector<uint8_t> bytes = draco_bytes(g);
+    Doc d = draco_doc(bytes, bytes);
+    const std::vector<float> moves = {0, 0, 0, 2, 0, 0, 0, 0, -3};
+    d.j["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"] = {
+        {"attributes", {{"TRANSLATION", d.accessor(moves, 5126, "VEC3", 3)}}}};
+    d.j["extensionsRequired"] = {"KHR_draco_mesh_compression", "EXT_mesh_gpu_instancing"};
+    const fs::path file = d.write(dir / "instanced.gltf");
+    LoadedModel m = load_gltf(file);
+    // The decoded mesh is stored once, in its own space, and placed three times.
+    REQUIRE(m.prototypes.size() == 1);
+    REQUIRE(m.meshes.size() == 1);
+    check_same_corners(m.meshes[0], plain.meshes[0], 1e-4f, 5e-3f, 5e-4f);
+    REQUIRE(m.instances.size() == 3);
+    for (size_t k = 0; k < 3; ++k)
+        for (size_t r = 0; r < 3; ++r)
+            CHECK(m.instances[k].world_from_object.m[r][3] == doctest::Approx(moves[3 * k + r]));
+    // Baked, the copies cover x in [0, 3] and z from -3 to the bump's top.
+    bake_instances(m);
+    CHECK(triangles(m) == 3 * g.indices.size() / 3);
+    const Bounds3 b = bounds(m), one = bounds(plain);
+    CHECK(b.lo.x == doctest::Approx(one.lo.x).epsilon(1e-3));
+    CHECK(b.hi.x == doctest::Approx(one.hi.x + 2).epsilon(1e-3));
+    CHECK(b.lo.z == doctest::Approx(one.lo.z - 3).epsilon(1e-3));
+    CHECK(b.hi.z == doctest::Approx(one.hi.z).epsilon(1e-3));
+}

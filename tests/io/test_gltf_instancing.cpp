@@ -1,5 +1,5 @@
 // EXT_mesh_gpu_instancing: a node's mesh loads once, as a prototype, with one
-// instance per entry of its TRANSLATION / ROTATION / SCALE accessors; the
+// instance per entry of its TRANSLATION / ROTATION / SCALE (or custom) accessors; the
 // documents are built here, the references with plain nodes or by hand.
 #include <cmath>
 #include <functional>
@@ -223,6 +223,28 @@ TEST_CASE("EXT_mesh_gpu_instancing: missing attributes default to identity") {
     }
 }
 
+TEST_CASE("EXT_mesh_gpu_instancing: custom attributes alone give the instance count at the identity") {
+    // The specification makes every attribute optional and asks only that all of a
+    // node's attributes, custom ones (`_ID`, ...) included, have the same count.
+    const fs::path dir = scratch("gpu_instancing_custom");
+    Doc d = instancing_doc(json::object());
+    json& attrs = d.j["nodes"][0]["extensions"][kExt]["attributes"];
+    attrs["_ID"] = d.accessor(std::vector<uint16_t>{7, 8, 9}, 5123, "SCALAR", 3);
+    attrs["_FEATURE_ID_0"] = d.accessor(std::vector<float>{0, 1, 2}, 5126, "SCALAR", 3);
+    d.j["nodes"][0]["translation"] = {1, 2, 3};
+    const LoadedModel m = load_model(d.write(dir / "custom.gltf"));
+    REQUIRE(m.prototypes.size() == 1);
+    REQUIRE(m.instances.size() == 3);
+    for (const InstanceDesc& in : m.instances)
+        check_matrix(in.world_from_object, Mat4::translate({1, 2, 3}), 1e-9);
+
+    // Beside a transform attribute they are ignored; the transforms place the instances.
+    attrs["TRANSLATION"] = d.accessor(std::vector<float>{0, 0, 0, 2, 0, 0, 4, 0, 0}, 5126, "VEC3", 3);
+    const LoadedModel moved = load_model(d.write(dir / "moved.gltf"));
+    REQUIRE(moved.instances.size() == 3);
+    check_matrix(moved.instances[2].world_from_object, Mat4::translate({5, 2, 3}), 1e-9);
+}
+
 TEST_CASE("EXT_mesh_gpu_instancing: a morphed mesh is instanced with the node's weights") {
     const fs::path dir = scratch("gpu_instancing_morph");
     Doc d = instancing_doc(json::object());
@@ -315,17 +337,20 @@ TEST_CASE("EXT_mesh_gpu_instancing: bad attributes are InputErrors naming the no
          },
          attrs + ".TRANSLATION", "count 0"},
         {"no attributes", [&](Doc& d) { d.j["nodes"][0]["extensions"][kExt].erase("attributes"); }, attrs,
-         "has none of TRANSLATION, ROTATION and SCALE"},
+         "has no attributes"},
         {"attributes not an object",
          [&](Doc& d) {
              d.j["nodes"][0]["extensions"][kExt]["attributes"] = {1, 2};
          },
          attrs, "is not an object"},
-        {"only a custom attribute",
+        {"custom attribute count differs",
          [&](Doc& d) {
-             set(d, "_ID", d.accessor(std::vector<float>{0, 1}, 5126, "SCALAR", 2));
+             set(d, "TRANSLATION", d.accessor(std::vector<float>{0, 0, 0, 1, 1, 1}, 5126, "VEC3", 2));
+             set(d, "_FEATURE_ID_0", d.accessor(std::vector<float>{0, 1, 2}, 5126, "SCALAR", 3));
          },
-         attrs, "has none of TRANSLATION, ROTATION and SCALE"},
+         attrs + "._FEATURE_ID_0", "has 3 instances, another attribute has 2"},
+        {"custom attribute accessor out of range", [&](Doc& d) { set(d, "_ID", 42); }, attrs + "._ID",
+         "accessor 42 does not exist"},
     };
     for (const Case& c : cases) {
         const std::string what = c.what;
