@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* const kInfoUsage =
-    "usage: sahara info [SCENE.json | MODEL.obj|.gltf|.glb] [--json]\n"
+    "usage: sahara info [SCENE.json | MODEL.obj|.gltf|.glb] [--variant NAME] [--json]\n"
     "\n"
     "Describes a scene or model (the built-in default scene if none is given):\n"
     "objects, triangles, materials, textures, lights, bounds, estimated memory,\n"
@@ -33,6 +33,7 @@ const char* const kInfoUsage =
     "'Ignored inputs' names what the file gives that is not rendered (e.g. a\n"
     "glTF occlusion map, unsupported extensions, volume attenuation).\n"
     "\n"
+    "  --variant NAME  describe the glTF model in its material variant NAME\n"
     "  --json       machine-readable output on stdout\n"
     "  -h, --help   this text\n";
 
@@ -40,14 +41,19 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-/// A scene file, or a model wrapped into a scene description (its material
-/// variants, if any, in `variants`).
-SceneDesc load_input(const std::optional<std::string>& input, std::vector<std::string>& variants) {
+/// A scene file, or a model (in material variant `variant`, if given) wrapped
+/// into a scene description (its material variants, if any, in `variants`).
+SceneDesc load_input(const std::optional<std::string>& input, const std::optional<std::string>& variant,
+                     std::vector<std::string>& variants) {
     if (!input) return default_scene();
     const FileKind kind = file_kind(*input);
+    if (variant && !is_model_kind(kind))
+        throw input_error(*input, "",
+                          "--variant applies to a glTF model; a scene file names its variants "
+                          "with the mesh object's \"variant\" key");
     if (kind == FileKind::scene) return parse_scene_file(*input);
     if (is_model_kind(kind)) {
-        LoadedModel m = load_model(*input);
+        LoadedModel m = load_model(*input, Mat4::identity(), SharedMeshes::copy, variant);
         variants = std::move(m.variants);
         SceneDesc d;
         d.source = *input;
@@ -59,10 +65,10 @@ SceneDesc load_input(const std::optional<std::string>& input, std::vector<std::s
 
 }  // namespace
 
-StatsReport scene_info(const std::optional<std::string>& input) {
+StatsReport scene_info(const std::optional<std::string>& input, const std::optional<std::string>& variant) {
     auto t = Clock::now();
     std::vector<std::string> variants;
-    const SceneDesc desc = load_input(input, variants);
+    const SceneDesc desc = load_input(input, variant, variants);
     const double load = seconds_since(t);
     t = Clock::now();
     const Scene scene = build_scene(desc);
@@ -71,8 +77,9 @@ StatsReport scene_info(const std::optional<std::string>& input) {
     if (!variants.empty()) {
         std::string names;
         for (const std::string& v : variants) names += (names.empty() ? "" : ", ") + v;
-        s.add("Material variants", "KHR_materials_variants", names + " (the default materials are rendered)",
-              variants);
+        s.add("Material variants", "KHR_materials_variants", names, variants);
+        s.add("Material variants", "Rendered", variant ? *variant : "the default materials",
+              variant ? nlohmann::json(*variant) : nlohmann::json());
     }
     s.add_seconds("Time", "Load", load);
     s.add_seconds("Time", "Build", build);
@@ -81,11 +88,13 @@ StatsReport scene_info(const std::optional<std::string>& input) {
 
 int run_info_command(const std::vector<std::string>& args) {
     std::optional<std::string> input;
+    std::optional<std::string> variant;
     bool json = false, help = false;
     try {
         CLI::App app;
         configure_app(app, help);
         app.add_flag("--json", json);
+        app.add_option_function<std::string>("--variant", [&variant](const std::string& v) { variant = v; });
         const std::vector<std::string> inputs = parse_command_line(app, args);
         if (inputs.size() > 1)
             throw UsageError("more than one input given ('" + inputs[0] + "' and '" + inputs[1] + "')");
@@ -98,7 +107,7 @@ int run_info_command(const std::vector<std::string>& args) {
         return 0;
     }
     try {
-        const StatsReport s = scene_info(input);
+        const StatsReport s = scene_info(input, variant);
         if (json)
             std::printf("%s\n", s.to_json().dump(2).c_str());
         else

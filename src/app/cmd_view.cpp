@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,11 +32,14 @@ const char* const kViewUsage =
     "  --env-strength S    multiplies the environment's radiance (default 1)\n"
     "  --gltf-camera N     look through the model's glTF camera N instead\n"
     "  --no-ground         no ground plane\n"
+    "  --variant NAME      render the glTF file's material variant NAME (KHR_materials_variants;\n"
+    "                      `sahara info MODEL` lists them)\n"
     "  every `sahara render` option (--spp, --threads, --preview, --integrator, ...) works too\n";
 
 struct ViewArgs {
     RenderArgs render;
     ViewOptions view;
+    std::optional<std::string> variant;
 };
 
 ViewArgs parse_view_args(const std::vector<std::string>& args) {
@@ -55,6 +59,7 @@ ViewArgs parse_view_args(const std::vector<std::string>& args) {
             v.view.gltf_camera = int(parse_int_value("--gltf-camera", s, 0, 1 << 20));
         });
         app.add_flag_callback("--no-ground", [&v] { v.view.ground = false; });
+        app.add_option_function<std::string>("--variant", [&v](const std::string& s) { v.variant = s; });
     });
     if (!v.render.help && !v.render.scene) throw UsageError("no MODEL given");
     return v;
@@ -75,7 +80,8 @@ int run_view_command(const std::vector<std::string>& args) {
     }
     const std::string model = *v.render.scene;
     return run_render(v.render, [&] {
-        return make_view_scene(load_model(model), file_kind(model) == FileKind::gltf, v.view, model);
+        return make_view_scene(load_model(model, Mat4::identity(), SharedMeshes::copy, v.variant),
+                               file_kind(model) == FileKind::gltf, v.view, model);
     });
 }
 

@@ -23,6 +23,8 @@ struct Source {
     tinygltf::Model model;
     /// Encoded bytes of images given as data: URIs, captured while tinygltf parses.
     std::map<int, std::vector<unsigned char>> data_uri_images;
+    /// The KHR_materials_variants variant to render (its index); none: the default materials.
+    std::optional<size_t> variant;
 };
 
 /// The bytes of bufferViews[bv], checked to lie inside their buffer.
@@ -107,6 +109,17 @@ void apply_skin(const Source& src, const tinygltf::Primitive& prim, const std::s
 /// instance, or nothing if the node does not use the extension.
 std::optional<std::vector<Mat4>> gpu_instances(const Source& src, const tinygltf::Node& node,
                                                const std::string& node_element);
+
+/// The names of the file's KHR_materials_variants ("variant N" where a name is missing).
+std::vector<std::string> variant_names(const tinygltf::Model& model);
+
+/// The index of the variant called `name`; an InputError listing the file's variants if none is.
+size_t chosen_variant(const Source& src, const std::string& name);
+
+/// The material `prim` (at `element`, e.g. "meshes[0].primitives[1]") takes under
+/// `src.variant`: its mapping's, else its default. With a variant chosen, every
+/// mapping of the primitive is checked (indices in range) and errors name it.
+int variant_material(const Source& src, const tinygltf::Primitive& prim, const std::string& element);
 
 /// Walks the default scene (node transforms, then `world_from_model`) into
 /// meshes, cameras and lights of `out`; drops zero-area triangles.

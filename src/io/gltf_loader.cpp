@@ -182,23 +182,10 @@ void parse(Source& src, const std::vector<unsigned char>& bytes) {
     if (!ok) throw input_error(src.file, "", "malformed glTF: " + first_line(err));
 }
 
-/// The names of the file's KHR_materials_variants ("variant N" where a name is missing).
-std::vector<std::string> variant_names(const tinygltf::Model& model) {
-    std::vector<std::string> out;
-    auto ext = model.extensions.find("KHR_materials_variants");
-    if (ext == model.extensions.end() || !ext->second.Has("variants")) return out;
-    const tinygltf::Value& list = ext->second.Get("variants");
-    for (size_t i = 0; list.IsArray() && i < list.ArrayLen(); ++i) {
-        const tinygltf::Value& v = list.Get(int(i));
-        out.push_back(v.Has("name") && v.Get("name").IsString() ? v.Get("name").Get<std::string>()
-                                                                : "variant " + std::to_string(i));
-    }
-    return out;
-}
-
 }  // namespace
 
-LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared) {
+LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared,
+                      const std::optional<std::string>& variant) {
     Source src;
     src.file = file.string();
     src.dir = file.parent_path();
@@ -209,9 +196,11 @@ LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_
     parse(src, prepared ? *prepared : bytes);
     gltf::decode_meshopt_views(src);  // first: a Draco bitstream may sit in a meshopt bufferView
     gltf::decode_draco_primitives(src);
+    if (variant) src.variant = gltf::chosen_variant(src, *variant);
     LoadedModel out;
     gltf::build_scene(src, world_from_model, shared, out);
-    out.variants = variant_names(src.model);
+    out.variants = gltf::variant_names(src.model);
+    out.variant = variant;
     if (out.dropped_degenerate > 0)
         log_info(src.file + ": dropped " + std::to_string(out.dropped_degenerate) + " zero-area triangles");
     return out;

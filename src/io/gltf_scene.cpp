@@ -232,8 +232,11 @@ class SceneBuilder {
         if (!out) return out;
         const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
         const std::string element = indexed("meshes", mesh) + "." + indexed("primitives", p);
-        out->material = materials_.get(prim.material, element + ".material", !out->colors.empty());
-        mark_vertex_alpha(*out, prim.material);
+        const int material = variant_material(src_, prim, element);
+        const std::string user = material == prim.material ? element + ".material"
+                                                           : element + ".extensions.KHR_materials_variants";
+        out->material = materials_.get(material, user, !out->colors.empty());
+        mark_vertex_alpha(*out, material);
         return out;
     }
 

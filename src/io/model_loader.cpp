@@ -6,12 +6,17 @@
 
 namespace sahara {
 
-LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared) {
+LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model, SharedMeshes shared,
+                       const std::optional<std::string>& variant) {
     switch (file_kind(file)) {
         case FileKind::obj:
+            if (variant)
+                throw input_error(file.string(), "",
+                                  "material variant '" + *variant +
+                                      "' asked for, but only glTF files have material variants");
             return load_obj(file, world_from_model);
         case FileKind::gltf:
-            return load_gltf(file, world_from_model, shared);
+            return load_gltf(file, world_from_model, shared, variant);
         default:
             throw input_error(
                 file.string(), "",

@@ -2,6 +2,7 @@
 /// Loads a downloaded model (.obj with its .mtl, .gltf, .glb) into plain scene
 /// data. Loaders never build acceleration structures.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,8 +25,9 @@ struct LoadedModel {
     std::vector<PrototypeDesc> prototypes;
     std::vector<InstanceDesc> instances;
     size_t dropped_degenerate = 0;  ///< zero-area triangles removed
-    /// KHR_materials_variants names, for `sahara info`; every primitive keeps its default material.
+    /// KHR_materials_variants names, for `sahara info`, and the one rendered (none: the default materials).
     std::vector<std::string> variants;
+    std::optional<std::string> variant;
 };
 
 /// What a loader does with a glTF mesh that several nodes draw: copy it per node
@@ -41,8 +43,11 @@ void bake_instances(LoadedModel& model);
 
 /// Picks the loader by extension. Throws InputError naming the file and element.
 /// `world_from_model` is applied to positions/normals (and glTF node transforms before it).
+/// `variant` names the glTF KHR_materials_variants variant to render (an InputError
+/// if the file has no such variant; OBJ files have none).
 LoadedModel load_model(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity(),
-                       SharedMeshes shared = SharedMeshes::copy);
+                       SharedMeshes shared = SharedMeshes::copy,
+                       const std::optional<std::string>& variant = std::nullopt);
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity());
 
 /// How load_obj reads a file for the BVH tools (io/mesh_triangles.h) rather than for rendering.
@@ -54,6 +59,7 @@ struct ObjReadOptions {
 LoadedModel load_obj(const std::filesystem::path& file, const Mat4& world_from_model,
                      const ObjReadOptions& options);
 LoadedModel load_gltf(const std::filesystem::path& file, const Mat4& world_from_model = Mat4::identity(),
-                      SharedMeshes shared = SharedMeshes::copy);
+                      SharedMeshes shared = SharedMeshes::copy,
+                      const std::optional<std::string>& variant = std::nullopt);
 
 }  // namespace sahara

@@ -279,8 +279,9 @@ Vec3d choose_local_origin(const Vec3d& camera_position) {
 
 SceneLoaders SceneLoaders::standard() {
     SceneLoaders l;
-    l.load_model = [](const std::filesystem::path& f, const Mat4& m) {
-        return sahara::load_model(f, m, SharedMeshes::instance);
+    l.load_model = [](const std::filesystem::path& f, const Mat4& m,
+                      const std::optional<std::string>& variant) {
+        return sahara::load_model(f, m, SharedMeshes::instance, variant);
     };
     l.read_image = [](const std::filesystem::path& f, bool srgb) { return sahara::read_image(f, srgb); };
     return l;

@@ -16,8 +16,10 @@ namespace sahara {
 
 /// The file readers the parser calls; tests substitute their own.
 struct SceneLoaders {
-    /// Loads a mesh file with `world_from_model` applied (default: load_model).
-    std::function<LoadedModel(const std::filesystem::path&, const Mat4&)> load_model;
+    /// Loads a mesh file with `world_from_model` applied, in the glTF material
+    /// variant given, if any (default: load_model).
+    std::function<LoadedModel(const std::filesystem::path&, const Mat4&, const std::optional<std::string>&)>
+        load_model;
     /// Reads an image, optionally sRGB-decoded (default: read_image).
     std::function<std::shared_ptr<const Image>(const std::filesystem::path&, bool srgb_to_linear)> read_image;
 

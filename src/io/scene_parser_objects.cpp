@@ -203,11 +203,13 @@ NamedObject parse_mesh(JsonObject& o, ParseContext& ctx) {
     std::filesystem::path path = ctx.resolve_existing(file);
     std::optional<uint32_t> material;
     if (auto v = o.get("material")) material = ctx.material(*v);
+    std::optional<std::string> variant;
+    if (auto v = o.get("variant")) variant = v->string();
     // The loaders apply the whole matrix in double, so the model lands at the local origin.
     const Mat4 m = ctx.local_from_object(object_transform(o));
     LoadedModel model;
     try {
-        model = ctx.loaders->load_model(path, m);
+        model = ctx.loaders->load_model(path, m, variant);
     } catch (const InputError& e) {
         file.fail(e.what());
     }

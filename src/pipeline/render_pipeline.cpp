@@ -28,11 +28,17 @@ void RenderOverrides::apply(RenderSettings& r) const {
     if (packets) r.packets = *packets;
 }
 
-SceneDesc load_scene_source(const std::optional<std::string>& source) {
+SceneDesc load_scene_source(const std::optional<std::string>& source,
+                            const std::optional<std::string>& variant) {
+    const FileKind kind = source ? file_kind(*source) : FileKind::scene;
+    if (variant && !is_model_kind(kind))
+        throw input_error(source.value_or("the default scene"), "",
+                          "a material variant applies to a glTF model; a scene names its variants with "
+                          "the mesh object's \"variant\" key");
     if (!source) return default_scene();
-    const FileKind kind = file_kind(*source);
     if (is_model_kind(kind))
-        return make_view_scene(load_model(*source), kind == FileKind::gltf, ViewOptions{}, *source);
+        return make_view_scene(load_model(*source, Mat4::identity(), SharedMeshes::copy, variant),
+                               kind == FileKind::gltf, ViewOptions{}, *source);
     return parse_scene_file(*source);
 }
 

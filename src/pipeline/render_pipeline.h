@@ -32,8 +32,10 @@ struct RenderOverrides {
 };
 
 /// A scene file (.json), a model (.obj, .gltf, .glb: framed as `sahara view`
-/// frames it) or, for nullopt, the built-in default scene. Throws InputError.
-SceneDesc load_scene_source(const std::optional<std::string>& source);
+/// frames it; a glTF model in material variant `variant`, if given) or, for
+/// nullopt, the built-in default scene. Throws InputError.
+SceneDesc load_scene_source(const std::optional<std::string>& source,
+                            const std::optional<std::string>& variant = std::nullopt);
 
 /// Applies `overrides` to `desc` (and, for an animation frame, shifts the
 /// shutter by `frame`: moving objects move on), then builds the runtime scene

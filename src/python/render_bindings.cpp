@@ -130,19 +130,24 @@ RenderKwargs parse_kwargs(const py::object& spp, const py::object& width, const 
 /// A scene loaded and built once, rendered any number of times.
 class PyScene {
    public:
-    explicit PyScene(const py::object& source) {
+    PyScene(const py::object& source, const py::object& variant_arg) {
         const auto t = Clock::now();
+        const std::optional<std::string> variant = str_arg(variant_arg, "variant");
         SceneDesc desc;
         if (source.is_none()) {
-            desc = load_scene_source(std::nullopt);
+            desc = load_scene_source(std::nullopt, variant);
         } else if (py::isinstance<py::dict>(source)) {
+            if (variant)
+                throw py::value_error(
+                    "variant: applies to a glTF model path; a dict names its variants with the mesh "
+                    "object's 'variant' key");
             const Json json = json_from_python(source, "scene");
             py::gil_scoped_release unlocked;
             desc = parse_scene_value(json, kDictSceneName);
         } else if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
             const std::string path = py::str(py::module_::import("os").attr("fspath")(source));
             py::gil_scoped_release unlocked;
-            desc = load_scene_source(path);
+            desc = load_scene_source(path, variant);
         } else {
             throw py::type_error("scene: expected a path, a dict or None, got " + type_name(source));
         }
@@ -324,10 +329,13 @@ void bind_errors(py::module_& m) {
 void bind_render(py::module_& m) {
     py::class_<PyScene>(m, "Scene",
                         "A scene loaded and built once (path, dict or None), rendered many times.")
-        .def(py::init<const py::object&>(), py::arg("scene") = py::none(),
+        .def(py::init<const py::object&, const py::object&>(), py::arg("scene") = py::none(), py::kw_only(),
+             py::arg("variant") = py::none(),
              "Loads and builds the scene once: a scene file (.json), a model (.obj, .gltf, .glb, framed "
              "as `sahara view` frames it), a dict in the scene format, or None for the built-in default "
-             "scene. Raises InputError for bad scene input.")
+             "scene. variant: the glTF model's KHR_materials_variants variant to render (None: the "
+             "default materials). Raises InputError for bad scene input and for a variant the model "
+             "does not have.")
         .def(
             "_render",
             [](PyScene& ps, const py::object& spp, const py::object& width, const py::object& height,

@@ -45,7 +45,7 @@ struct FakeLoaders {
             img->width = srgb ? 1 : 2;
             return std::shared_ptr<const Image>(img);
         };
-        l.load_model = [this](const fs::path&, const Mat4& m) {
+        l.load_model = [this](const fs::path&, const Mat4& m, const std::optional<std::string>&) {
             model_transforms.push_back(m);
             LoadedModel model;
             TriangleMesh mesh;

@@ -51,8 +51,12 @@ class Image(_np.ndarray):
                 return f.read()
 
 
-def _scene_object(scene):
-    return scene if isinstance(scene, Scene) else Scene(scene)  # noqa: F405
+def _scene_object(scene, variant=None):
+    if isinstance(scene, Scene):  # noqa: F405
+        if variant is not None:
+            raise ValueError("variant: a sahara.Scene is already loaded; pass variant to sahara.Scene")
+        return scene
+    return Scene(scene, variant=variant)  # noqa: F405
 
 
 def _as_image(result):
@@ -62,7 +66,7 @@ def _as_image(result):
 
 
 def render(scene=None, *, spp=None, width=None, height=None, seed=None, max_depth=None,
-           threads=None, integrator=None, time=None, progress=False):
+           threads=None, integrator=None, time=None, progress=False, variant=None):
     """Renders a scene and returns an Image (float32 H x W x 3, linear RGB).
 
     scene: a scene file (.json), a model (.obj, .gltf, .glb, framed as
@@ -71,12 +75,14 @@ def render(scene=None, *, spp=None, width=None, height=None, seed=None, max_dept
     value, as the command line's flag of the same name does; the pixels equal
     those of `sahara render ... -o out.exr` with the same settings.
     time: stop after this many seconds with what is done. threads: 0 or None
-    for all cores. progress: draw progress on stderr. The GIL is released
+    for all cores. progress: draw progress on stderr. variant: the glTF
+    model's KHR_materials_variants variant to render, as `sahara view
+    --variant` (None: the default materials). The GIL is released
     while rendering; Ctrl-C raises KeyboardInterrupt promptly.
     Raises InputError (a ValueError) for bad scene input, TypeError or
     ValueError for a bad argument.
     """
-    return _scene_object(scene).render(
+    return _scene_object(scene, variant).render(
         spp=spp, width=width, height=height, seed=seed, max_depth=max_depth, threads=threads,
         integrator=integrator, time=time, progress=progress)
 
