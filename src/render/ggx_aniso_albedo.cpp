@@ -99,7 +99,7 @@ GgxAnisoAlbedoTable::GgxAnisoAlbedoTable(int strata) {
 }
 
 const GgxAnisoAlbedoTable& GgxAnisoAlbedoTable::get() {
-    static const GgxAnisoAlbedoTable table(8);
+    static const GgxAnisoAlbedoTable table(7);
     return table;
 }
 

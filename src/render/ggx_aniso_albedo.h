@@ -15,7 +15,7 @@ namespace sahara {
 
 class GgxAnisoAlbedoTable {
    public:
-    static constexpr int kMuSteps = 12, kPhiSteps = 6, kRoughnessSteps = 10, kStretchSteps = 6;
+    static constexpr int kMuSteps = 12, kPhiSteps = 6, kRoughnessSteps = 12, kStretchSteps = 8;
 
     /// The process-wide table, built on first use (thread-safe).
     static const GgxAnisoAlbedoTable& get();

@@ -116,8 +116,8 @@ TEST_CASE("anisotropic pbr reflection is reciprocal") {
 
 TEST_CASE("white furnace: an anisotropic white pbr material keeps its energy at every angle") {
     // White metal and white dielectric over a white base reflect what they receive,
-    // whichever way the anisotropy points and wherever the light comes from. The
-    // table's interpolation errs by up to about 2% near grazing angles (either way).
+    // whichever way the anisotropy points and wherever the light comes from, up
+    // to the anisotropic albedo table's error (about 1%, either way).
     const int n = scaled(8000);
     for (float metallic : {1.0f, 0.0f})
         for (float roughness : {0.05f, 0.3f, 0.6f, 1.0f})
@@ -132,8 +132,8 @@ TEST_CASE("white furnace: an anisotropic white pbr material keeps its energy at 
                             INFO("metallic " << metallic << " roughness " << roughness << " strength "
                                              << strength << " rotation " << rotation << " cos_o " << cos_o
                                              << " phi " << phi << " albedo " << a.mean.x << " se " << a.se.x);
-                            CHECK(a.mean.x <= 1.0f + 4.0f * a.se.x + 0.02f);
-                            CHECK(a.mean.x >= 0.95f - 4.0f * a.se.x);
+                            CHECK(a.mean.x <= 1.0f + 4.0f * a.se.x + 0.01f);
+                            CHECK(a.mean.x >= 0.97f - 4.0f * a.se.x);
                         }
                 }
 }
