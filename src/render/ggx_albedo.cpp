@@ -31,8 +31,7 @@ GgxAlbedo integrate_albedo(float mu, float alpha, int strata) {
     return {float(e / n), float(es / n)};
 }
 
-}  // namespace
-
+/// 2 * integral over [0, 1] of f(mu) mu dmu for f linear between equally spaced samples.
 double cosine_average(const std::vector<double>& f) {
     const double h = 1.0 / double(f.size() - 1);
     double sum = 0;
@@ -44,6 +43,8 @@ double cosine_average(const std::vector<double>& f) {
     }
     return 2 * sum;
 }
+
+}  // namespace
 
 GgxAlbedoTable::GgxAlbedoTable(int strata) {
     table_.resize(size_t(kRoughnessSteps) * kMuSteps);

@@ -16,10 +16,6 @@ inline void albedo_table_cell(float x, int n, int* i, float* t) {
     *t = f - float(*i);
 }
 
-/// 2 * integral over [0, 1] of f(mu) mu dmu for f linear between equally spaced
-/// samples: the cosine-weighted average of what a table interpolates.
-double cosine_average(const std::vector<double>& f);
-
 /// GGX alpha never goes below this in the glTF material: alpha = roughness^2 = 0
 /// would be a delta lobe, and 1e-3 already reflects like a mirror.
 inline constexpr float kMinPbrAlpha = 1e-3f;
