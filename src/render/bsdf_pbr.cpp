@@ -50,15 +50,16 @@ float ggx_reflection_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
 
 /// The single-scattering albedo towards w and its hemispherical average, from the
 /// table that fits the material: unequal alphas depend on w's azimuth too
-/// (equal ones read the finer isotropic table).
+/// (equal ones read the finer isotropic table, which the caller holds, so that
+/// isotropic materials pay one test for this).
 bool anisotropic_albedo(const Bsdf& b) { return b.anisotropic && b.alpha != b.alpha_y; }
-GgxAlbedo ggx_albedo(const Bsdf& b, const Vec3& w) {
+GgxAlbedo ggx_albedo(const Bsdf& b, const GgxAlbedoTable& table, const Vec3& w) {
     return anisotropic_albedo(b) ? GgxAnisoAlbedoTable::get().at(w, b.alpha, b.alpha_y)
-                                 : GgxAlbedoTable::get().at(w.z, b.roughness);
+                                 : table.at(w.z, b.roughness);
 }
-GgxAlbedo ggx_albedo_average(const Bsdf& b) {
+GgxAlbedo ggx_albedo_average(const Bsdf& b, const GgxAlbedoTable& table) {
     return anisotropic_albedo(b) ? GgxAnisoAlbedoTable::get().average(b.alpha, b.alpha_y)
-                                 : GgxAlbedoTable::get().average(b.roughness);
+                                 : table.average(b.roughness);
 }
 
 /// Everything the lobes need that depends on the material only, from the tables.
@@ -352,8 +353,9 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
 }
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
-    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b));
-    const GgxAlbedo e = ggx_albedo(b, wo);
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const GgxAlbedo e = ggx_albedo(b, table, wo);
     PbrLobeWeights w;
     const float f0 = mean(t.f0);
     w.specular = f0 * e.e + (t.f90 - f0) * e.e_schlick;
@@ -383,8 +385,9 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
         *pdf = p.transmit * pdf_t;
         return f;
     }
-    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b));
-    const GgxAlbedo eo = ggx_albedo(b, wo), ei = ggx_albedo(b, wi);
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const GgxAlbedo eo = ggx_albedo(b, table, wo), ei = ggx_albedo(b, table, wi);
     Rgb f = eval_specular(b, t, wo, wi);
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)
