@@ -4,6 +4,7 @@
 
 #include "render/bsdf_layers.h"
 #include "render/ggx_albedo.h"
+#include "render/ggx_aniso_albedo.h"
 #include "render/sheen.h"
 #include "scene/texture.h"
 
@@ -45,6 +46,20 @@ float ggx_vndf_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wm) {
 float ggx_reflection_pdf(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
     return b.anisotropic ? ggx_reflection_pdf(wo, wi, b.alpha, b.alpha_y)
                          : ggx_reflection_pdf(wo, wi, b.alpha);
+}
+
+/// The single-scattering albedo towards w and its hemispherical average, from the
+/// table that fits the material: unequal alphas depend on w's azimuth too
+/// (equal ones read the finer isotropic table, which the caller holds, so that
+/// isotropic materials pay one test for this).
+bool anisotropic_albedo(const Bsdf& b) { return b.anisotropic && b.alpha != b.alpha_y; }
+GgxAlbedo ggx_albedo(const Bsdf& b, const GgxAlbedoTable& table, const Vec3& w) {
+    return anisotropic_albedo(b) ? GgxAnisoAlbedoTable::get().at(w, b.alpha, b.alpha_y)
+                                 : table.at(w.z, b.roughness);
+}
+GgxAlbedo ggx_albedo_average(const Bsdf& b, const GgxAlbedoTable& table) {
+    return anisotropic_albedo(b) ? GgxAnisoAlbedoTable::get().average(b.alpha, b.alpha_y)
+                                 : table.average(b.roughness);
 }
 
 /// Everything the lobes need that depends on the material only, from the tables.
@@ -231,12 +246,9 @@ Vec3 anisotropy_tangent(const SurfaceInteraction& si, const Vec3& n) {
 /// alpha_t = mix(alpha, 1, strength^2) along it and alpha across it. A
 /// strength of 0 leaves the material isotropic.
 ///
-/// The albedo tables (multiple-scattering compensation, the base's and the
-/// layers' scaling) stay at the material's roughness, the smaller alpha: its
-/// albedo is at least the anisotropic lobe's, so they never add energy. Strong
-/// anisotropy on a smooth material thus loses part of what it scatters more
-/// than once. Tables read at the geometric mean of the two alphas, or at the
-/// alpha projected on the viewing direction, create energy at some angles.
+/// The albedo tables (multiple-scattering compensation, the base's scaling)
+/// then come from GgxAnisoAlbedoTable, which follows the two alphas and the
+/// azimuth of each direction.
 void set_anisotropy(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures) {
     float strength = m.anisotropy;
@@ -342,8 +354,8 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
     const GgxAlbedoTable& table = GgxAlbedoTable::get();
-    const PbrTerms t = pbr_terms(b, table.average(b.roughness));
-    const GgxAlbedo e = table.at(wo.z, b.roughness);
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const GgxAlbedo e = ggx_albedo(b, table, wo);
     PbrLobeWeights w;
     const float f0 = mean(t.f0);
     w.specular = f0 * e.e + (t.f90 - f0) * e.e_schlick;
@@ -374,8 +386,8 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
         return f;
     }
     const GgxAlbedoTable& table = GgxAlbedoTable::get();
-    const PbrTerms t = pbr_terms(b, table.average(b.roughness));
-    const GgxAlbedo eo = table.at(wo.z, b.roughness), ei = table.at(wi.z, b.roughness);
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const GgxAlbedo eo = ggx_albedo(b, table, wo), ei = ggx_albedo(b, table, wi);
     Rgb f = eval_specular(b, t, wo, wi);
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)

@@ -114,22 +114,28 @@ TEST_CASE("anisotropic pbr reflection is reciprocal") {
     }
 }
 
-TEST_CASE("white furnace: an anisotropic white pbr material creates no energy at any angle") {
-    const int n = scaled(20000);
-    for (const MaterialDesc& m : anisotropic_materials(Rgb(1.0f))) {
-        const Bsdf b = bsdf_with_tangent(m);
-        for (float cos_o : {1.0f, 0.7f, 0.3f, 0.1f})
-            for (float phi : {0.0f, 0.8f, 1.57f}) {
-                const Stat a = directional_albedo(b, direction(cos_o, phi), n);
-                INFO("metallic " << m.metallic << " roughness " << m.roughness << " strength " << m.anisotropy
-                                 << " cos_o " << cos_o << " phi " << phi << " albedo " << a.mean.x << " se "
-                                 << a.se.x);
-                for (int c = 0; c < 3; ++c) CHECK(a.mean[c] <= 1.0f + 4.0f * a.se[c] + 0.01f);
-                // The compensation reads the table at the smaller alpha: strong
-                // anisotropy loses part of its multiple scattering, never most of the light.
-                CHECK(a.mean.x > 0.4f);
-            }
-    }
+TEST_CASE("white furnace: an anisotropic white pbr material keeps its energy at every angle") {
+    // White metal and white dielectric over a white base reflect what they receive,
+    // whichever way the anisotropy points and wherever the light comes from, up
+    // to the anisotropic albedo table's error (-2% to +1%, most near grazing angles).
+    const int n = scaled(8000);
+    for (float metallic : {1.0f, 0.0f})
+        for (float roughness : {0.05f, 0.3f, 0.6f, 1.0f})
+            for (float strength : {0.5f, 0.9f, 1.0f})
+                for (float rotation : {0.0f, 1.1f}) {
+                    const Bsdf b = bsdf_with_tangent(
+                        anisotropic(pbr(Rgb(1.0f), metallic, roughness), strength, rotation));
+                    REQUIRE(b.anisotropic);
+                    for (float cos_o : {1.0f, 0.7f, 0.3f, 0.1f})
+                        for (float phi : {0.0f, 0.8f, 1.57f}) {
+                            const Stat a = directional_albedo(b, b.frame.to_local(direction(cos_o, phi)), n);
+                            INFO("metallic " << metallic << " roughness " << roughness << " strength "
+                                             << strength << " rotation " << rotation << " cos_o " << cos_o
+                                             << " phi " << phi << " albedo " << a.mean.x << " se " << a.se.x);
+                            CHECK(a.mean.x <= 1.0f + 4.0f * a.se.x + 0.01f);
+                            CHECK(a.mean.x >= 0.97f - 4.0f * a.se.x);
+                        }
+                }
 }
 
 TEST_CASE("anisotropic GGX visible-normal sampler follows its pdf (chi-square)") {
