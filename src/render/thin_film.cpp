@@ -101,7 +101,7 @@ float thin_film_reflectance_bound(float film_ior, const Rgb& base_f0, float outs
         const float b = std::sqrt(normal_reflectance(film_ior, ior_of_reflectance(base_f0[c])));
         bound = std::max(bound, sq((a + b) / (1.0f + a * b)));
     }
-    return bound;
+    return std::min(1.0f, 1.4f * bound);
 }
 
 }  // namespace sahara

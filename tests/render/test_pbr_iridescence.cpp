@@ -114,10 +114,10 @@ TEST_CASE("thin film reflectance stays in [0 1] and its colour moves with thickn
     // Past the critical angle of a film less dense than outside, everything reflects.
     CHECK(thin_film_reflectance(0.1f, 1.1f, 300.0f, dielectric, 1.5f) == Rgb(1.0f));
     // The bound holds at normal incidence for every thickness.
-    for (float ior : {1.3f, 1.8f, 2.5f}) {
+    for (float ior : {1.3f, 1.8f, 2.5f, 3.0f}) {
         const float bound = thin_film_reflectance_bound(ior, dielectric);
-        for (float d = 10.0f; d <= 1500.0f; d += 10.0f)
-            CHECK(max_component(thin_film_reflectance(1.0f, ior, d, dielectric)) <= bound + 0.02f);
+        for (float d = 10.0f; d <= 1500.0f; d += 5.0f)
+            CHECK(max_component(thin_film_reflectance(1.0f, ior, d, dielectric)) <= bound);
     }
 }
 
