@@ -3,11 +3,12 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "gltf_test_doc.h"
-#include "render/integrator.h"
+#include "io/scene_parser.h"
 #include "render_test_util.h"
 
 using namespace sahara;
@@ -40,15 +41,8 @@ const json kFilm = {{"iridescenceFactor", 1.0},
 
 /// What a camera ray sees head-on at the triangle of `file` under a white sky.
 Stat head_on(const fs::path& file) {
-    const LoadedModel model = load_gltf(file);
     SceneDesc d = empty_scene(Rgb(1.0f));
-    const uint32_t first = uint32_t(d.materials.size());
-    d.materials.insert(d.materials.end(), model.materials.begin(), model.materials.end());
-    d.textures = model.textures;
-    for (TriangleMesh mesh : model.meshes) {
-        mesh.material += first;
-        d.meshes.push_back(std::move(mesh));
-    }
+    merge_loaded_model(d, load_gltf(file), std::nullopt);
     const Scene scene = build_scene(d);
     return radiance_stats(scene, Ray{{0.3f, 0.3f, 3.0f}, {0, 0, -1}, 0.0f, kInfinity, 0.0f}, scaled(4000), 4);
 }
