@@ -78,6 +78,21 @@ struct PbrLayersDesc {
     }
 };
 
+/// pbr only: KHR_materials_iridescence, a thin dielectric film over the
+/// material (render/thin_film.h) whose Fresnel replaces the specular lobe's in
+/// proportion `factor`. A zero factor or thickness leaves the material as it
+/// is, and costs nothing at render time.
+struct IridescenceDesc {
+    float factor = 0.0f;        ///< in [0, 1]
+    int texture = -1;           ///< R scales factor
+    float ior = 1.3f;           ///< the film's
+    float thickness_min = 100;  ///< nm, at thickness texture G = 0
+    float thickness_max = 400;  ///< nm, at G = 1, and the thickness without a texture
+    int thickness_texture = -1;
+
+    bool any() const { return factor > 0.0f && (thickness_max > 0.0f || thickness_texture >= 0); }
+};
+
 struct MaterialDesc {
     std::string name;
     MaterialType type = MaterialType::lambertian;
@@ -126,6 +141,7 @@ struct MaterialDesc {
     float anisotropy = 0.0f;
     float anisotropy_rotation = 0.0f;
     int anisotropy_texture = -1;
+    IridescenceDesc iridescence;
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
@@ -153,6 +169,8 @@ void for_each_texture_slot(Material& m, F&& f) {
     f("sheen colour", m.layers.sheen_color_texture);
     f("sheen roughness", m.layers.sheen_roughness_texture);
     f("anisotropy", m.anisotropy_texture);
+    f("iridescence", m.iridescence.texture);
+    f("iridescence thickness", m.iridescence.thickness_texture);
     f("alpha", m.alpha_texture);
 }
 

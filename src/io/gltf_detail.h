@@ -65,6 +65,7 @@ class Materials {
     void set_clearcoat(PbrLayersDesc& out, const tinygltf::Value& ext, const std::string& element);
     void set_sheen(PbrLayersDesc& out, const tinygltf::Value& ext, const std::string& element);
     void set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
+    void set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
     std::optional<TextureRef> texture_info(const tinygltf::Value& ext, const char* key) const;
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
     int texture(const TextureRef& ref, bool srgb, const std::string& element);

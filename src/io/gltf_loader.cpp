@@ -34,10 +34,10 @@ const std::set<std::string> kSupportedRequired = {
     "KHR_materials_variants"};
 /// More of them: material models and image formats.
 const std::set<std::string> kSupportedRequiredMaterials = {
-    "KHR_materials_unlit",     "KHR_materials_pbrSpecularGlossiness",
-    "KHR_materials_specular",  "EXT_texture_webp",
-    "KHR_materials_clearcoat", "KHR_materials_sheen",
-    "KHR_materials_anisotropy"};
+    "KHR_materials_unlit",      "KHR_materials_pbrSpecularGlossiness",
+    "KHR_materials_specular",   "EXT_texture_webp",
+    "KHR_materials_clearcoat",  "KHR_materials_sheen",
+    "KHR_materials_anisotropy", "KHR_materials_iridescence"};
 
 bool supported_required(const std::string& name) {
     return kSupportedRequired.count(name) || kSupportedRequiredMaterials.count(name);

@@ -1,7 +1,7 @@
 // glTF materials -> MaterialDesc of type pbr (every core input and the
-// transmission, ior, volume, emissive-strength, clearcoat, sheen and anisotropy extensions), textures ->
-// TextureDesc with the uv convention of scene_desc.h, images decoded through
-// OpenImageIO. Occlusion maps are ignored on purpose: a path tracer computes occlusion.
+// transmission, ior, volume, emissive-strength, clearcoat, sheen, anisotropy and iridescence extensions),
+// textures -> TextureDesc with the uv convention of scene_desc.h, images decoded through OpenImageIO.
+// Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -238,6 +238,9 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
         } else if (name == "KHR_materials_anisotropy") {
             set_anisotropy(out, value, ext);
             out.extensions.push_back(name);
+        } else if (name == "KHR_materials_iridescence") {
+            set_iridescence(out, value, ext);
+            out.extensions.push_back(name);
         } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
@@ -304,6 +307,38 @@ void Materials::set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, co
     out.anisotropy_rotation = float(number(ext, "anisotropyRotation", 0.0));
     if (auto info = texture_info(ext, "anisotropyTexture"))
         out.anisotropy_texture = texture(*info, false, element + ".anisotropyTexture");
+}
+
+/// KHR_materials_iridescence: the film's weight (factor x texture R), ior and
+/// thickness (nm; texture G between the minimum and the maximum). Data
+/// textures, read linear. A value that is not a number or outside the
+/// extension's schema (weight in [0, 1], ior >= 1, thicknesses >= 0) is refused.
+void Materials::set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element) {
+    // high < 0: no upper limit.
+    const auto read = [&](const char* key, double fallback, double low, double high) {
+        if (!ext.Has(key)) return float(fallback);
+        const tinygltf::Value& v = ext.Get(key);
+        const double d = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+        if (!(d >= low && (high < 0 || d <= high) && d < 1e30)) {
+            std::ostringstream range;
+            range << "must be a number ";
+            if (high < 0)
+                range << ">= " << low;
+            else
+                range << "in [" << low << ", " << high << "]";
+            throw input_error(src_.file, element + "." + key, range.str());
+        }
+        return float(d);
+    };
+    IridescenceDesc& d = out.iridescence;
+    d.factor = read("iridescenceFactor", 0.0, 0.0, 1.0);
+    d.ior = read("iridescenceIor", 1.3, 1.0, -1);
+    d.thickness_min = read("iridescenceThicknessMinimum", 100.0, 0.0, -1);
+    d.thickness_max = read("iridescenceThicknessMaximum", 400.0, 0.0, -1);
+    if (auto info = texture_info(ext, "iridescenceTexture"))
+        d.texture = texture(*info, false, element + ".iridescenceTexture");
+    if (auto info = texture_info(ext, "iridescenceThicknessTexture"))
+        d.thickness_texture = texture(*info, false, element + ".iridescenceThicknessTexture");
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).

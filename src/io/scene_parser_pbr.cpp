@@ -64,6 +64,13 @@ void parse_pbr_layers(JsonObject& o, PbrLayersDesc& l) {
     if (auto v = o.get("sheen_roughness")) l.sheen_roughness = v->number_f(unit);
 }
 
+/// The thin film of glTF's KHR_materials_iridescence, factors only: one thickness (nm).
+void parse_pbr_iridescence(JsonObject& o, IridescenceDesc& d) {
+    if (auto v = o.get("iridescence")) d.factor = v->number_f(NumberRange::closed(0, 1));
+    if (auto v = o.get("iridescence_ior")) d.ior = v->number_f(NumberRange::closed(1, 10));
+    if (auto v = o.get("iridescence_thickness")) d.thickness_max = v->number_f(NumberRange::non_negative());
+}
+
 }  // namespace
 
 void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
@@ -91,6 +98,7 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     parse_pbr_layers(o, m.layers);
     if (auto v = o.get("anisotropy")) m.anisotropy = v->number_f(unit);
     if (auto v = o.get("anisotropy_rotation")) m.anisotropy_rotation = v->number_f();
+    parse_pbr_iridescence(o, m.iridescence);
 }
 
 }  // namespace sahara

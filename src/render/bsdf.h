@@ -28,6 +28,17 @@ struct BsdfLayers {
     float sheen_roughness = 0, sheen_alpha = 0;
 };
 
+/// pbr's thin film (KHR_materials_iridescence) at one point; read only when Bsdf::iridescent.
+struct BsdfFilm {
+    float weight = 0;          ///< how much of the film's Fresnel replaces the base's, in (0, 1]
+    float ior = 1.3f;          ///< the film's
+    float thickness = 0;       ///< nm, > 0
+    Rgb dielectric_f0{0.04f};  ///< the dielectric base's F0 under the film, before the specular weight
+    /// Schlick F0 that bounds the dielectric Fresnel with the film: the layer's
+    /// F0 for the albedo scaling, and the cap of the Fresnel (bsdf_pbr.cpp)
+    float bound_f0 = 0.04f;
+};
+
 /// A BSDF instantiated at one surface point.
 struct Bsdf {
     BsdfKind kind = BsdfKind::none;
@@ -49,6 +60,9 @@ struct Bsdf {
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
     bool thin = false;       ///< thin-walled: transmission without refraction
     BsdfLayers layers;       ///< clearcoat and sheen over all of the above
+
+    bool iridescent = false;  ///< `film` is on: KHR_materials_iridescence
+    BsdfFilm film;
 
     bool is_delta() const { return kind == BsdfKind::mirror || kind == BsdfKind::dielectric; }
 };

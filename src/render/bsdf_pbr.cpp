@@ -6,6 +6,7 @@
 #include "render/ggx_albedo.h"
 #include "render/ggx_aniso_albedo.h"
 #include "render/sheen.h"
+#include "render/thin_film.h"
 #include "scene/texture.h"
 
 namespace sahara {
@@ -103,12 +104,34 @@ float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
     return b.f0 * e.e + (b.f90 - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
 }
 
+/// KHR_materials_iridescence: Schlick's Fresnel and the film's mixed by the
+/// film's weight, for the dielectric and the metal alike, then by metallic.
+/// The dielectric one is capped by Schlick's curve from film.bound_f0, the F0
+/// its albedo scaling uses, so that the base below never gets more than the
+/// film leaves; the metal's needs no cap, the film reflecting at most 1.
+Rgb iridescent_fresnel(const Bsdf& b, float cos_theta) {
+    const BsdfFilm& film = b.film;
+    Rgb dielectric(0.0f), metal(0.0f);
+    if (b.metallic < 1.0f) {
+        const Rgb thin =
+            thin_film_reflectance(cos_theta, film.ior, film.thickness, film.dielectric_f0) * b.f90;
+        dielectric = min(lerp(fresnel_schlick(b.f0_color, b.f90, cos_theta), thin, film.weight),
+                         fresnel_schlick(Rgb(film.bound_f0), b.f90, cos_theta));
+    }
+    if (b.metallic > 0.0f)
+        metal = lerp(fresnel_schlick(b.albedo, cos_theta),
+                     thin_film_reflectance(cos_theta, film.ior, film.thickness, b.albedo), film.weight);
+    return lerp(dielectric, metal, b.metallic);
+}
+
 /// Single-scattering GGX reflection, f cos.
 Rgb eval_specular(const Bsdf& b, const PbrTerms& t, const Vec3& wo, const Vec3& wi) {
     const Vec3 wm = normalize(wo + wi);
     const float lo = ggx_lambda(b, wo), li = ggx_lambda(b, wi);
     const float g2 = 1.0f / (1.0f + lo + li);
-    return fresnel_schlick(t.f0, t.f90, std::abs(dot(wo, wm))) * (ggx_d(b, wm) * g2 / (4.0f * wo.z));
+    const float cos_m = std::abs(dot(wo, wm));
+    const Rgb fresnel = b.iridescent ? iridescent_fresnel(b, cos_m) : fresnel_schlick(t.f0, t.f90, cos_m);
+    return fresnel * (ggx_d(b, wm) * g2 / (4.0f * wo.z));
 }
 
 /// The half vector of a refraction from wo (outside, +z) to wi (below), facing +z.
@@ -207,6 +230,32 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.f0_color = Rgb(std::min(f0.x, 1.0f), std::min(f0.y, 1.0f), std::min(f0.z, 1.0f)) * weight;
     b.f0 = max_component(b.f0_color);
     b.f90 = weight;
+}
+
+/// KHR_materials_iridescence at si: the film's weight (factor x texture R) and
+/// thickness (texture G between the minimum and the maximum, else the
+/// maximum). A film of no weight or thickness leaves the material untouched.
+/// The dielectric layer's F0 becomes the bound of what it reflects with the
+/// film, so that the albedo scaling keeps the whole energy conserving.
+void set_iridescence(Bsdf& b, const IridescenceDesc& d, const SurfaceInteraction& si,
+                     const std::vector<TextureDesc>& textures) {
+    const float weight = std::clamp(d.factor * texture_channel(d.texture, 0, si, textures), 0.0f, 1.0f);
+    float thickness = d.thickness_max;
+    if (d.thickness_texture >= 0)
+        thickness = d.thickness_min + (d.thickness_max - d.thickness_min) *
+                                          texture_channel(d.thickness_texture, 1, si, textures);
+    if (!(weight > 0) || !(thickness > 0)) return;
+    BsdfFilm& film = b.film;
+    film.weight = weight;
+    film.ior = d.ior;
+    film.thickness = thickness;
+    // The film lies on the dielectric before KHR_materials_specular's weight,
+    // which scales what the two reflect together.
+    film.dielectric_f0 = b.f90 > 0 ? b.f0_color / b.f90 : b.f0_color;
+    const float film_f0 = thin_film_reflectance_bound(d.ior, film.dielectric_f0) * b.f90;
+    film.bound_f0 = std::min(1.0f, b.f0 + weight * std::max(0.0f, film_f0 - b.f0));
+    b.f0 = film.bound_f0;
+    b.iridescent = true;
 }
 
 /// The coat's weight at si: clearcoat x its texture's R.
@@ -345,11 +394,18 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.f0 = r * r;
     b.f0_color = Rgb(b.f0);
     if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
+    if (m.iridescence.factor > 0) set_iridescence(b, m.iridescence, si, textures);
     b.thin = m.thin_walled;
     b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
     if (m.anisotropy > 0) set_anisotropy(b, m, si, textures);
     if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);
+}
+
+Rgb pbr_fresnel(const Bsdf& b, float cos_theta) {
+    if (b.iridescent) return iridescent_fresnel(b, cos_theta);
+    return fresnel_schlick(lerp(b.f0_color, b.albedo, b.metallic),
+                           1.0f - (1.0f - b.metallic) * (1.0f - b.f90), cos_theta);
 }
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {

@@ -13,6 +13,12 @@
 /// reflect reaches the base and the whole stays reciprocal. A white material
 /// then reflects everything at any roughness, metallic or not.
 ///
+/// KHR_materials_iridescence replaces, in proportion to its weight, the
+/// specular lobe's Fresnel by a thin film's (render/thin_film.h); the
+/// dielectric layer's albedo, which scales the base, is then taken at an F0
+/// that bounds the film's reflectance, and the film's Fresnel is capped by
+/// Schlick's curve from that F0, so the layering still conserves energy.
+///
 /// Transmission (KHR_materials_transmission) replaces that fraction of the
 /// base by a rough dielectric interface (Walter et al. 2007) refracting with
 /// the material's ior, as `dielectric` does for a closed volume.
@@ -36,6 +42,11 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
 /// light seen and a light sampled agree.
 Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
                  const std::vector<TextureDesc>& textures, const Vec3& wo);
+
+/// The specular lobe's Fresnel at cos_theta to the microfacet normal:
+/// Schlick's, the dielectric's and the metal's mixed by metallic, with the
+/// thin film where KHR_materials_iridescence puts one (render/thin_film.h).
+Rgb pbr_fresnel(const Bsdf& b, float cos_theta);
 
 /// The lobes' weights at one wo: the probabilities sample_pbr uses.
 struct PbrLobeWeights {

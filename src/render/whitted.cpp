@@ -76,9 +76,7 @@ Rgb whitted_pbr(const Scene& scene, const SurfaceInteraction& si, const Material
         if (dot(wr, si.ng) > 0)
             radiance += f * branch(scene, si, wr, false, time, depth, max_depth, weight * max_component(f));
     };
-    mirror(si.ns, fresnel_schlick(b.albedo * b.metallic + b.f0_color * (1.0f - b.metallic),
-                                  1.0f - (1.0f - b.metallic) * (1.0f - b.f90), dot(wo, si.ns)) *
-                      layers.base_scale);
+    mirror(si.ns, pbr_fresnel(b, dot(wo, si.ns)) * layers.base_scale);
     if (layers.coat_fresnel > 0)
         mirror(b.layers.coat_frame ? b.frame.to_world(b.layers.coat_normal) : b.frame.n,
                Rgb(layers.coat_fresnel));

@@ -52,6 +52,7 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
         {"alphaMode", "BLEND"},
         {"extensions",
          {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}},
+          {"KHR_materials_dispersion", {{"dispersion", 0.5}}},
           {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}},
           {"KHR_materials_transmission", {{"transmissionFactor", 0.5}}},
           {"KHR_materials_volume",
@@ -71,9 +72,10 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     CHECK(m["alpha_mode"] == "blend");
     CHECK(m["double_sided"] == false);
     const json& ignored = j["Ignored inputs"]["[0] paint"];
-    for (const char* what : {"occlusion map", "KHR_materials_iridescence"})
+    for (const char* what : {"occlusion map", "KHR_materials_dispersion"})
         CHECK_MESSAGE(contains(ignored, what), std::string(what));
-    CHECK_FALSE(contains(ignored, "KHR_materials_clearcoat"));  // rendered
+    CHECK_FALSE(contains(ignored, "KHR_materials_clearcoat"));    // rendered
+    CHECK_FALSE(contains(ignored, "KHR_materials_iridescence"));  // rendered
     CHECK(m["clearcoat"] == 1.0);
     CHECK_FALSE(contains(ignored, "volume attenuation (not rendered yet)"));  // rendered now
     CHECK(m["volume_attenuation"] == true);
@@ -86,7 +88,7 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     for (const char* text :
          {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
           "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
-          "clearcoat 1 (roughness 0)", "Ignored inputs", "occlusion map, KHR_materials_iridescence"})
+          "clearcoat 1 (roughness 0)", "Ignored inputs", "occlusion map, KHR_materials_dispersion"})
         CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
 }
 

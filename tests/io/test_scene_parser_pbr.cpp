@@ -137,3 +137,23 @@ TEST_CASE("scene parser: pbr anisotropy keys") {
                    {"materials.m.anisotropy_rotation"});
     check_contains(bad(R"({"type": "metal", "anisotropy": 0.5})"), {"anisotropy"});  // pbr only
 }
+
+TEST_CASE("scene parser: pbr iridescence keys") {
+    const MaterialDesc plain = parse_one(R"({"type": "pbr"})");
+    CHECK_FALSE(plain.iridescence.any());
+    const MaterialDesc m = parse_one(
+        R"({"type": "pbr", "iridescence": 0.8, "iridescence_ior": 1.6, "iridescence_thickness": 320})");
+    CHECK(m.iridescence.factor == 0.8f);
+    CHECK(m.iridescence.ior == 1.6f);
+    CHECK(m.iridescence.thickness_max == 320.0f);
+    CHECK(m.iridescence.texture == -1);
+    CHECK(m.iridescence.thickness_texture == -1);
+    const auto bad = [](const std::string& material) {
+        return error_of(with_objects("[]", R"({"m": )" + material + "}"));
+    };
+    check_contains(bad(R"({"type": "pbr", "iridescence": 1.5})"), {"materials.m.iridescence", "[0, 1]"});
+    check_contains(bad(R"({"type": "pbr", "iridescence_ior": 0.5})"), {"materials.m.iridescence_ior"});
+    check_contains(bad(R"({"type": "pbr", "iridescence_thickness": -1})"),
+                   {"materials.m.iridescence_thickness"});
+    check_contains(bad(R"({"type": "lambertian", "iridescence": 0.5})"), {"iridescence"});  // pbr only
+}
