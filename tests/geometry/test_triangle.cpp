@@ -13,6 +13,7 @@
 #include "geometry/triangle.h"
 #include "mesh_fixtures.h"
 #include "scene/scene.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 using namespace sahara::test;
@@ -257,8 +258,7 @@ TEST_CASE("geometric normal, shading normal and uv interpolation") {
 }
 
 TEST_CASE("OBJ reader fan-splits polygons in file order and keeps degenerate triangles") {
-    const auto dir = std::filesystem::temp_directory_path() / "sahara_test_obj";
-    std::filesystem::create_directories(dir);
+    const auto dir = test::scratch_dir("test_obj");
     const auto file = dir / "fan.obj";
     {
         std::FILE* f = std::fopen(file.string().c_str(), "w");

@@ -15,18 +15,16 @@
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "scratch_dir.h"
 
 namespace sahara::test::gltf {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-inline fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("sahara_gltf_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+/// A fresh folder for one test's files. The process id keeps test cases that
+/// share a name apart when ctest runs them in parallel processes.
+inline fs::path scratch(const std::string& name) { return scratch_dir("gltf_" + name); }
 
 inline std::vector<uint8_t> read_all(const fs::path& f) {
     std::ifstream in(f, std::ios::binary);

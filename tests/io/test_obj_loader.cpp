@@ -15,6 +15,7 @@
 #include "io/model_loader.h"
 #include "mesh_fixtures.h"
 #include "test_data.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 using sahara::test::count_repeated_corner_triangles;
@@ -25,12 +26,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// A fresh scratch folder per test.
-fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("sahara_obj_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path scratch(const std::string& name) { return test::scratch_dir("obj_" + name); }
 
 void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
 

@@ -2,8 +2,6 @@
 // quirks of downloaded OBJ files: malformed numbers, UTF-16/32, quad splits.
 #include <doctest/doctest.h>
 #include <fcntl.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -12,18 +10,14 @@
 #include "base/error.h"
 #include "io/image_io.h"
 #include "io/model_loader.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("sahara_objmat_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path scratch(const std::string& name) { return test::scratch_dir("objmat_" + name); }
 
 void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
 

@@ -10,18 +10,14 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "io/model_loader.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("sahara_obj_text_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path scratch(const std::string& name) { return test::scratch_dir("obj_text_" + name); }
 
 void write(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
 

@@ -14,6 +14,7 @@
 #include "io/model_loader.h"
 #include "io/up_axis.h"
 #include "io/view_scene.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
@@ -49,8 +50,7 @@ struct ObjText {
         for (Vec3& p : v) p = f(p);
     }
     fs::path write(const std::string& name, const std::string& header = "") const {
-        const fs::path dir = fs::temp_directory_path() / "sahara_up_axis";
-        fs::create_directories(dir);
+        const fs::path dir = test::scratch_dir("up_axis");
         const fs::path file = dir / name;
         std::ofstream out(file);
         out << header;

@@ -14,6 +14,7 @@
 #include "render_test_util.h"
 #include "scene/instances.h"
 #include "scene/scene.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 using namespace sahara::test;
@@ -126,8 +127,7 @@ TEST_CASE("instance motion: a moving instance blurs into the mean of its frames"
 }
 
 TEST_CASE("instance motion: the scene format's instance velocity composes through nested instances") {
-    const auto dir = std::filesystem::temp_directory_path() / "sahara_instance_motion";
-    std::filesystem::create_directories(dir);
+    const auto dir = test::scratch_dir("instance_motion");
     std::ofstream(dir / "square.obj")
         << "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3 4\n";
     const SceneDesc d = parse_scene_json(R"({
