@@ -55,6 +55,23 @@ inline constexpr size_t kHugePageMinBytes = size_t(1) << 20;
 /// Marks [p, p + bytes) for transparent huge pages (a hint; no effect where unsupported).
 void advise_huge_pages(void* p, size_t bytes);
 
+/// While one of these is alive, the huge-page blocks AlignedAllocator frees are kept and
+/// handed to later requests they fit, instead of going back to the system; they are freed
+/// when the last scope ends. A fresh block costs the kernel's zeroing of each page at its
+/// first touch, and each phase of an acceleration build (binary tree, collapse, leaf
+/// blocks) would otherwise pay it again for memory the phase before had just freed.
+class HugeBlockReuse {
+   public:
+    HugeBlockReuse();
+    ~HugeBlockReuse();
+    HugeBlockReuse(const HugeBlockReuse&) = delete;
+    HugeBlockReuse& operator=(const HugeBlockReuse&) = delete;
+};
+/// A kept block of at least `bytes` (whole huge pages), or nullptr.
+void* take_kept_huge_block(size_t bytes);
+/// Keeps block `p` of `bytes` if a HugeBlockReuse is alive; false: the caller frees it.
+bool keep_huge_block(void* p, size_t bytes);
+
 /// Minimal allocator returning `Align`-byte aligned storage (huge pages for big arrays).
 template <class T, size_t Align>
 struct AlignedAllocator {
@@ -78,11 +95,18 @@ struct AlignedAllocator {
     T* allocate(size_t n) {
         if (n > std::numeric_limits<size_t>::max() / 4 / sizeof(T)) throw std::bad_array_new_length();
         const size_t bytes = n * sizeof(T);
+        const bool huge = alignment(bytes) == kHugePageBytes;
+        if (huge)
+            if (void* kept = take_kept_huge_block(reserved(bytes))) return static_cast<T*>(kept);
         void* p = ::operator new(reserved(bytes), std::align_val_t(alignment(bytes)));
-        if (alignment(bytes) == kHugePageBytes) advise_huge_pages(p, reserved(bytes));
+        if (huge) advise_huge_pages(p, reserved(bytes));
         return static_cast<T*>(p);
     }
-    void deallocate(T* p, size_t n) { ::operator delete(p, std::align_val_t(alignment(n * sizeof(T)))); }
+    void deallocate(T* p, size_t n) {
+        const size_t bytes = n * sizeof(T);
+        if (alignment(bytes) == kHugePageBytes && keep_huge_block(p, reserved(bytes))) return;
+        ::operator delete(p, std::align_val_t(alignment(bytes)));
+    }
     friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
 };
 

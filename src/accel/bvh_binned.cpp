@@ -64,6 +64,9 @@ class BinnedBuild {
             const Range root = init_refs();
             build(0, Bvh::kFirstPair, root, 0);
         }
+        // Free before compact() allocates the tree (see HugeBlockReuse).
+        refs_ = {};
+        scratch_ = {};
         compact();
     }
 

@@ -31,8 +31,7 @@ float half_area(const BvhNode& n) {
 template <int N>
 class CollapsePlan {
    public:
-    CollapsePlan(const Bvh& bvh, const WideCollapse& opt)
-        : bvh_(bvh), opt_(opt), cost_(bvh.nodes.size()), plan_(bvh.nodes.size()), range_(bvh.nodes.size()) {
+    CollapsePlan(const Bvh& bvh, const WideCollapse& opt) : bvh_(bvh), opt_(opt), table_(bvh.nodes.size()) {
         // Each node's costs depend only on its children's, so the subtrees below the
         // top levels are independent tasks; the result does not depend on the threads.
         if (bvh.nodes.size() < opt.parallel_min_nodes) {
@@ -54,7 +53,7 @@ class CollapsePlan {
     int children(uint32_t inner, Child out[N]) const {
         int n = 0;
         const uint32_t first = bvh_.nodes[inner].index;
-        const int j = plan_[inner].left_slots[N];
+        const int j = table_[inner].plan.left_slots[N];
         emit(first, j, out, n);
         emit(first + 1, N - j, out, n);
         return n;
@@ -77,6 +76,12 @@ class CollapsePlan {
     };
     struct Range {
         uint32_t first, count;  ///< the subtree's slots; first = kNoNode: not contiguous
+    };
+    /// Node x's share of the programme, in one array (one allocation, read together).
+    struct Entry {
+        Costs cost;  ///< [k]: least cost of subtree x in k slots
+        Choice plan;
+        Range range;
     };
     /// Costs and choices of the subtree of node x, children first.
     void solve(uint32_t x) {
@@ -177,28 +182,29 @@ class CollapsePlan {
         constexpr double inf = std::numeric_limits<double>::infinity();
         const BvhNode& node = bvh_.nodes[x];
         const double area = double(half_area(node));
-        Costs& f = cost_[x];
+        Entry& e = table_[x];
+        Costs& f = e.cost;
         if (node.is_leaf()) {
-            range_[x] = {node.index, node.count};
+            e.range = {node.index, node.count};
             f.fill(opt_.block_cost * area * double(blocks(node.count)));
             return;
         }
-        Choice& plan = plan_[x];
+        Choice& plan = e.plan;
         plan = Choice{};
-        const Range& l = range_[node.index];
-        const Range& r = range_[node.index + 1];
+        const Range& l = table_[node.index].range;
+        const Range& r = table_[node.index + 1].range;
         // A subtree whose primitives are contiguous slots may become one leaf.
         const bool contiguous = l.first != kNoNode && r.first == l.first + l.count;
-        range_[x] = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
-        const Costs& left = cost_[node.index];
-        const Costs& right = cost_[node.index + 1];
+        e.range = contiguous ? Range{l.first, l.count + r.count} : Range{kNoNode, 0};
+        const Costs& left = table_[node.index].cost;
+        const Costs& right = table_[node.index + 1].cost;
         const Costs opened = open_costs(left, right, bvh_.nodes[node.index].is_leaf(),
                                         bvh_.nodes[node.index + 1].is_leaf(), plan);
         // As one child, x is a node of its own (its area plus its children in N
         // slots) or, when small enough, a leaf.
         const double as_node = area + opened[N];
-        const double as_leaf = contiguous && range_[x].count <= opt_.merge_leaves_up_to
-                                   ? opt_.block_cost * area * double(blocks(range_[x].count))
+        const double as_leaf = contiguous && e.range.count <= opt_.merge_leaves_up_to
+                                   ? opt_.block_cost * area * double(blocks(e.range.count))
                                    : inf;
         plan.leaf = as_leaf < as_node;
         f[1] = std::min(as_node, as_leaf);
@@ -225,20 +231,19 @@ class CollapsePlan {
                                             std::to_string(kMaxWideLeafCount) +
                                             " primitives (BvhBuildParams::max_leaf_size)");
             out[n++] = {x, node.index, node.count};
-        } else if (plan_[x].open[k]) {
-            const int j = plan_[x].left_slots[k];
+        } else if (table_[x].plan.open[k]) {
+            const int j = table_[x].plan.left_slots[k];
             emit(node.index, j, out, n);
             emit(node.index + 1, k - j, out, n);
         } else {
-            out[n++] = {x, plan_[x].leaf ? range_[x].first : 0, plan_[x].leaf ? range_[x].count : 0};
+            const Entry& e = table_[x];
+            out[n++] = {x, e.plan.leaf ? e.range.first : 0, e.plan.leaf ? e.range.count : 0};
         }
     }
 
     const Bvh& bvh_;
     const WideCollapse opt_;
-    BuildArray<Costs> cost_;  ///< [x][k]: least cost of subtree x in k slots
-    BuildArray<Choice> plan_;
-    BuildArray<Range> range_;
+    BuildArray<Entry> table_;  ///< [x]: subtree x's costs, choices and slots
     std::array<Top, kTopNodes> top_;
 };
 

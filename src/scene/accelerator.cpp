@@ -217,6 +217,8 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 }
 
 void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
+    // Each phase below takes its arrays from the memory the phases before it freed.
+    const HugeBlockReuse reuse;
     const PrimitiveList prims = collect_primitives(scene);
     uses_tree_ = prims.size() > options.flat_loop_max_prims;
     const BvhBuildParams params = options.build_params();
