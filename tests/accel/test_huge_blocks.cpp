@@ -39,7 +39,7 @@ TEST_CASE("huge blocks: a kept block more than a huge page larger than the reque
     CHECK(fits.get() == kept);
 }
 
-TEST_CASE("huge blocks: a reused block comes back with its own size, not the last request's") {
+TEST_CASE("huge blocks: a reused block comes back with its own size and not the last request's") {
     const HugeBlockReuse reuse;
     HugeVector block(6 * kMiB);
     const char* p = block.data();
