@@ -10,26 +10,9 @@
 #include <sstream>
 #include <string>
 
-namespace sahara::test {
+#include "scratch_dir.h"
 
-/// A fresh directory per test, removed afterwards.
-struct TempDir {
-    std::filesystem::path path;
-    explicit TempDir(const std::string& name)
-        : path(std::filesystem::temp_directory_path() /
-               ("sahara_test_" + std::to_string(::getpid()) + "_" + name)) {
-        std::filesystem::remove_all(path);
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    /// The path of `file` in the directory.
-    std::string operator/(const std::string& file) const { return (path / file).string(); }
-};
+namespace sahara::test {
 
 /// What a run of the executable left: its exit code and output.
 struct CliRun {

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <functional>
 
+#include "render/film.h"
 #include "render/integrator.h"
+#include "render/renderer.h"
 #include "render/sampler.h"
 #include "scene/scene.h"
 
@@ -86,6 +88,15 @@ inline Rgb radiance_along(SceneDesc d, IntegratorType integrator, const Ray& ray
     Sampler sampler(3, SamplerType::independent);
     sampler.start(0, 0, 0);
     return estimate_radiance(scene, ray, sampler, max_depth);
+}
+
+/// Renders the scene built from `d` into `film` on two threads (what the
+/// image-level tests compare: instanced against flat, frames against blur).
+inline void render_into(const SceneDesc& d, Film& film) {
+    const Scene scene = build_scene(d);
+    RenderOptions o;
+    o.threads = 2;
+    render_image(scene, film, o);
 }
 
 /// Statistics of estimate_radiance along one ray.

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <system_error>
 
 namespace sahara::test {
 
@@ -17,5 +18,19 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
     fs::create_directories(dir);
     return dir;
 }
+
+/// A scratch_dir that is removed when the test is done with it.
+struct TempDir {
+    std::filesystem::path path;
+    explicit TempDir(const std::string& name) : path(scratch_dir("test_" + name)) {}
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    /// The path of `file` in the directory.
+    std::string operator/(const std::string& file) const { return (path / file).string(); }
+};
 
 }  // namespace sahara::test

@@ -11,6 +11,7 @@
 #include "io/view_scene.h"
 #include "render/film.h"
 #include "render/renderer.h"
+#include "render_test_util.h"
 #include "scene/instances.h"
 #include "scene/scene.h"
 
@@ -102,11 +103,8 @@ std::vector<double> render_view(const fs::path& file) {
     desc.render.height = 36;
     desc.render.spp = 16;
     desc.render.max_depth = 3;
-    const Scene scene = build_scene(desc);
     Film film(desc.render.width, desc.render.height);
-    RenderOptions o;
-    o.threads = 2;
-    render_image(scene, film, o);
+    test::render_into(desc, film);
     std::vector<double> out;
     for (int y = 0; y < film.height(); ++y)
         for (int x = 0; x < film.width(); ++x) {

@@ -1,32 +1,16 @@
 #include <doctest/doctest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
 #include "base/error.h"
 #include "io/image_io.h"
+#include "scratch_dir.h"
 
 using namespace sahara;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// A fresh directory for one test case, removed with everything in it at the end.
-struct TempDir {
-    fs::path path = fs::temp_directory_path() / ("sahara-test-io-" + std::to_string(::getpid()));
-    TempDir() {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-};
 
 std::vector<float> gradient_pixels(int w, int h) {
     std::vector<float> rgb(size_t(w) * size_t(h) * 3);
@@ -43,7 +27,7 @@ std::vector<float> gradient_pixels(int w, int h) {
 }  // namespace
 
 TEST_CASE("image round trip: EXR is linear and exact in float") {
-    const TempDir dir;
+    const test::TempDir dir("image_io");
     const fs::path file = dir.path / "round.exr";
     std::vector<float> rgb = gradient_pixels(7, 5);
     rgb[0] = 12.5f;  // HDR values are not clipped
@@ -56,7 +40,7 @@ TEST_CASE("image round trip: EXR is linear and exact in float") {
 }
 
 TEST_CASE("image round trip: PFM is linear, exact in float and stored bottom row first") {
-    const TempDir dir;
+    const test::TempDir dir("image_io");
     const fs::path file = dir.path / "round.pfm";
     std::vector<float> rgb = gradient_pixels(7, 5);
     rgb[0] = 12.5f;  // top-left red: HDR values are not clipped
@@ -80,7 +64,7 @@ TEST_CASE("image round trip: PFM is linear, exact in float and stored bottom row
 }
 
 TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
-    const TempDir dir;
+    const test::TempDir dir("image_io");
     const fs::path file = dir.path / "round.png";
     const std::vector<float> rgb = gradient_pixels(9, 4);
     write_image(file, 9, 4, rgb);
@@ -94,7 +78,7 @@ TEST_CASE("image round trip: PNG is sRGB-encoded 8-bit") {
 }
 
 TEST_CASE("image writing is atomic and checks its path first") {
-    const TempDir tmp;
+    const test::TempDir tmp("image_io");
     const fs::path& dir = tmp.path;
     CHECK_THROWS_AS(check_output_path(dir / "missing" / "x.png"), InputError);
     CHECK_THROWS_AS(check_output_path(dir / "x.bmpx"), InputError);
@@ -108,7 +92,7 @@ TEST_CASE("image writing is atomic and checks its path first") {
 }
 
 TEST_CASE("an output name that is a directory or under a file is refused with the reason") {
-    const TempDir tmp;
+    const test::TempDir tmp("image_io");
     const fs::path& dir = tmp.path;
     fs::create_directory(dir / "taken.png");
     std::ofstream(dir / "plain.txt") << "x";
@@ -129,7 +113,7 @@ TEST_CASE("an output name that is a directory or under a file is refused with th
 }
 
 TEST_CASE("reading a missing or broken image names the file") {
-    const TempDir tmp;
+    const test::TempDir tmp("image_io");
     const fs::path& dir = tmp.path;
     CHECK_THROWS_WITH_AS(read_image(dir / "nope.png", true), doctest::Contains("nope.png"), InputError);
     { std::ofstream(dir / "broken.png") << "not a png"; }

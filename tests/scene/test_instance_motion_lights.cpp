@@ -51,11 +51,8 @@ SceneDesc albedo_scene(float shutter_open, float shutter_close) {
 std::vector<double> render_means(const SceneDesc& d, int spp) {
     SceneDesc copy = d;
     copy.render.spp = spp;
-    const Scene scene = build_scene(copy);
     Film film(d.render.width, d.render.height);
-    RenderOptions o;
-    o.threads = 2;
-    render_image(scene, film, o);
+    render_into(copy, film);
     std::vector<double> v;
     for (int y = 0; y < film.height(); ++y)
         for (int x = 0; x < film.width(); ++x) v.push_back(film.sum(x, y).x / double(film.count(x, y)));

@@ -10,6 +10,7 @@
 #include "render/film.h"
 #include "render/renderer.h"
 #include "render/stats.h"
+#include "render_test_util.h"
 #include "scene/instances.h"
 #include "scene/scene.h"
 
@@ -46,13 +47,6 @@ TriangleMesh smooth_ball() {
     TriangleMesh m = make_icosphere(2);
     for (const Vec3& p : m.positions) m.normals.push_back(normalize(p));
     return m;
-}
-
-void render(const SceneDesc& d, Film& film) {
-    const Scene scene = build_scene(d);
-    RenderOptions o;
-    o.threads = 2;
-    render_image(scene, film, o);
 }
 
 /// Fraction of pixels whose mean differs by more than `tol` (relative, per channel).
@@ -119,8 +113,8 @@ TEST_CASE("instances: an instanced mesh renders the same pixels as the same mesh
             CHECK(scene.triangles.size() == 0);  // nothing copied into the flat tree
             CHECK_FALSE(scene.packets_pay_off());
             Film a(64, 48), b(64, 48);
-            render(inst, a);
-            render(flat, b);
+            test::render_into(inst, a);
+            test::render_into(flat, b);
             // Float rounding moves a silhouette sample now and then; nothing else differs.
             CAPTURE(smooth);
             CAPTURE(int(integrator));
