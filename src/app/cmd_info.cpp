@@ -10,6 +10,7 @@
 
 #include "app/cli_args.h"
 #include "base/error.h"
+#include "base/text.h"
 #include "io/files.h"
 #include "io/model_loader.h"
 #include "pipeline/scene_info.h"
@@ -75,9 +76,7 @@ StatsReport scene_info(const std::optional<std::string>& input, const std::optio
     const double build = seconds_since(t);
     StatsReport s = describe_scene(desc, scene);
     if (!variants.empty()) {
-        std::string names;
-        for (const std::string& v : variants) names += (names.empty() ? "" : ", ") + v;
-        s.add("Material variants", "KHR_materials_variants", names, variants);
+        s.add("Material variants", "KHR_materials_variants", join(variants), variants);
         s.add("Material variants", "Rendered", variant ? *variant : "the default materials",
               variant ? nlohmann::json(*variant) : nlohmann::json());
     }

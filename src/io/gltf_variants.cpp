@@ -1,6 +1,7 @@
 // KHR_materials_variants: the file's variant names, the caller's choice of one,
 // and the material each primitive takes under it.
 #include "base/error.h"
+#include "base/text.h"
 #include "io/gltf_detail.h"
 
 namespace sahara::gltf {
@@ -8,12 +9,6 @@ namespace sahara::gltf {
 namespace {
 
 const char* kExt = "KHR_materials_variants";
-
-std::string joined(const std::vector<std::string>& names) {
-    std::string out;
-    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-    return out;
-}
 
 /// A JSON integer in [0, size), or an InputError naming `element`.
 size_t checked_index(const Source& src, const tinygltf::Value& v, size_t size, const char* what,
@@ -48,7 +43,7 @@ size_t chosen_variant(const Source& src, const std::string& name) {
         if (names[i] == name) return i;
     throw input_error(src.file, kExt,
                       "no material variant named '" + name + "'" +
-                          (names.empty() ? ", the file has none" : "; the file has: " + joined(names)));
+                          (names.empty() ? ", the file has none" : "; the file has: " + join(names)));
 }
 
 int variant_material(const Source& src, const tinygltf::Primitive& prim, const std::string& element) {

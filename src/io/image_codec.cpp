@@ -1,4 +1,5 @@
 // Finds and loads the image codec plugin (image_codec.h).
+#include "base/text.h"
 #include "io/image_codec.h"
 
 #include <dlfcn.h>
@@ -67,9 +68,7 @@ Loaded load() {
     if (sahara_image_codec_api) return {sahara_image_codec_api(), ""};
     const ImageCodecSearch search = find_image_codec();
     if (search.found.empty()) {
-        std::string tried;
-        for (const std::string& file : search.tried) tried += (tried.empty() ? "" : ", ") + file;
-        return {nullptr, "the image codec plugin is missing (looked for " + tried +
+        return {nullptr, "the image codec plugin is missing (looked for " + join(search.tried) +
                              "; build the target sahara_image_codec, or install sahara again)"};
     }
     const std::string& file = search.found;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <variant>
 
+#include "base/text.h"
 #include "io/image_codec.h"
 #include "io/plot.h"
 
@@ -254,9 +255,7 @@ bool draw_text_with_superscript(OIIO::ImageBuf& canvas, const PlotText& t, const
 
 /// Why texts are missing when no font of `fonts` was found; `what` names the image.
 std::string no_font_warning(const std::vector<std::string>& fonts, const std::string& what) {
-    std::string tried;
-    for (const std::string& f : fonts) tried += (tried.empty() ? "" : ", ") + f;
-    return "no TrueType font found (tried " + tried +
+    return "no TrueType font found (tried " + join(fonts) +
            "; Debian: apt-get install fonts-dejavu-core): " + what + " has no text";
 }
 

@@ -1,3 +1,4 @@
+#include "base/text.h"
 #include "io/json_reader.h"
 
 #include <algorithm>
@@ -323,8 +324,7 @@ JsonValue JsonObject::require(const char* key, const std::string& what) {
 void JsonObject::finish() const {
     for (const auto& [key, v] : value_.json().items()) {
         if (std::find(allowed_.begin(), allowed_.end(), key) != allowed_.end()) continue;
-        std::string list;
-        for (const auto& a : allowed_) list += (list.empty() ? "" : ", ") + a;
+        const std::string list = join(allowed_);
         throw input_error(value_.file(), child_path(key),
                           "unknown key" + (list.empty() ? std::string(" (no keys are allowed here)")
                                                         : " (allowed here: " + list + ")"));

@@ -1,3 +1,4 @@
+#include "base/text.h"
 #include "pipeline/material_info.h"
 
 #include <algorithm>
@@ -28,12 +29,6 @@ const char* material_type_name(MaterialType t) {
             return "unlit";
     }
     return "?";
-}
-
-std::string join(const std::vector<std::string>& items, const char* separator) {
-    std::string out;
-    for (const std::string& item : items) out.append(out.empty() ? "" : separator).append(item);
-    return out;
 }
 
 std::string number_text(float v) {

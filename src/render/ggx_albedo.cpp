@@ -9,26 +9,13 @@ namespace sahara {
 
 namespace {
 
-/// E and Es at one (mu, alpha) by stratified visible-normal sampling: each
-/// sample's weight f cos / pdf is G2 / G1(wo) times the Fresnel term.
+/// E and Es at one (mu, alpha).
 GgxAlbedo integrate_albedo(float mu, float alpha, int strata) {
     mu = std::max(mu, 1e-4f);
     const Vec3 wo(std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, mu);
-    const double lo = ggx_lambda(wo, alpha);
-    double e = 0, es = 0;
-    for (int i = 0; i < strata; ++i)
-        for (int j = 0; j < strata; ++j) {
-            const Vec2 u{(float(i) + 0.5f) / float(strata), (float(j) + 0.5f) / float(strata)};
-            const Vec3 wm = sample_ggx_vndf(wo, alpha, u);
-            const Vec3 wi = wm * (2.0f * dot(wo, wm)) - wo;
-            if (wi.z <= 0) continue;
-            const double w = (1.0 + lo) / (1.0 + lo + double(ggx_lambda(wi, alpha)));
-            const double m = std::clamp(1.0 - double(dot(wo, wm)), 0.0, 1.0);
-            e += w;
-            es += w * (m * m) * (m * m) * m;
-        }
-    const double n = double(strata) * double(strata);
-    return {float(e / n), float(es / n)};
+    return integrate_ggx_albedo(
+        wo, [&](const Vec3& w) { return ggx_lambda(w, alpha); },
+        [&](const Vec2& u) { return sample_ggx_vndf(wo, alpha, u); }, strata);
 }
 
 /// 2 * integral over [0, 1] of f(mu) mu dmu for f linear between equally spaced samples.

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "math/vec3.h"
+
 namespace sahara {
 
 /// Cell i and linear weight t of x in [0, 1] over n equally spaced table samples
@@ -26,6 +28,29 @@ inline constexpr float kMinPbrAlpha = 1e-3f;
 struct GgxAlbedo {
     float e = 1, e_schlick = 0;
 };
+
+/// E and Es towards wo (wo.z > 0) by stratified visible-normal sampling, for
+/// the isotropic and the anisotropic tables alike: each sample's weight
+/// f cos / pdf is G2 / G1(wo) times the Fresnel term. `lambda(w)` is the
+/// lobe's Smith Lambda and `sample_vndf(u)` its visible normal for wo.
+template <class Lambda, class SampleVndf>
+GgxAlbedo integrate_ggx_albedo(const Vec3& wo, Lambda lambda, SampleVndf sample_vndf, int strata) {
+    const double lo = lambda(wo);
+    double e = 0, es = 0;
+    for (int i = 0; i < strata; ++i)
+        for (int j = 0; j < strata; ++j) {
+            const Vec2 u{(float(i) + 0.5f) / float(strata), (float(j) + 0.5f) / float(strata)};
+            const Vec3 wm = sample_vndf(u);
+            const Vec3 wi = wm * (2.0f * dot(wo, wm)) - wo;
+            if (wi.z <= 0) continue;
+            const double w = (1.0 + lo) / (1.0 + lo + double(lambda(wi)));
+            const double m = std::clamp(1.0 - double(dot(wo, wm)), 0.0, 1.0);
+            e += w;
+            es += w * (m * m) * (m * m) * m;
+        }
+    const double n = double(strata) * double(strata);
+    return {float(e / n), float(es / n)};
+}
 
 class GgxAlbedoTable {
    public:

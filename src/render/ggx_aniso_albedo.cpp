@@ -9,26 +9,6 @@ namespace sahara {
 
 namespace {
 
-/// E and Es towards wo (wo.z > 0) by stratified visible-normal sampling, as for
-/// the isotropic table: each sample weighs G2 / G1(wo) times the Fresnel term.
-GgxAlbedo integrate_albedo(const Vec3& wo, float alpha_x, float alpha_y, int strata) {
-    const double lo = ggx_lambda(wo, alpha_x, alpha_y);
-    double e = 0, es = 0;
-    for (int i = 0; i < strata; ++i)
-        for (int j = 0; j < strata; ++j) {
-            const Vec2 u{(float(i) + 0.5f) / float(strata), (float(j) + 0.5f) / float(strata)};
-            const Vec3 wm = sample_ggx_vndf(wo, alpha_x, alpha_y, u);
-            const Vec3 wi = wm * (2.0f * dot(wo, wm)) - wo;
-            if (wi.z <= 0) continue;
-            const double w = (1.0 + lo) / (1.0 + lo + double(ggx_lambda(wi, alpha_x, alpha_y)));
-            const double m = std::clamp(1.0 - double(dot(wo, wm)), 0.0, 1.0);
-            e += w;
-            es += w * (m * m) * (m * m) * m;
-        }
-    const double n = double(strata) * double(strata);
-    return {float(e / n), float(es / n)};
-}
-
 /// alpha_x of the table's stretch coordinate s in [0, 1]: the perceptual
 /// roughness sqrt(alpha_x) goes linearly from sqrt(alpha_y) to 1.
 float stretched_alpha(float alpha_y, float s) {
@@ -87,7 +67,9 @@ GgxAnisoAlbedoTable::GgxAnisoAlbedoTable(int strata) {
                 for (int p = 0; p < kPhiSteps; ++p) {
                     const float phi = phi_of_coordinate(float(p) / float(kPhiSteps - 1));
                     const Vec3 wo(sin_o * std::cos(phi), sin_o * std::sin(phi), mu);
-                    const GgxAlbedo a = integrate_albedo(wo, alpha_x, alpha_y, strata);
+                    const GgxAlbedo a = integrate_ggx_albedo(
+                        wo, [&](const Vec3& w) { return ggx_lambda(w, alpha_x, alpha_y); },
+                        [&](const Vec2& u) { return sample_ggx_vndf(wo, alpha_x, alpha_y, u); }, strata);
                     table_[index(r, s, m, p)] = a;
                     const double w = mu_w[size_t(m)] * phi_w[size_t(p)];
                     e_avg += w * double(a.e);
