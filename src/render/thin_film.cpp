@@ -2,20 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "math/sampling.h"
+#include "render/bsdf.h"
 
 namespace sahara {
 
 namespace {
 
-constexpr float kPi = std::numbers::pi_v<float>;
-
 float sq(float x) { return x * x; }
 
-float schlick(float f0, float cos_theta) {
-    const float m = 1.0f - cos_theta, m2 = m * m;
-    return f0 + (1.0f - f0) * (m2 * m2 * m);
-}
+float schlick(float f0, float cos_theta) { return fresnel_schlick(Rgb(f0), cos_theta).x; }
 
 /// Reflectance at normal incidence of an interface between iors a and b.
 float normal_reflectance(float a, float b) { return sq((a - b) / (a + b)); }
