@@ -10,6 +10,7 @@ import pytest
 
 sys.path.insert(0, os.path.dirname(__file__))
 import sahara  # noqa: E402
+from gltf_docs import write_gltf  # noqa: E402
 from raycast_meshes import brute_force_nearest, cube, icosphere, unwelded  # noqa: E402
 
 
@@ -301,29 +302,16 @@ def test_from_file_reads_triangles_in_file_order(tmp_path):
 
 def test_from_file_bakes_gltf_gpu_instances(tmp_path):
     """EXT_mesh_gpu_instancing: every instance's triangle is a primitive, in instance order."""
-    import base64
-    import json
-
-    positions = np.array([0, 0, 0, 1, 0, 0, 0, 1, 0], np.float32)
-    moves = np.array([0, 0, 0, 5, 0, 0], np.float32)
-    data = positions.tobytes() + moves.tobytes()
-    doc = {
-        "asset": {"version": "2.0"},
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    moves = np.array([[0, 0, 0], [5, 0, 0]], np.float32)
+    path = write_gltf(tmp_path / "instanced.gltf", [positions, moves], {
         "extensionsUsed": ["EXT_mesh_gpu_instancing"],
         "extensionsRequired": ["EXT_mesh_gpu_instancing"],
-        "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-                        {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3},
-                      {"bufferView": 1, "componentType": 5126, "type": "VEC3", "count": 2}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
         "nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 1}}}}],
         "scenes": [{"nodes": [0]}],
-    }
-    path = tmp_path / "instanced.gltf"
-    path.write_text(json.dumps(doc))
-    caster = sahara.RayCaster.from_file(str(path))
+    })
+    caster = sahara.RayCaster.from_file(path)
     assert len(caster.triangles) == 2
     rays = rays_from([[0.2, 0.2, 1], [5.2, 0.2, 1]], [[0, 0, -1], [0, 0, -1]])
     assert caster.cast_rays(rays)["primitive_ids"].tolist() == [0, 1]

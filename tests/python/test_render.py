@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import sahara
+from gltf_docs import write_gltf
 
 
 def read_exr(path):
@@ -151,34 +152,23 @@ def test_a_time_limit_returns_what_is_done(workshop):
 
 def _variants_gltf(path):
     """A quad in unlit grey; its variant "Red" maps it to unlit red (KHR_materials_variants)."""
-    import base64
-
-    data = np.array([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0], np.float32).tobytes()
-    data += np.array([0, 1, 2, 0, 2, 3], np.uint16).tobytes()
+    corners = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32)
+    indices = np.array([0, 1, 2, 0, 2, 3], np.uint16)
 
     def unlit(name, rgb):
         return {"name": name, "pbrMetallicRoughness": {"baseColorFactor": rgb + [1]},
                 "extensions": {"KHR_materials_unlit": {}}}
 
-    doc = {
-        "asset": {"version": "2.0"},
+    return write_gltf(path, [corners, indices], {
         "extensionsUsed": ["KHR_materials_variants", "KHR_materials_unlit"],
         "extensions": {"KHR_materials_variants": {"variants": [{"name": "Red"}]}},
-        "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
-                        {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 4},
-                      {"bufferView": 1, "componentType": 5123, "type": "SCALAR", "count": 6}],
         "materials": [unlit("grey", [0.5, 0.5, 0.5]), unlit("red", [1, 0, 0])],
         "meshes": [{"primitives": [{
             "attributes": {"POSITION": 0}, "indices": 1, "material": 0,
             "extensions": {"KHR_materials_variants": {"mappings": [{"material": 1, "variants": [0]}]}}}]}],
         "nodes": [{"mesh": 0}],
         "scenes": [{"nodes": [0]}],
-    }
-    path.write_text(json.dumps(doc))
-    return str(path)
+    })
 
 
 def test_a_glTF_variant_renders_its_colours(tmp_path):
