@@ -252,8 +252,11 @@ inline constexpr double kAutoMinRaysPerPrimitive = 100.0;
 /// treated as an interior: at least 1,000 primitives and largest_share >=
 /// kAutoMinLargestShare (what makes the automatic builder pick reinsert).
 bool looks_like_interior(size_t primitives, double largest_share);
-/// The largest_share of these boxes (BvhWorkload).
-double largest_box_area_share(std::span<const Bounds3> boxes);
+/// The largest_share of these boxes (BvhWorkload). With a threshold > 0, a share that the
+/// largest box already shows to be below it (the 1% largest boxes cover at most 1% of
+/// the boxes times the largest area) comes back as that upper bound, still below the
+/// threshold, without the selection of the largest boxes: enough to compare with it.
+double largest_box_area_share(std::span<const Bounds3> boxes, double threshold = 0.0);
 
 /// Insertion-based reinsertion (Bittner, Hapala, Havran 2013) on `bvh`, built
 /// over `prim_boxes`, then an SAH-optimal collapse of subtrees into leaves of at

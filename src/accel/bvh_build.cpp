@@ -219,17 +219,33 @@ BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
     return long_render && uneven ? BvhBuilder::reinsert : BvhBuilder::binned;
 }
 
-double largest_box_area_share(std::span<const Bounds3> boxes) {
+double largest_box_area_share(std::span<const Bounds3> boxes, double threshold) {
+    const auto n = int64_t(boxes.size());
+    const size_t k = std::max<size_t>(1, boxes.size() / 100);
+    if (threshold > 0.0) {
+        // The selection below is serial (most of this function's time at two threads); a
+        // pass without it settles most meshes, whose largest box is far from the threshold.
+        double total = 0;
+        float largest = 0.0f;
+#pragma omp parallel for reduction(+ : total) reduction(max : largest) schedule(static) if (n >= 65536)
+        for (int64_t i = 0; i < n; ++i) {
+            const float a = boxes[size_t(i)].surface_area();
+            total += double(a);
+            largest = std::max(largest, a);
+        }
+        if (!(total > 0)) return 0.0;
+        // The margin covers the rounding of the summed areas (far below 1e-9 of the total).
+        const double bound = double(k) * double(largest) * (1.0 + 1e-9) / total;
+        if (bound < threshold) return bound;
+    }
     // Areas are floats already; keeping them as floats halves the selection's memory,
     // and the pass runs on every thread, since it sits in front of the build. The array
     // is not zero-filled first: that was a serial pass (and its page faults) on one thread.
-    const auto n = int64_t(boxes.size());
     const BuildArray<float> areas(boxes.size());
     double total = 0;
 #pragma omp parallel for reduction(+ : total) schedule(static) if (n >= 65536)
     for (int64_t i = 0; i < n; ++i) total += double(areas[size_t(i)] = boxes[size_t(i)].surface_area());
     if (!(total > 0)) return 0.0;
-    const size_t k = std::max<size_t>(1, boxes.size() / 100);
     float* const a = areas.get();
     std::nth_element(a, a + std::ptrdiff_t(k - 1), a + boxes.size(), std::greater<>());
     double top = 0;

@@ -225,9 +225,11 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
     const BvhBuildInput input{prims.box_span(), prims.center_span(), scene.triangles.positions,
                               scene.triangles.indices};
     // One pass over every box, which the builder choice and node pairing may both ask for.
+    // Both only compare it with kAutoMinLargestShare (looks_like_interior), so a bound below
+    // that serves as well as the share.
     std::optional<double> share;
     const std::function<double()> largest_share = [&] {
-        if (!share) share = largest_box_area_share(prims.box_span());
+        if (!share) share = largest_box_area_share(prims.box_span(), kAutoMinLargestShare);
         return *share;
     };
     builder_ = resolve_builder(prims.size(), options, largest_share);

@@ -256,6 +256,26 @@ TEST_CASE("the automatic builder picks reinsert only for long renders of scenes 
     CHECK(Accelerator(scene, opt).builder() == BvhBuilder::binned);
 }
 
+TEST_CASE("largest_box_area_share with a threshold settles a mesh without the selection") {
+    const TriangleMesh sphere = make_icosphere(4), room = make_room(1, 0);
+    const std::vector<Bounds3> sphere_boxes = boxes_of(sphere).boxes, room_boxes = boxes_of(room).boxes;
+    // Even triangles: the largest one bounds the share below the threshold, and the bound
+    // is what comes back (never below the share).
+    const double sphere_share = largest_box_area_share(sphere_boxes);
+    const double sphere_bound = largest_box_area_share(sphere_boxes, kAutoMinLargestShare);
+    CHECK(sphere_bound < kAutoMinLargestShare);
+    CHECK(sphere_bound > sphere_share);
+    // A room: no bound below the threshold exists, so the share itself.
+    CHECK(largest_box_area_share(room_boxes, kAutoMinLargestShare) == largest_box_area_share(room_boxes));
+    // One box of 100 times the others' area among 200 (the top 1% is 2 boxes): the bound
+    // 200 / 299 is above the threshold but the share 101 / 299 is not; the share it is.
+    std::vector<Bounds3> boxes(200, Bounds3{{0, 0, 0}, {1, 1, 1}});
+    boxes[57] = Bounds3{{0, 0, 0}, {10, 10, 10}};
+    const double share = largest_box_area_share(boxes, kAutoMinLargestShare);
+    CHECK(share == largest_box_area_share(boxes));
+    CHECK(share == doctest::Approx(101.0 / 299.0));
+}
+
 TEST_CASE("automatic node pairing leaves out interiors and trees that fit in the cache") {
     CHECK(looks_like_interior(1000, kAutoMinLargestShare));
     CHECK_FALSE(looks_like_interior(999, 1.0));  // too small to matter
