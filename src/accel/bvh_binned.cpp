@@ -10,7 +10,9 @@
 /// as kScanChunks OpenMP tasks (stable partition into the other of two buffers), the
 /// subtrees above params.parallel_threshold are tasks. The chunks do not depend
 /// on the thread count, and every node owns a fixed region of the node array
-/// (compacted at the end), so the tree is the same for any thread count.
+/// (compacted at the end), so the tree is the same for any thread count. A subtree
+/// built by one thread packs its nodes at the start of its region, in the order the
+/// compaction keeps, and the compaction's copy is chunked in the same parallel region.
 #include "accel/bvh_binned.h"
 #include "accel/bvh_bins.h"
 #include "accel/bvh_small_sweep.h"
@@ -61,13 +63,17 @@ class BinnedBuild {
 #pragma omp parallel
 #pragma omp single
         {
-            const Range root = init_refs();
-            build(0, Bvh::kFirstPair, root, 0);
+            // A taskgroup, not the region's end: the compaction below runs on both threads.
+#pragma omp taskgroup
+            {
+                const Range root = init_refs();
+                build(0, Bvh::kFirstPair, root, 0);
+            }
+            // Free before compact() allocates the tree (see HugeBlockReuse).
+            refs_ = {};
+            scratch_ = {};
+            compact();
         }
-        // Free before compact() allocates the tree (see HugeBlockReuse).
-        refs_ = {};
-        scratch_ = {};
-        compact();
     }
 
    private:
@@ -95,31 +101,52 @@ class BinnedBuild {
 
     /// Builds the subtree of `r` at node `slot`; its descendants go to the 2 * n - 2 slots from `region`.
     void build(uint32_t slot, uint32_t region, const Range& r, int depth) {
+        const uint32_t n = r.end - r.begin;
+        if (n <= params_.parallel_threshold) {
+            build_serial(slot, region, r, depth);
+            return;
+        }
+        Range left, right;
+        if (!split_node(slot, r, depth, left, right)) return;
+        used_pairs_[region / 2] = 1;
+        nodes_[slot].index = region;
+        const uint32_t right_region = region + 2 * (left.end - left.begin);
+        // No taskwait: nothing here needs the subtree, and libgomp's taskwait blocks
+        // the thread until that very child ends (it runs no other queued subtree), which
+        // would leave threads idle. The taskgroup's end waits for every task.
+#pragma omp task default(shared) firstprivate(region, left, depth)
+        build(region, region + 2, left, depth + 1);
+        build(region + 1, right_region, right, depth + 1);
+    }
+
+    /// build() by one thread: each split takes the next pair from `next`, so the subtree's
+    /// pairs are packed from the start of its region, in depth-first order, left before
+    /// right: the order the pairs' regions would have had, which compact() keeps.
+    void build_serial(uint32_t slot, uint32_t& next, const Range& r, int depth) {
+        Range left, right;
+        if (!split_node(slot, r, depth, left, right)) return;
+        const uint32_t pair = next;
+        next += 2;
+        used_pairs_[pair / 2] = 1;
+        nodes_[slot].index = pair;
+        build_serial(pair, next, left, depth + 1);
+        build_serial(pair + 1, next, right, depth + 1);
+    }
+
+    /// Sets node `slot`'s box and splits `r` (an inner node, index left to the caller), or
+    /// makes the node a leaf and returns false.
+    bool split_node(uint32_t slot, const Range& r, int depth, Range& left, Range& right) {
         BvhNode& node = nodes_[slot];
         node.set_box(r.box);
         const uint32_t n = r.end - r.begin;
-        Range left, right;
         if (n == 1 || !split(r, depth, left, right)) {
             node.index = r.begin;
             node.count = n;
             for (uint32_t i = r.begin; i < r.end; ++i) out_.prim_indices[i] = r.refs[i].id;
-            return;
+            return false;
         }
-        used_pairs_[region / 2] = 1;
-        node.index = region;
         node.count = 0;
-        const uint32_t right_region = region + 2 * (left.end - left.begin);
-        if (n > params_.parallel_threshold) {
-            // No taskwait: nothing here needs the subtree, and libgomp's taskwait blocks
-            // the thread until that very child ends (it runs no other queued subtree), which
-            // would leave threads idle. The end of the parallel region waits for every task.
-#pragma omp task default(shared) firstprivate(region, left, depth)
-            build(region, region + 2, left, depth + 1);
-            build(region + 1, right_region, right, depth + 1);
-        } else {
-            build(region, region + 2, left, depth + 1);
-            build(region + 1, right_region, right, depth + 1);
-        }
+        return true;
     }
 
     /// SAH split of `r` into `left` and `right` (partitioned in place), or false for a leaf.
@@ -329,7 +356,8 @@ class BinnedBuild {
     }
 
     /// Removes the unused pairs of the node regions, keeping the order (depth-first, left
-    /// before right: the order of a serial build that allocates pairs as it goes).
+    /// before right: the order of a serial build that allocates pairs as it goes). Runs in
+    /// the build's parallel region: the copy is chunked.
     void compact() {
         if (nodes_[0].is_leaf()) {
             out_.nodes.assign(1, nodes_[0]);
@@ -343,14 +371,16 @@ class BinnedBuild {
             pairs += used_pairs_[k];
         }
         out_.nodes.resize(2 * size_t(pairs));
-        for (uint32_t k = 0; k < n_; ++k) {
-            if (!used_pairs_[k]) continue;
-            for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
-                BvhNode node = nodes_[2 * k + j];
-                if (!node.is_leaf()) node.index = 2 * new_pair[node.index / 2];
-                out_.nodes[2 * new_pair[k] + j] = node;
+        for_chunks(0, n_, [&](uint32_t, uint32_t b, uint32_t e) {
+            for (uint32_t k = b; k < e; ++k) {
+                if (!used_pairs_[k]) continue;
+                for (uint32_t j = 0; j < (k == 0 ? 1u : 2u); ++j) {  // nodes[1], padding, is set below
+                    BvhNode node = nodes_[2 * k + j];
+                    if (!node.is_leaf()) node.index = 2 * new_pair[node.index / 2];
+                    out_.nodes[2 * new_pair[k] + j] = node;
+                }
             }
-        }
+        });
         out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
     }
 
