@@ -60,8 +60,11 @@ class BinnedBuild {
         nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
         if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
+            // The main thread, not any one: compact() allocates, and a worker's malloc arena
+            // would hand out fresh pages where the main thread's reuses freed ones. The other
+            // threads run the tasks from the region's end barrier.
 #pragma omp parallel
-#pragma omp single
+#pragma omp master
         {
             // A taskgroup, not the region's end: the compaction below runs on both threads.
 #pragma omp taskgroup
