@@ -10,9 +10,8 @@
 /// as kScanChunks OpenMP tasks (stable partition into the other of two buffers), the
 /// subtrees above params.parallel_threshold are tasks. The chunks do not depend
 /// on the thread count, and every node owns a fixed region of the node array
-/// (compacted at the end), so the tree is the same for any thread count. A subtree
-/// built by one thread packs its nodes at the start of its region, in the order the
-/// compaction keeps, and the compaction's copy is chunked in the same parallel region.
+/// (compacted at the end, in chunks, in the same parallel region), so the tree is the
+/// same for any thread count.
 #include "accel/bvh_binned.h"
 #include "accel/bvh_bins.h"
 #include "accel/bvh_small_sweep.h"
@@ -60,13 +59,13 @@ class BinnedBuild {
         nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
         if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
-            // The main thread, not any one: compact() allocates, and a worker's malloc arena
-            // would hand out fresh pages where the main thread's reuses freed ones. The other
-            // threads run the tasks from the region's end barrier.
 #pragma omp parallel
 #pragma omp master
         {
-            // A taskgroup, not the region's end: the compaction below runs on both threads.
+            // On the main thread, not any one: compact() allocates, and a worker's malloc
+            // arena would hand out fresh pages where the main thread's reuses freed ones.
+            // The other threads run the tasks from the region's end barrier. A taskgroup,
+            // not the region's end, waits for the subtrees: the compaction runs on all threads.
 #pragma omp taskgroup
             {
                 const Range root = init_refs();
@@ -104,52 +103,31 @@ class BinnedBuild {
 
     /// Builds the subtree of `r` at node `slot`; its descendants go to the 2 * n - 2 slots from `region`.
     void build(uint32_t slot, uint32_t region, const Range& r, int depth) {
-        const uint32_t n = r.end - r.begin;
-        if (n <= params_.parallel_threshold) {
-            build_serial(slot, region, r, depth);
-            return;
-        }
-        Range left, right;
-        if (!split_node(slot, r, depth, left, right)) return;
-        used_pairs_[region / 2] = 1;
-        nodes_[slot].index = region;
-        const uint32_t right_region = region + 2 * (left.end - left.begin);
-        // No taskwait: nothing here needs the subtree, and libgomp's taskwait blocks
-        // the thread until that very child ends (it runs no other queued subtree), which
-        // would leave threads idle. The taskgroup's end waits for every task.
-#pragma omp task default(shared) firstprivate(region, left, depth)
-        build(region, region + 2, left, depth + 1);
-        build(region + 1, right_region, right, depth + 1);
-    }
-
-    /// build() by one thread: each split takes the next pair from `next`, so the subtree's
-    /// pairs are packed from the start of its region, in depth-first order, left before
-    /// right: the order the pairs' regions would have had, which compact() keeps.
-    void build_serial(uint32_t slot, uint32_t& next, const Range& r, int depth) {
-        Range left, right;
-        if (!split_node(slot, r, depth, left, right)) return;
-        const uint32_t pair = next;
-        next += 2;
-        used_pairs_[pair / 2] = 1;
-        nodes_[slot].index = pair;
-        build_serial(pair, next, left, depth + 1);
-        build_serial(pair + 1, next, right, depth + 1);
-    }
-
-    /// Sets node `slot`'s box and splits `r` (an inner node, index left to the caller), or
-    /// makes the node a leaf and returns false.
-    bool split_node(uint32_t slot, const Range& r, int depth, Range& left, Range& right) {
         BvhNode& node = nodes_[slot];
         node.set_box(r.box);
         const uint32_t n = r.end - r.begin;
+        Range left, right;
         if (n == 1 || !split(r, depth, left, right)) {
             node.index = r.begin;
             node.count = n;
             for (uint32_t i = r.begin; i < r.end; ++i) out_.prim_indices[i] = r.refs[i].id;
-            return false;
+            return;
         }
+        used_pairs_[region / 2] = 1;
+        node.index = region;
         node.count = 0;
-        return true;
+        const uint32_t right_region = region + 2 * (left.end - left.begin);
+        if (n > params_.parallel_threshold) {
+            // No taskwait: nothing here needs the subtree, and libgomp's taskwait blocks
+            // the thread until that very child ends (it runs no other queued subtree), which
+            // would leave threads idle. The taskgroup's end waits for every task.
+#pragma omp task default(shared) firstprivate(region, left, depth)
+            build(region, region + 2, left, depth + 1);
+            build(region + 1, right_region, right, depth + 1);
+        } else {
+            build(region, region + 2, left, depth + 1);
+            build(region + 1, right_region, right, depth + 1);
+        }
     }
 
     /// SAH split of `r` into `left` and `right` (partitioned in place), or false for a leaf.
