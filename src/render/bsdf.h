@@ -37,6 +37,9 @@ struct BsdfFilm {
     /// Schlick F0 that bounds the dielectric Fresnel with the film: the layer's
     /// F0 for the albedo scaling, and the cap of the Fresnel (bsdf_pbr.cpp)
     float bound_f0 = 0.04f;
+    /// The clearcoat's weight over the film: where coated, the film's outside
+    /// medium is the coat (KHR_materials_iridescence), not air.
+    float coat = 0;
 };
 
 /// A BSDF instantiated at one surface point.

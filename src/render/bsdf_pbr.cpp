@@ -104,6 +104,20 @@ float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
     return b.f0 * e.e + (b.f90 - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
 }
 
+/// The film's reflectance at cos_theta (measured in air) over a base of
+/// reflectance base_f0. Under a clearcoat of weight film.coat the film lies
+/// in the coat (ior 1.5), which the layering does not bend rays through but
+/// which the light crosses at the refracted angle: the outside ior and that
+/// angle change, the angle in the film does not (Snell's invariant).
+Rgb film_reflectance(const BsdfFilm& film, float cos_theta, const Rgb& base_f0) {
+    const auto in_air = [&] { return thin_film_reflectance(cos_theta, film.ior, film.thickness, base_f0); };
+    if (!(film.coat > 0)) return in_air();
+    const float sin_sq = std::max(0.0f, 1.0f - cos_theta * cos_theta) / (kCoatIor * kCoatIor);
+    const Rgb coated =
+        thin_film_reflectance(std::sqrt(1.0f - sin_sq), film.ior, film.thickness, base_f0, kCoatIor);
+    return film.coat < 1.0f ? lerp(in_air(), coated, film.coat) : coated;
+}
+
 /// KHR_materials_iridescence: Schlick's Fresnel and the film's mixed by the
 /// film's weight, for the dielectric and the metal alike, then by metallic.
 /// The dielectric one is capped by Schlick's curve from film.bound_f0, the F0
@@ -113,14 +127,13 @@ Rgb iridescent_fresnel(const Bsdf& b, float cos_theta) {
     const BsdfFilm& film = b.film;
     Rgb dielectric(0.0f), metal(0.0f);
     if (b.metallic < 1.0f) {
-        const Rgb thin =
-            thin_film_reflectance(cos_theta, film.ior, film.thickness, film.dielectric_f0) * b.f90;
+        const Rgb thin = film_reflectance(film, cos_theta, film.dielectric_f0) * b.f90;
         dielectric = min(lerp(fresnel_schlick(b.f0_color, b.f90, cos_theta), thin, film.weight),
                          fresnel_schlick(Rgb(film.bound_f0), b.f90, cos_theta));
     }
     if (b.metallic > 0.0f)
-        metal = lerp(fresnel_schlick(b.albedo, cos_theta),
-                     thin_film_reflectance(cos_theta, film.ior, film.thickness, b.albedo), film.weight);
+        metal = lerp(fresnel_schlick(b.albedo, cos_theta), film_reflectance(film, cos_theta, b.albedo),
+                     film.weight);
     return lerp(dielectric, metal, b.metallic);
 }
 
@@ -236,7 +249,8 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
 /// thickness (texture G between the minimum and the maximum, else the
 /// maximum). A film of no weight or thickness leaves the material untouched.
 /// The dielectric layer's F0 becomes the bound of what it reflects with the
-/// film, so that the albedo scaling keeps the whole energy conserving.
+/// film, so that the albedo scaling keeps the whole energy conserving. Reads
+/// the clearcoat's weight from b.layers (set before).
 void set_iridescence(Bsdf& b, const IridescenceDesc& d, const SurfaceInteraction& si,
                      const std::vector<TextureDesc>& textures) {
     const float weight = std::clamp(d.factor * texture_channel(d.texture, 0, si, textures), 0.0f, 1.0f);
@@ -252,7 +266,11 @@ void set_iridescence(Bsdf& b, const IridescenceDesc& d, const SurfaceInteraction
     // The film lies on the dielectric before KHR_materials_specular's weight,
     // which scales what the two reflect together.
     film.dielectric_f0 = b.f90 > 0 ? b.f0_color / b.f90 : b.f0_color;
-    const float film_f0 = thin_film_reflectance_bound(d.ior, film.dielectric_f0) * b.f90;
+    film.coat = b.layers.clearcoat;
+    float film_f0 = thin_film_reflectance_bound(d.ior, film.dielectric_f0);
+    if (film.coat > 0)
+        film_f0 = std::max(film_f0, thin_film_reflectance_bound(d.ior, film.dielectric_f0, kCoatIor));
+    film_f0 *= b.f90;
     film.bound_f0 = std::min(1.0f, b.f0 + weight * std::max(0.0f, film_f0 - b.f0));
     b.f0 = film.bound_f0;
     b.iridescent = true;
@@ -394,12 +412,12 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.f0 = r * r;
     b.f0_color = Rgb(b.f0);
     if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
-    if (m.iridescence.factor > 0) set_iridescence(b, m.iridescence, si, textures);
     b.thin = m.thin_walled;
     b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
     if (m.anisotropy > 0) set_anisotropy(b, m, si, textures);
     if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);
+    if (m.iridescence.factor > 0) set_iridescence(b, m.iridescence, si, textures);
 }
 
 Rgb pbr_fresnel(const Bsdf& b, float cos_theta) {
