@@ -142,6 +142,9 @@ struct MaterialDesc {
     float anisotropy_rotation = 0.0f;
     int anisotropy_texture = -1;
     IridescenceDesc iridescence;
+    /// KHR_materials_dispersion: 20 / the Abbe number of a volume's ior
+    /// (render/dispersion.h); 0 (none) or more. Thin walls do not disperse.
+    float dispersion = 0.0f;
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;

@@ -87,8 +87,10 @@ struct BsdfSample {
 Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures);
 
-/// The BSDF of material `m` at `si`.
-Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+/// The BSDF of material `m` at `si`. A path that carries one wavelength
+/// (render/dispersion.h; 0: all of them) sees a pbr volume's ior at that wavelength.
+Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures,
+               float wavelength_nm = 0.0f);
 
 /// f(wo, wi) * |cos(theta_i)| and the density sample() would give wi; zero for delta BSDFs.
 Rgb eval_bsdf(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "render/bsdf_layers.h"
+#include "render/dispersion.h"
 #include "render/ggx_albedo.h"
 #include "render/ggx_aniso_albedo.h"
 #include "render/sheen.h"
@@ -390,7 +391,7 @@ Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
 }
 
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures) {
+                   const std::vector<TextureDesc>& textures, float wavelength_nm) {
     b.kind = BsdfKind::pbr;
     b.albedo = material_albedo(m, si, textures);
     float roughness = m.roughness, metallic = m.metallic, transmission = m.transmission;
@@ -408,12 +409,15 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.alpha = pbr_alpha(b.roughness);
     b.metallic = std::clamp(metallic, 0.0f, 1.0f);
     b.transmission = std::clamp(transmission, 0.0f, 1.0f);
-    const float r = (m.ior - 1.0f) / (m.ior + 1.0f);
+    // The whole interface, reflection included, has the ior of the path's wavelength.
+    const float ior =
+        wavelength_nm > 0.0f && disperses(m) ? dispersed_ior(m.ior, m.dispersion, wavelength_nm) : m.ior;
+    const float r = (ior - 1.0f) / (ior + 1.0f);
     b.f0 = r * r;
     b.f0_color = Rgb(b.f0);
     if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
     b.thin = m.thin_walled;
-    b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
+    b.eta = m.thin_walled ? 1.0f : si.front_face ? ior : 1.0f / ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
     if (m.anisotropy > 0) set_anisotropy(b, m, si, textures);
     if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);

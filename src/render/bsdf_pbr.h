@@ -30,9 +30,10 @@ namespace sahara {
 
 /// The glTF material's BSDF at `si`: base colour (factor x texture x vertex
 /// colour), metallic-roughness texture (G roughness, B metallic), transmission
-/// texture (R), normal map; each texture reads its own UV set.
+/// texture (R), normal map; each texture reads its own UV set. With a
+/// wavelength (nm, > 0) a dispersive volume takes its ior there (render/dispersion.h).
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures);
+                   const std::vector<TextureDesc>& textures, float wavelength_nm = 0.0f);
 
 /// Radiance emitted (factor x texture x strength, from either side) towards wo,
 /// any length, away from the surface. A clearcoat over the emission lets
