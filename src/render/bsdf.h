@@ -62,7 +62,15 @@ struct Bsdf {
     float f90 = 1;        ///< the dielectric layer's reflectance at grazing angles (KHR_materials_specular)
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
     bool thin = false;       ///< thin-walled: transmission without refraction
-    BsdfLayers layers;       ///< clearcoat and sheen over all of the above
+    /// The weight of the base colour's Lambertian lobe: (1 - metallic)
+    /// (1 - transmission), times 1 - diffuse_transmission.
+    float diffuse_share = 1;
+    /// KHR_materials_diffuse_transmission: the share of the diffuse base that
+    /// is a Lambertian transmission instead, and that lobe's weight (its colour
+    /// times (1 - metallic) (1 - transmission) diffuse_transmission).
+    float diffuse_transmission = 0;
+    Rgb diffuse_transmit{0.0f};
+    BsdfLayers layers;  ///< clearcoat and sheen over all of the above
 
     bool iridescent = false;  ///< `film` is on: KHR_materials_iridescence
     BsdfFilm film;

@@ -96,7 +96,7 @@ PbrTerms pbr_terms(const Bsdf& b, const GgxAlbedo& avg) {
     const Rgb metal_avg = base + (Rgb(1.0f) - base) * (1.0f / 21.0f);
     t.spec_ms = lerp(dielectric_ms, multiscatter_fresnel(metal_avg, avg.e), b.metallic);
     t.dielectric_avg = b.f0 * avg.e + (b.f90 - b.f0) * avg.e_schlick + t.one_minus_e_avg * t.dielectric_ms;
-    t.diffuse = base * ((1.0f - b.metallic) * (1.0f - b.transmission));
+    t.diffuse = base * b.diffuse_share;
     return t;
 }
 
@@ -136,6 +136,17 @@ Rgb iridescent_fresnel(const Bsdf& b, float cos_theta) {
         metal = lerp(fresnel_schlick(b.albedo, cos_theta), film_reflectance(film, cos_theta, b.albedo),
                      film.weight);
     return lerp(dielectric, metal, b.metallic);
+}
+
+/// What reaches the Lambertian lobes below the dielectric layer for light
+/// from wo leaving towards wi (either side): (1 - Ed(mu_o)) (1 - Ed(mu_i)) /
+/// (1 - Ed_avg), symmetric so that they stay reciprocal. A layer that reflects
+/// everything (F0 clamped to 1 by KHR_materials_specular) leaves them nothing.
+float diffuse_scale(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& eo, const GgxAlbedo& ei) {
+    const float base_avg = 1.0f - t.dielectric_avg;
+    return base_avg > 1e-6f
+               ? (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) / base_avg
+               : 0.0f;
 }
 
 /// Single-scattering GGX reflection, f cos.
@@ -178,6 +189,18 @@ Rgb eval_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf)
     const float f =
         fresnel_t * ggx_d(b, wm) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) / (b.eta * b.eta);
     return tint * f;
+}
+
+/// The Lambertian transmission (wi below), f |cos|; adds its share of the density to *pdf.
+Rgb eval_diffuse_transmission(const Bsdf& b, const PbrLobeWeights& p, const Vec3& wo, const Vec3& wi,
+                              float* pdf) {
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const Vec3 wi_up(wi.x, wi.y, -wi.z);  // the albedo tables are of the upper side
+    const float cos_pi = -wi.z * kInvPi;
+    *pdf += p.diffuse_transmit * cos_pi;
+    return b.diffuse_transmit *
+           (diffuse_scale(b, t, ggx_albedo(b, table, wo), ggx_albedo(b, table, wi_up)) * cos_pi);
 }
 
 /// A transmitted direction for the visible normal wm; false if there is none.
@@ -350,6 +373,24 @@ void set_anisotropy(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.alpha = b.alpha + (1.0f - b.alpha) * (strength * strength);
 }
 
+/// KHR_materials_diffuse_transmission at si: the share (factor x texture A)
+/// and the colour (factor x texture RGB).
+void set_diffuse_transmission(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                              const std::vector<TextureDesc>& textures) {
+    const float share =
+        std::clamp(m.diffuse_transmission * texture_channel(m.diffuse_transmission_texture, 3, si, textures),
+                   0.0f, 1.0f);
+    Rgb color = m.diffuse_transmission_color;
+    if (m.diffuse_transmission_color_texture >= 0)
+        color *= sample_texture_rgb(textures[size_t(m.diffuse_transmission_color_texture)],
+                                    texcoord(si, textures, m.diffuse_transmission_color_texture));
+    color = Rgb(std::clamp(color.x, 0.0f, 1.0f), std::clamp(color.y, 0.0f, 1.0f),
+                std::clamp(color.z, 0.0f, 1.0f));
+    b.diffuse_transmission = share;
+    b.diffuse_transmit = color * (b.diffuse_share * share);
+    b.diffuse_share *= 1.0f - share;
+}
+
 /// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.
 void set_pbr_layers(Bsdf& b, const PbrLayersDesc& d, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures) {
@@ -409,6 +450,8 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.alpha = pbr_alpha(b.roughness);
     b.metallic = std::clamp(metallic, 0.0f, 1.0f);
     b.transmission = std::clamp(transmission, 0.0f, 1.0f);
+    b.diffuse_share = (1.0f - b.metallic) * (1.0f - b.transmission);
+    if (m.diffuse_transmission > 0) set_diffuse_transmission(b, m, si, textures);
     // The whole interface, reflection included, has the ior of the path's wavelength.
     const float ior =
         wavelength_nm > 0.0f && disperses(m) ? dispersed_ior(m.ior, m.dispersion, wavelength_nm) : m.ior;
@@ -439,12 +482,17 @@ PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
     w.specular = f0 * e.e + (t.f90 - f0) * e.e_schlick;
     w.cosine = mean(t.spec_ms) * (1.0f - e.e) + mean(t.diffuse) * (1.0f - dielectric_albedo(b, t, e));
     w.transmit = (1.0f - b.metallic) * b.transmission * mean(b.albedo) * (1.0f - f0);
-    const float sum = w.specular + w.cosine + w.transmit;
+    float sum = w.specular + w.cosine + w.transmit;
+    if (b.diffuse_transmission > 0) {
+        w.diffuse_transmit = mean(b.diffuse_transmit) * (1.0f - dielectric_albedo(b, t, e));
+        sum += w.diffuse_transmit;
+    }
     if (!(sum > 0)) return {};
     w.total = sum;
     w.specular /= sum;
     w.cosine /= sum;
     w.transmit /= sum;
+    w.diffuse_transmit /= sum;
     return w;
 }
 
@@ -457,10 +505,13 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     if (wo.z <= 0 || wi.z == 0) return Rgb(0.0f);
     const PbrLobeWeights p = pbr_lobe_weights(b, wo);
     if (wi.z < 0) {
-        if (p.transmit <= 0) return Rgb(0.0f);
-        float pdf_t = 0;
-        const Rgb f = eval_transmission(b, wo, wi, &pdf_t);
-        *pdf = p.transmit * pdf_t;
+        Rgb f(0.0f);
+        if (p.transmit > 0) {
+            float pdf_t = 0;
+            f = eval_transmission(b, wo, wi, &pdf_t);
+            *pdf = p.transmit * pdf_t;
+        }
+        if (p.diffuse_transmit > 0) f += eval_diffuse_transmission(b, p, wo, wi, pdf);
         return f;
     }
     const GgxAlbedoTable& table = GgxAlbedoTable::get();
@@ -470,12 +521,7 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)
         f += t.spec_ms * ((1.0f - eo.e) * (1.0f - ei.e) / t.one_minus_e_avg * cos_pi);
-    // A layer that reflects everything (F0 clamped to 1 by KHR_materials_specular) leaves the base nothing.
-    const float base_avg = 1.0f - t.dielectric_avg;
-    const float diffuse_scale = base_avg > 1e-6f ? (1.0f - dielectric_albedo(b, t, eo)) *
-                                                       (1.0f - dielectric_albedo(b, t, ei)) / base_avg
-                                                 : 0.0f;
-    f += t.diffuse * (diffuse_scale * cos_pi);
+    f += t.diffuse * (diffuse_scale(b, t, eo, ei) * cos_pi);
     *pdf = p.specular * ggx_reflection_pdf(b, wo, wi) + p.cosine * cos_pi;
     return f;
 }
@@ -490,7 +536,11 @@ bool sample_pbr_base_direction(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lo
         *wi = sample_cosine_hemisphere(u);
         return true;
     }
-    return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(b, wo, u), wi);
+    if (u_lobe < p.specular + p.cosine + p.transmit || !(p.diffuse_transmit > 0))
+        return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(b, wo, u), wi);
+    const Vec3 d = sample_cosine_hemisphere(u);
+    *wi = Vec3(d.x, d.y, -d.z);
+    return true;
 }
 
 bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s) {
