@@ -142,6 +142,16 @@ struct MaterialDesc {
     float anisotropy_rotation = 0.0f;
     int anisotropy_texture = -1;
     IridescenceDesc iridescence;
+    /// KHR_materials_dispersion: 20 / the Abbe number of a volume's ior
+    /// (render/dispersion.h); 0 (none) or more. Thin walls do not disperse.
+    float dispersion = 0.0f;
+    /// KHR_materials_diffuse_transmission: the share of the diffuse base that
+    /// is a Lambertian transmission instead (factor x texture A), tinted by its
+    /// colour (factor x texture RGB, sRGB).
+    float diffuse_transmission = 0.0f;
+    int diffuse_transmission_texture = -1;
+    Rgb diffuse_transmission_color{1.0f, 1.0f, 1.0f};
+    int diffuse_transmission_color_texture = -1;
     /// Inputs the source file gives that the renderer does not use (e.g. "occlusion map"),
     /// filled by the loaders so that `sahara info` can name them.
     std::vector<std::string> ignored;
@@ -171,6 +181,8 @@ void for_each_texture_slot(Material& m, F&& f) {
     f("anisotropy", m.anisotropy_texture);
     f("iridescence", m.iridescence.texture);
     f("iridescence thickness", m.iridescence.thickness_texture);
+    f("diffuse transmission", m.diffuse_transmission_texture);
+    f("diffuse transmission colour", m.diffuse_transmission_color_texture);
     f("alpha", m.alpha_texture);
 }
 

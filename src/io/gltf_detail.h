@@ -66,6 +66,10 @@ class Materials {
     void set_sheen(PbrLayersDesc& out, const tinygltf::Value& ext, const std::string& element);
     void set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
     void set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
+    void set_dispersion(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
+    void set_diffuse_transmission(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element);
+    float bounded_number(const tinygltf::Value& ext, const char* key, double fallback, double low,
+                         double high, const std::string& element) const;
     std::optional<TextureRef> texture_info(const tinygltf::Value& ext, const char* key) const;
     int texture(const tinygltf::TextureInfo& info, bool srgb, const std::string& element);
     int texture(const TextureRef& ref, bool srgb, const std::string& element);

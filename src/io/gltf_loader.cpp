@@ -37,7 +37,8 @@ const std::set<std::string> kSupportedRequiredMaterials = {
     "KHR_materials_unlit",      "KHR_materials_pbrSpecularGlossiness",
     "KHR_materials_specular",   "EXT_texture_webp",
     "KHR_materials_clearcoat",  "KHR_materials_sheen",
-    "KHR_materials_anisotropy", "KHR_materials_iridescence"};
+    "KHR_materials_anisotropy", "KHR_materials_iridescence",
+    "KHR_materials_dispersion", "KHR_materials_diffuse_transmission"};
 
 bool supported_required(const std::string& name) {
     return kSupportedRequired.count(name) || kSupportedRequiredMaterials.count(name);

@@ -1,5 +1,6 @@
 // glTF materials -> MaterialDesc of type pbr (every core input and the
-// transmission, ior, volume, emissive-strength, clearcoat, sheen, anisotropy and iridescence extensions),
+// transmission, ior, volume, emissive-strength, clearcoat, sheen, anisotropy, iridescence, dispersion
+// and diffuse-transmission extensions),
 // textures -> TextureDesc with the uv convention of scene_desc.h, images decoded through OpenImageIO.
 // Occlusion maps are ignored on purpose: a path tracer computes occlusion.
 #include <algorithm>
@@ -241,6 +242,12 @@ void Materials::set_extensions(MaterialDesc& out, const tinygltf::Material& m, c
         } else if (name == "KHR_materials_iridescence") {
             set_iridescence(out, value, ext);
             out.extensions.push_back(name);
+        } else if (name == "KHR_materials_dispersion") {
+            set_dispersion(out, value, ext);
+            out.extensions.push_back(name);
+        } else if (name == "KHR_materials_diffuse_transmission") {
+            set_diffuse_transmission(out, value, ext);
+            out.extensions.push_back(name);
         } else if (!read_elsewhere(name)) {
             out.ignored.push_back(name);
             if (ignored_.insert(name).second)
@@ -314,21 +321,8 @@ void Materials::set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, co
 /// textures, read linear. A value that is not a number or outside the
 /// extension's schema (weight in [0, 1], ior >= 1, thicknesses >= 0) is refused.
 void Materials::set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element) {
-    // high < 0: no upper limit.
     const auto read = [&](const char* key, double fallback, double low, double high) {
-        if (!ext.Has(key)) return float(fallback);
-        const tinygltf::Value& v = ext.Get(key);
-        const double d = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
-        if (!(d >= low && (high < 0 || d <= high) && d < 1e30)) {
-            std::ostringstream range;
-            range << "must be a number ";
-            if (high < 0)
-                range << ">= " << low;
-            else
-                range << "in [" << low << ", " << high << "]";
-            throw input_error(src_.file, element + "." + key, range.str());
-        }
-        return float(d);
+        return bounded_number(ext, key, fallback, low, high, element);
     };
     IridescenceDesc& d = out.iridescence;
     d.factor = read("iridescenceFactor", 0.0, 0.0, 1.0);
@@ -339,6 +333,53 @@ void Materials::set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, c
         d.texture = texture(*info, false, element + ".iridescenceTexture");
     if (auto info = texture_info(ext, "iridescenceThicknessTexture"))
         d.thickness_texture = texture(*info, false, element + ".iridescenceThicknessTexture");
+}
+
+/// KHR_materials_dispersion: 20 / the Abbe number of the volume's ior (>= 0).
+void Materials::set_dispersion(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element) {
+    out.dispersion = bounded_number(ext, "dispersion", 0.0, 0.0, -1, element);
+}
+
+/// KHR_materials_diffuse_transmission: the share of the diffuse base that
+/// transmits (factor x texture A, linear) and its colour (factor x texture RGB,
+/// sRGB), each factor within the extension's schema.
+void Materials::set_diffuse_transmission(MaterialDesc& out, const tinygltf::Value& ext,
+                                         const std::string& element) {
+    out.diffuse_transmission = bounded_number(ext, "diffuseTransmissionFactor", 0.0, 0.0, 1.0, element);
+    if (auto info = texture_info(ext, "diffuseTransmissionTexture"))
+        out.diffuse_transmission_texture = texture(*info, false, element + ".diffuseTransmissionTexture");
+    const char* color_key = "diffuseTransmissionColorFactor";
+    if (ext.Has(color_key)) {
+        const std::vector<double> c = numbers(ext, color_key);
+        const tinygltf::Value& v = ext.Get(color_key);
+        const bool valid = v.IsArray() && v.ArrayLen() == 3 && c.size() == 3 &&
+                           std::all_of(c.begin(), c.end(), [](double x) { return x >= 0.0 && x <= 1.0; });
+        if (!valid) throw input_error(src_.file, element + "." + color_key, "must be 3 numbers in [0, 1]");
+        out.diffuse_transmission_color = rgb_of(c, Rgb(1.0f));
+    }
+    if (auto info = texture_info(ext, "diffuseTransmissionColorTexture"))
+        out.diffuse_transmission_color_texture =
+            texture(*info, true, element + ".diffuseTransmissionColorTexture");
+}
+
+/// The number at `key` of an extension object, `fallback` without one; a value
+/// that is not a number or lies outside [low, high] (high < 0: no upper limit)
+/// is refused, naming the element.
+float Materials::bounded_number(const tinygltf::Value& ext, const char* key, double fallback, double low,
+                                double high, const std::string& element) const {
+    if (!ext.Has(key)) return float(fallback);
+    const tinygltf::Value& v = ext.Get(key);
+    const double d = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+    if (!(d >= low && (high < 0 || d <= high) && d < 1e30)) {
+        std::ostringstream range;
+        range << "must be a number ";
+        if (high < 0)
+            range << ">= " << low;
+        else
+            range << "in [" << low << ", " << high << "]";
+        throw input_error(src_.file, element + "." + key, range.str());
+    }
+    return float(d);
 }
 
 /// A textureInfo inside an extension object (tinygltf leaves those as JSON values).

@@ -99,6 +99,9 @@ void parse_pbr_material(JsonObject& o, ParseContext& ctx, MaterialDesc& m) {
     if (auto v = o.get("anisotropy")) m.anisotropy = v->number_f(unit);
     if (auto v = o.get("anisotropy_rotation")) m.anisotropy_rotation = v->number_f();
     parse_pbr_iridescence(o, m.iridescence);
+    if (auto v = o.get("dispersion")) m.dispersion = v->number_f(NumberRange::non_negative());
+    if (auto v = o.get("diffuse_transmission")) m.diffuse_transmission = v->number_f(unit);
+    if (auto v = o.get("diffuse_transmission_color")) m.diffuse_transmission_color = v->vec3(unit);
 }
 
 }  // namespace sahara

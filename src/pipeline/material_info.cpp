@@ -113,6 +113,12 @@ void describe_material(StatsReport& s, const std::string& label, const MaterialD
     value["volume_attenuation"] = transmits && !m.thin_walled && attenuates(m);
     if (value["volume_attenuation"] == true)
         parts.push_back("volume attenuation over " + number_text(m.attenuation_distance));
+    const bool disperses = transmits && !m.thin_walled && m.dispersion > 0.0f;
+    value["dispersion"] = disperses ? m.dispersion : 0.0f;
+    if (disperses) parts.push_back("dispersion " + number_text(m.dispersion));
+    const bool diffuse_transmits = pbr && m.diffuse_transmission > 0.0f;
+    value["diffuse_transmission"] = diffuse_transmits ? m.diffuse_transmission : 0.0f;
+    if (diffuse_transmits) parts.push_back("diffuse transmission " + number_text(m.diffuse_transmission));
     describe_layers(parts, value, m);
     const std::string alpha = alpha_mode(m);
     value["alpha_mode"] = alpha;

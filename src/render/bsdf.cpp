@@ -78,14 +78,14 @@ bool sample_dielectric(const Bsdf& b, const Vec3& wo, float u_lobe, BsdfSample& 
 
 }  // namespace
 
-Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si,
-               const std::vector<TextureDesc>& textures) {
+Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures,
+               float wavelength_nm) {
     Bsdf b;
     b.frame = Frame(si.ns);
     b.ng = si.ng;
     switch (m.type) {
         case MaterialType::pbr:
-            make_pbr_bsdf(b, m, si, textures);
+            make_pbr_bsdf(b, m, si, textures, wavelength_nm);
             break;
         case MaterialType::lambertian:
             b.kind = BsdfKind::lambertian;

@@ -37,6 +37,9 @@ struct BsdfFilm {
     /// Schlick F0 that bounds the dielectric Fresnel with the film: the layer's
     /// F0 for the albedo scaling, and the cap of the Fresnel (bsdf_pbr.cpp)
     float bound_f0 = 0.04f;
+    /// The clearcoat's weight over the film: where coated, the film's outside
+    /// medium is the coat (KHR_materials_iridescence), not air.
+    float coat = 0;
 };
 
 /// A BSDF instantiated at one surface point.
@@ -59,7 +62,15 @@ struct Bsdf {
     float f90 = 1;        ///< the dielectric layer's reflectance at grazing angles (KHR_materials_specular)
     float transmission = 0;  ///< fraction of the base that refracts instead of diffusing
     bool thin = false;       ///< thin-walled: transmission without refraction
-    BsdfLayers layers;       ///< clearcoat and sheen over all of the above
+    /// The weight of the base colour's Lambertian lobe: (1 - metallic)
+    /// (1 - transmission), times 1 - diffuse_transmission.
+    float diffuse_share = 1;
+    /// KHR_materials_diffuse_transmission: the share of the diffuse base that
+    /// is a Lambertian transmission instead, and that lobe's weight (its colour
+    /// times (1 - metallic) (1 - transmission) diffuse_transmission).
+    float diffuse_transmission = 0;
+    Rgb diffuse_transmit{0.0f};
+    BsdfLayers layers;  ///< clearcoat and sheen over all of the above
 
     bool iridescent = false;  ///< `film` is on: KHR_materials_iridescence
     BsdfFilm film;
@@ -84,8 +95,10 @@ struct BsdfSample {
 Rgb material_albedo(const MaterialDesc& m, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures);
 
-/// The BSDF of material `m` at `si`.
-Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures);
+/// The BSDF of material `m` at `si`. A path that carries one wavelength
+/// (render/dispersion.h; 0: all of them) sees a pbr volume's ior at that wavelength.
+Bsdf make_bsdf(const MaterialDesc& m, const SurfaceInteraction& si, const std::vector<TextureDesc>& textures,
+               float wavelength_nm = 0.0f);
 
 /// f(wo, wi) * |cos(theta_i)| and the density sample() would give wi; zero for delta BSDFs.
 Rgb eval_bsdf(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf);

@@ -24,6 +24,9 @@
 
 namespace sahara {
 
+/// The coat's ior, as KHR_materials_clearcoat fixes it.
+inline constexpr float kCoatIor = 1.5f;
+
 /// The probabilities of the coat, the sheen and the base at wo, and the base's scale.
 struct LayerWeights {
     float coat = 0, sheen = 0, base = 0;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "render/bsdf_layers.h"
+#include "render/dispersion.h"
 #include "render/ggx_albedo.h"
 #include "render/ggx_aniso_albedo.h"
 #include "render/sheen.h"
@@ -95,13 +96,27 @@ PbrTerms pbr_terms(const Bsdf& b, const GgxAlbedo& avg) {
     const Rgb metal_avg = base + (Rgb(1.0f) - base) * (1.0f / 21.0f);
     t.spec_ms = lerp(dielectric_ms, multiscatter_fresnel(metal_avg, avg.e), b.metallic);
     t.dielectric_avg = b.f0 * avg.e + (b.f90 - b.f0) * avg.e_schlick + t.one_minus_e_avg * t.dielectric_ms;
-    t.diffuse = base * ((1.0f - b.metallic) * (1.0f - b.transmission));
+    t.diffuse = base * b.diffuse_share;
     return t;
 }
 
 /// Ed(mu): albedo of the dielectric layer (single and multiple scattering).
 float dielectric_albedo(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& e) {
     return b.f0 * e.e + (b.f90 - b.f0) * e.e_schlick + (1.0f - e.e) * t.dielectric_ms;
+}
+
+/// The film's reflectance at cos_theta (measured in air) over a base of
+/// reflectance base_f0. Under a clearcoat of weight film.coat the film lies
+/// in the coat (ior 1.5), which the layering does not bend rays through but
+/// which the light crosses at the refracted angle: the outside ior and that
+/// angle change, the angle in the film does not (Snell's invariant).
+Rgb film_reflectance(const BsdfFilm& film, float cos_theta, const Rgb& base_f0) {
+    const auto in_air = [&] { return thin_film_reflectance(cos_theta, film.ior, film.thickness, base_f0); };
+    if (!(film.coat > 0)) return in_air();
+    const float sin_sq = std::max(0.0f, 1.0f - cos_theta * cos_theta) / (kCoatIor * kCoatIor);
+    const Rgb coated =
+        thin_film_reflectance(std::sqrt(1.0f - sin_sq), film.ior, film.thickness, base_f0, kCoatIor);
+    return film.coat < 1.0f ? lerp(in_air(), coated, film.coat) : coated;
 }
 
 /// KHR_materials_iridescence: Schlick's Fresnel and the film's mixed by the
@@ -113,15 +128,25 @@ Rgb iridescent_fresnel(const Bsdf& b, float cos_theta) {
     const BsdfFilm& film = b.film;
     Rgb dielectric(0.0f), metal(0.0f);
     if (b.metallic < 1.0f) {
-        const Rgb thin =
-            thin_film_reflectance(cos_theta, film.ior, film.thickness, film.dielectric_f0) * b.f90;
+        const Rgb thin = film_reflectance(film, cos_theta, film.dielectric_f0) * b.f90;
         dielectric = min(lerp(fresnel_schlick(b.f0_color, b.f90, cos_theta), thin, film.weight),
                          fresnel_schlick(Rgb(film.bound_f0), b.f90, cos_theta));
     }
     if (b.metallic > 0.0f)
-        metal = lerp(fresnel_schlick(b.albedo, cos_theta),
-                     thin_film_reflectance(cos_theta, film.ior, film.thickness, b.albedo), film.weight);
+        metal = lerp(fresnel_schlick(b.albedo, cos_theta), film_reflectance(film, cos_theta, b.albedo),
+                     film.weight);
     return lerp(dielectric, metal, b.metallic);
+}
+
+/// What reaches the Lambertian lobes below the dielectric layer for light
+/// from wo leaving towards wi (either side): (1 - Ed(mu_o)) (1 - Ed(mu_i)) /
+/// (1 - Ed_avg), symmetric so that they stay reciprocal. A layer that reflects
+/// everything (F0 clamped to 1 by KHR_materials_specular) leaves them nothing.
+float diffuse_scale(const Bsdf& b, const PbrTerms& t, const GgxAlbedo& eo, const GgxAlbedo& ei) {
+    const float base_avg = 1.0f - t.dielectric_avg;
+    return base_avg > 1e-6f
+               ? (1.0f - dielectric_albedo(b, t, eo)) * (1.0f - dielectric_albedo(b, t, ei)) / base_avg
+               : 0.0f;
 }
 
 /// Single-scattering GGX reflection, f cos.
@@ -164,6 +189,18 @@ Rgb eval_transmission(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf)
     const float f =
         fresnel_t * ggx_d(b, wm) / (1.0f + lo + li) * std::abs(i_m * o_m) / (wo.z * denom) / (b.eta * b.eta);
     return tint * f;
+}
+
+/// The Lambertian transmission (wi below), f |cos|; adds its share of the density to *pdf.
+Rgb eval_diffuse_transmission(const Bsdf& b, const PbrLobeWeights& p, const Vec3& wo, const Vec3& wi,
+                              float* pdf) {
+    const GgxAlbedoTable& table = GgxAlbedoTable::get();
+    const PbrTerms t = pbr_terms(b, ggx_albedo_average(b, table));
+    const Vec3 wi_up(wi.x, wi.y, -wi.z);  // the albedo tables are of the upper side
+    const float cos_pi = -wi.z * kInvPi;
+    *pdf += p.diffuse_transmit * cos_pi;
+    return b.diffuse_transmit *
+           (diffuse_scale(b, t, ggx_albedo(b, table, wo), ggx_albedo(b, table, wi_up)) * cos_pi);
 }
 
 /// A transmitted direction for the visible normal wm; false if there is none.
@@ -236,7 +273,8 @@ void apply_specular(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
 /// thickness (texture G between the minimum and the maximum, else the
 /// maximum). A film of no weight or thickness leaves the material untouched.
 /// The dielectric layer's F0 becomes the bound of what it reflects with the
-/// film, so that the albedo scaling keeps the whole energy conserving.
+/// film, so that the albedo scaling keeps the whole energy conserving. Reads
+/// the clearcoat's weight from b.layers (set before).
 void set_iridescence(Bsdf& b, const IridescenceDesc& d, const SurfaceInteraction& si,
                      const std::vector<TextureDesc>& textures) {
     const float weight = std::clamp(d.factor * texture_channel(d.texture, 0, si, textures), 0.0f, 1.0f);
@@ -252,7 +290,11 @@ void set_iridescence(Bsdf& b, const IridescenceDesc& d, const SurfaceInteraction
     // The film lies on the dielectric before KHR_materials_specular's weight,
     // which scales what the two reflect together.
     film.dielectric_f0 = b.f90 > 0 ? b.f0_color / b.f90 : b.f0_color;
-    const float film_f0 = thin_film_reflectance_bound(d.ior, film.dielectric_f0) * b.f90;
+    film.coat = b.layers.clearcoat;
+    float film_f0 = thin_film_reflectance_bound(d.ior, film.dielectric_f0);
+    if (film.coat > 0)
+        film_f0 = std::max(film_f0, thin_film_reflectance_bound(d.ior, film.dielectric_f0, kCoatIor));
+    film_f0 *= b.f90;
     film.bound_f0 = std::min(1.0f, b.f0 + weight * std::max(0.0f, film_f0 - b.f0));
     b.f0 = film.bound_f0;
     b.iridescent = true;
@@ -331,6 +373,24 @@ void set_anisotropy(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si
     b.alpha = b.alpha + (1.0f - b.alpha) * (strength * strength);
 }
 
+/// KHR_materials_diffuse_transmission at si: the share (factor x texture A)
+/// and the colour (factor x texture RGB).
+void set_diffuse_transmission(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
+                              const std::vector<TextureDesc>& textures) {
+    const float share =
+        std::clamp(m.diffuse_transmission * texture_channel(m.diffuse_transmission_texture, 3, si, textures),
+                   0.0f, 1.0f);
+    Rgb color = m.diffuse_transmission_color;
+    if (m.diffuse_transmission_color_texture >= 0)
+        color *= sample_texture_rgb(textures[size_t(m.diffuse_transmission_color_texture)],
+                                    texcoord(si, textures, m.diffuse_transmission_color_texture));
+    color = Rgb(std::clamp(color.x, 0.0f, 1.0f), std::clamp(color.y, 0.0f, 1.0f),
+                std::clamp(color.z, 0.0f, 1.0f));
+    b.diffuse_transmission = share;
+    b.diffuse_transmit = color * (b.diffuse_share * share);
+    b.diffuse_share *= 1.0f - share;
+}
+
 /// KHR_materials_clearcoat and KHR_materials_sheen at si: factors times textures.
 void set_pbr_layers(Bsdf& b, const PbrLayersDesc& d, const SurfaceInteraction& si,
                     const std::vector<TextureDesc>& textures) {
@@ -372,7 +432,7 @@ Rgb pbr_emission(const MaterialDesc& m, const SurfaceInteraction& si,
 }
 
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures) {
+                   const std::vector<TextureDesc>& textures, float wavelength_nm) {
     b.kind = BsdfKind::pbr;
     b.albedo = material_albedo(m, si, textures);
     float roughness = m.roughness, metallic = m.metallic, transmission = m.transmission;
@@ -390,16 +450,21 @@ void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
     b.alpha = pbr_alpha(b.roughness);
     b.metallic = std::clamp(metallic, 0.0f, 1.0f);
     b.transmission = std::clamp(transmission, 0.0f, 1.0f);
-    const float r = (m.ior - 1.0f) / (m.ior + 1.0f);
+    b.diffuse_share = (1.0f - b.metallic) * (1.0f - b.transmission);
+    if (m.diffuse_transmission > 0) set_diffuse_transmission(b, m, si, textures);
+    // The whole interface, reflection included, has the ior of the path's wavelength.
+    const float ior =
+        wavelength_nm > 0.0f && disperses(m) ? dispersed_ior(m.ior, m.dispersion, wavelength_nm) : m.ior;
+    const float r = (ior - 1.0f) / (ior + 1.0f);
     b.f0 = r * r;
     b.f0_color = Rgb(b.f0);
     if (has_specular_inputs(m)) apply_specular(b, m, si, textures);
-    if (m.iridescence.factor > 0) set_iridescence(b, m.iridescence, si, textures);
     b.thin = m.thin_walled;
-    b.eta = m.thin_walled ? 1.0f : si.front_face ? m.ior : 1.0f / m.ior;
+    b.eta = m.thin_walled ? 1.0f : si.front_face ? ior : 1.0f / ior;
     if (m.normal_texture >= 0) b.frame = Frame(mapped_normal(m.normal_texture, m.normal_scale, si, textures));
     if (m.anisotropy > 0) set_anisotropy(b, m, si, textures);
     if (m.layers.any()) set_pbr_layers(b, m.layers, si, textures);
+    if (m.iridescence.factor > 0) set_iridescence(b, m.iridescence, si, textures);
 }
 
 Rgb pbr_fresnel(const Bsdf& b, float cos_theta) {
@@ -417,12 +482,17 @@ PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo) {
     w.specular = f0 * e.e + (t.f90 - f0) * e.e_schlick;
     w.cosine = mean(t.spec_ms) * (1.0f - e.e) + mean(t.diffuse) * (1.0f - dielectric_albedo(b, t, e));
     w.transmit = (1.0f - b.metallic) * b.transmission * mean(b.albedo) * (1.0f - f0);
-    const float sum = w.specular + w.cosine + w.transmit;
+    float sum = w.specular + w.cosine + w.transmit;
+    if (b.diffuse_transmission > 0) {
+        w.diffuse_transmit = mean(b.diffuse_transmit) * (1.0f - dielectric_albedo(b, t, e));
+        sum += w.diffuse_transmit;
+    }
     if (!(sum > 0)) return {};
     w.total = sum;
     w.specular /= sum;
     w.cosine /= sum;
     w.transmit /= sum;
+    w.diffuse_transmit /= sum;
     return w;
 }
 
@@ -435,10 +505,13 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     if (wo.z <= 0 || wi.z == 0) return Rgb(0.0f);
     const PbrLobeWeights p = pbr_lobe_weights(b, wo);
     if (wi.z < 0) {
-        if (p.transmit <= 0) return Rgb(0.0f);
-        float pdf_t = 0;
-        const Rgb f = eval_transmission(b, wo, wi, &pdf_t);
-        *pdf = p.transmit * pdf_t;
+        Rgb f(0.0f);
+        if (p.transmit > 0) {
+            float pdf_t = 0;
+            f = eval_transmission(b, wo, wi, &pdf_t);
+            *pdf = p.transmit * pdf_t;
+        }
+        if (p.diffuse_transmit > 0) f += eval_diffuse_transmission(b, p, wo, wi, pdf);
         return f;
     }
     const GgxAlbedoTable& table = GgxAlbedoTable::get();
@@ -448,12 +521,7 @@ Rgb eval_pbr_base(const Bsdf& b, const Vec3& wo, const Vec3& wi, float* pdf) {
     const float cos_pi = wi.z * kInvPi;
     if (t.one_minus_e_avg > 1e-6f)
         f += t.spec_ms * ((1.0f - eo.e) * (1.0f - ei.e) / t.one_minus_e_avg * cos_pi);
-    // A layer that reflects everything (F0 clamped to 1 by KHR_materials_specular) leaves the base nothing.
-    const float base_avg = 1.0f - t.dielectric_avg;
-    const float diffuse_scale = base_avg > 1e-6f ? (1.0f - dielectric_albedo(b, t, eo)) *
-                                                       (1.0f - dielectric_albedo(b, t, ei)) / base_avg
-                                                 : 0.0f;
-    f += t.diffuse * (diffuse_scale * cos_pi);
+    f += t.diffuse * (diffuse_scale(b, t, eo, ei) * cos_pi);
     *pdf = p.specular * ggx_reflection_pdf(b, wo, wi) + p.cosine * cos_pi;
     return f;
 }
@@ -468,7 +536,11 @@ bool sample_pbr_base_direction(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lo
         *wi = sample_cosine_hemisphere(u);
         return true;
     }
-    return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(b, wo, u), wi);
+    if (u_lobe < p.specular + p.cosine + p.transmit || !(p.diffuse_transmit > 0))
+        return p.transmit > 0 && sample_transmission(b, wo, sample_ggx_vndf(b, wo, u), wi);
+    const Vec3 d = sample_cosine_hemisphere(u);
+    *wi = Vec3(d.x, d.y, -d.z);
+    return true;
 }
 
 bool sample_pbr(const Bsdf& b, const Vec3& wo, Vec2 u, float u_lobe, BsdfSample& s) {

@@ -23,6 +23,12 @@
 /// base by a rough dielectric interface (Walter et al. 2007) refracting with
 /// the material's ior, as `dielectric` does for a closed volume.
 ///
+/// Diffuse transmission (KHR_materials_diffuse_transmission) replaces that
+/// share of what is left of the Lambertian base by a Lambertian lobe on the far
+/// side, of its own colour, scaled like the base by what the dielectric layer
+/// leaves on both sides: (1 - Ed(mu_o)) (1 - Ed(|mu_i|)) / (1 - Ed_avg).
+/// It does not bend light, so it behaves alike on thin walls and volumes.
+///
 /// All directions here are local (shading normal +z); wo.z > 0 is required.
 #include "render/bsdf.h"
 
@@ -30,9 +36,10 @@ namespace sahara {
 
 /// The glTF material's BSDF at `si`: base colour (factor x texture x vertex
 /// colour), metallic-roughness texture (G roughness, B metallic), transmission
-/// texture (R), normal map; each texture reads its own UV set.
+/// texture (R), normal map; each texture reads its own UV set. With a
+/// wavelength (nm, > 0) a dispersive volume takes its ior there (render/dispersion.h).
 void make_pbr_bsdf(Bsdf& b, const MaterialDesc& m, const SurfaceInteraction& si,
-                   const std::vector<TextureDesc>& textures);
+                   const std::vector<TextureDesc>& textures, float wavelength_nm = 0.0f);
 
 /// Radiance emitted (factor x texture x strength, from either side) towards wo,
 /// any length, away from the surface. A clearcoat over the emission lets
@@ -50,10 +57,11 @@ Rgb pbr_fresnel(const Bsdf& b, float cos_theta);
 
 /// The lobes' weights at one wo: the probabilities sample_pbr uses.
 struct PbrLobeWeights {
-    float specular = 0;  ///< single-scattering GGX reflection (visible-normal sampled)
-    float cosine = 0;    ///< diffuse base and multiple-scattering lobe (cosine sampled)
-    float transmit = 0;  ///< rough refraction
-    float total = 0;     ///< the three before normalisation: the base's estimated albedo at wo
+    float specular = 0;          ///< single-scattering GGX reflection (visible-normal sampled)
+    float cosine = 0;            ///< diffuse base and multiple-scattering lobe (cosine sampled)
+    float transmit = 0;          ///< rough refraction
+    float diffuse_transmit = 0;  ///< Lambertian transmission (KHR_materials_diffuse_transmission)
+    float total = 0;             ///< the lobes before normalisation: the base's estimated albedo at wo
 };
 
 PbrLobeWeights pbr_lobe_weights(const Bsdf& b, const Vec3& wo);

@@ -9,6 +9,7 @@
 #include "render/background.h"
 #include "render/bsdf.h"
 #include "render/bsdf_pbr.h"
+#include "render/dispersion.h"
 #include "render/lights.h"
 #include "scene/texture.h"
 
@@ -74,11 +75,11 @@ inline bool sample_shading(const Bsdf& b, const Vec3& wo, Sampler& sampler, Bsdf
 
 template <bool kLambertOnly>
 auto make_shading(const MaterialDesc& m, const SurfaceInteraction& si,
-                  const std::vector<TextureDesc>& textures) {
+                  const std::vector<TextureDesc>& textures, [[maybe_unused]] float wavelength_nm) {
     if constexpr (kLambertOnly)
         return LambertShading{material_albedo(m, si, textures), si.ns, si.ng};
     else
-        return make_bsdf(m, si, textures);
+        return make_bsdf(m, si, textures, wavelength_nm);
 }
 
 /// Next-event estimation at a non-delta vertex: one emitter, one shadow ray
@@ -221,6 +222,8 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
     float eta_scale = 1;  // undoes the 1/eta^2 of refraction for Russian roulette
     PrevVertex prev;
     Medium medium;
+    float wavelength =
+        0;  // nm once a dispersive volume made the path carry one channel (render/dispersion.h)
     [[maybe_unused]] int unlit_passes = 0;
     for (int depth = 1; depth <= max_depth; ++depth) {
         Hit hit;
@@ -254,7 +257,13 @@ Rgb path_kernel(const Scene& scene, Ray ray, Sampler& sampler, int max_depth, co
         if (depth == max_depth) break;
 
         const Vec3 wo = -ray.dir;
-        const auto bsdf = make_shading<kLambertOnly>(mat, si, scene.textures);
+        if constexpr (!kLambertOnly)
+            if (wavelength == 0 && disperses(mat)) {
+                const PathWavelength w = sample_path_wavelength(sampler.next_1d());
+                wavelength = w.nm;
+                beta *= w.weight();
+            }
+        const auto bsdf = make_shading<kLambertOnly>(mat, si, scene.textures, wavelength);
         if constexpr (S != Strategy::none) {
             const float u_select = sampler.next_1d();
             const Vec2 u_light = sampler.next_2d();

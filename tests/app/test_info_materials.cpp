@@ -53,6 +53,8 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
         {"extensions",
          {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1}}},
           {"KHR_materials_dispersion", {{"dispersion", 0.5}}},
+          {"KHR_materials_diffuse_transmission", {{"diffuseTransmissionFactor", 0.25}}},
+          {"KHR_materials_volume_scatter", json::object()},
           {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}},
           {"KHR_materials_transmission", {{"transmissionFactor", 0.5}}},
           {"KHR_materials_volume",
@@ -72,8 +74,14 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     CHECK(m["alpha_mode"] == "blend");
     CHECK(m["double_sided"] == false);
     const json& ignored = j["Ignored inputs"]["[0] paint"];
-    for (const char* what : {"occlusion map", "KHR_materials_dispersion"})
+    for (const char* what : {"occlusion map", "KHR_materials_volume_scatter"})
         CHECK_MESSAGE(contains(ignored, what), std::string(what));
+    CHECK_FALSE(contains(ignored, "KHR_materials_dispersion"));            // rendered
+    CHECK_FALSE(contains(ignored, "KHR_materials_diffuse_transmission"));  // rendered
+    CHECK(m["dispersion"].get<double>() == doctest::Approx(0.5));
+    CHECK(m["diffuse_transmission"].get<double>() == doctest::Approx(0.25));
+    CHECK(contains(m["extensions"], "KHR_materials_dispersion"));
+    CHECK(contains(m["extensions"], "KHR_materials_diffuse_transmission"));
     CHECK_FALSE(contains(ignored, "KHR_materials_clearcoat"));    // rendered
     CHECK_FALSE(contains(ignored, "KHR_materials_iridescence"));  // rendered
     CHECK(m["clearcoat"] == 1.0);
@@ -88,7 +96,8 @@ TEST_CASE("info: a glTF pbr material with its textures and vertex colours and th
     for (const char* text :
          {"[0] paint", "textures: base colour, metallic-roughness, normal map, emission",
           "vertex colours and alpha", "transmission 0.5, ior 1.5", "alpha blend", "one-sided",
-          "clearcoat 1 (roughness 0)", "Ignored inputs", "occlusion map, KHR_materials_dispersion"})
+          "clearcoat 1 (roughness 0)", "dispersion 0.5", "diffuse transmission 0.25", "Ignored inputs",
+          "occlusion map, KHR_materials_volume_scatter"})
         CHECK_MESSAGE(r.out.find(text) != std::string::npos, std::string(text));
 }
 

@@ -157,3 +157,24 @@ TEST_CASE("scene parser: pbr iridescence keys") {
                    {"materials.m.iridescence_thickness"});
     check_contains(bad(R"({"type": "lambertian", "iridescence": 0.5})"), {"iridescence"});  // pbr only
 }
+
+TEST_CASE("scene parser: pbr dispersion and diffuse transmission keys") {
+    const MaterialDesc plain = parse_one(R"({"type": "pbr"})");
+    CHECK(plain.dispersion == 0.0f);
+    CHECK(plain.diffuse_transmission == 0.0f);
+    const MaterialDesc m = parse_one(
+        R"({"type": "pbr", "dispersion": 0.7, "diffuse_transmission": 0.4, "diffuse_transmission_color": [1, 0.5, 0.2]})");
+    CHECK(m.dispersion == 0.7f);
+    CHECK(m.diffuse_transmission == 0.4f);
+    CHECK(m.diffuse_transmission_color == Rgb(1.0f, 0.5f, 0.2f));
+    CHECK(m.diffuse_transmission_texture == -1);
+    const auto bad = [](const std::string& material) {
+        return error_of(with_objects("[]", R"({"m": )" + material + "}"));
+    };
+    check_contains(bad(R"({"type": "pbr", "dispersion": -1})"), {"materials.m.dispersion"});
+    check_contains(bad(R"({"type": "pbr", "diffuse_transmission": 2})"),
+                   {"materials.m.diffuse_transmission", "[0, 1]"});
+    check_contains(bad(R"({"type": "pbr", "diffuse_transmission_color": [1, 2, 0]})"),
+                   {"materials.m.diffuse_transmission_color"});
+    check_contains(bad(R"({"type": "lambertian", "dispersion": 0.5})"), {"dispersion"});  // pbr only
+}
