@@ -136,9 +136,9 @@ __attribute__((always_inline)) inline int intersect_triangle_block4(const Triang
 }
 
 /// Loads lane group [v][axis] of blocks b0 (low half) and b1 (high half).
-__attribute__((target("avx2,fma"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b0,
-                                                                                 const TriangleBlock4* b1,
-                                                                                 int v, int axis) {
+__attribute__((target("avx2"), always_inline)) inline __m256 load_block_pair(const TriangleBlock4* b0,
+                                                                             const TriangleBlock4* b1, int v,
+                                                                             int axis) {
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(b0->p[v][axis])),
                                 _mm_load_ps(b1->p[v][axis]), 1);
 }
@@ -148,7 +148,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline __m256 load_block_pair
 /// result (and of `exact_zero`) is lane l & 3 of b0 for l < 4, of b1 otherwise;
 /// t/u/v_out hold 8 lanes. Not always_inline, like WideRay<8, true>::test
 /// (traverse_wide.h): it is inlined once its generic caller sits inside the AVX2 traversal.
-__attribute__((target("avx2,fma"))) inline int intersect_triangle_blocks2_avx_simd(
+__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
     const TriangleRay& tr, const TriangleBlock4* b0, const TriangleBlock4* b1, float tmin, float tmax,
     float t_out[8], float u_out[8], float v_out[8], int& exact_zero) {
     const int kx = tr.kx, ky = tr.ky, kz = tr.kz;
@@ -195,11 +195,10 @@ __attribute__((target("avx2,fma"))) inline int intersect_triangle_blocks2_avx_si
 
 /// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step (lanes as
 /// in intersect_triangle_blocks2_avx_simd), exactly-zero lanes redone by the scalar test.
-__attribute__((target("avx2,fma"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
-                                                                              const TriangleBlock4* b,
-                                                                              float tmin, float tmax,
-                                                                              float t_out[8], float u_out[8],
-                                                                              float v_out[8]) {
+__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
+                                                                          const TriangleBlock4* b, float tmin,
+                                                                          float tmax, float t_out[8],
+                                                                          float u_out[8], float v_out[8]) {
     int exact_zero = 0;
     int result =
         intersect_triangle_blocks2_avx_simd(tr, b, b + 1, tmin, tmax, t_out, u_out, v_out, exact_zero);

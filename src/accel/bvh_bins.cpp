@@ -120,24 +120,24 @@ void fill_bins_sse2(const PrimRef* refs, uint32_t begin, uint32_t end, const Bin
 /// The AVX2 kernel keeps each bin's box as (lo, -hi) in one 256-bit register, so a single
 /// min updates it (min(-a, -b) = -max(a, b), bit for bit, NaN and signed zero alike with
 /// the same operand order), and clamps the three bin indices with one max and one min.
-[[gnu::target("avx2,fma")]] inline __m256 negate_hi(__m256 box) {
+[[gnu::target("avx2")]] inline __m256 negate_hi(__m256 box) {
     return _mm256_xor_ps(box,
                          _mm256_castsi256_ps(_mm256_setr_epi32(0, 0, 0, 0, INT_MIN, INT_MIN, INT_MIN, 0)));
 }
 
-[[gnu::target("avx2,fma")]] inline float* bin_box(Bins& b, int axis, uint32_t k) {
+[[gnu::target("avx2")]] inline float* bin_box(Bins& b, int axis, uint32_t k) {
     return reinterpret_cast<float*>(&b.box[axis][k]);
 }
 
-[[gnu::target("avx2,fma")]] void clear_negated(Bins& out, uint32_t bins) {
+[[gnu::target("avx2")]] void clear_negated(Bins& out, uint32_t bins) {
     out.clear_counts(bins);
     const __m256 empty = _mm256_set1_ps(kInfinity);
     for (int a = 0; a < 3; ++a)
         for (uint32_t k = 0; k < bins; ++k) _mm256_store_ps(bin_box(out, a, k), empty);
 }
 
-[[gnu::target("avx2,fma")]] inline void bin_one_avx2(const PrimRef& p, __m128 lo, __m128 scale, __m128i last,
-                                                     Bins& out) {
+[[gnu::target("avx2")]] inline void bin_one_avx2(const PrimRef& p, __m128 lo, __m128 scale, __m128i last,
+                                                 Bins& out) {
     __m128i k = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(p.c), lo), scale));
     k = _mm_min_epi32(_mm_max_epi32(k, _mm_setzero_si128()), last);  // BinMap::bins' clamp
     // lo and hi of the record; lanes 3 and 7 (the id's bits, padding) cleared as load_lo does.
@@ -151,8 +151,8 @@ void fill_bins_sse2(const PrimRef* refs, uint32_t begin, uint32_t end, const Bin
     }
 }
 
-[[gnu::target("avx2,fma")]] void fill_bins_avx2(const PrimRef* refs, uint32_t begin, uint32_t end,
-                                                const BinMap& map, Bins& out) {
+[[gnu::target("avx2")]] void fill_bins_avx2(const PrimRef* refs, uint32_t begin, uint32_t end,
+                                            const BinMap& map, Bins& out) {
     const uint32_t bins = map.count();
     const __m128i last = _mm_set1_epi32(map.last);
     clear_negated(out, bins);

@@ -280,8 +280,6 @@ BvhWide<N> make_bvh_wide(const Bvh& bvh, const WideCollapse& opt) {
     if (bvh.empty()) return out;
     out.empty = false;
     out.root = bvh.nodes[0];
-    for (const float b : out.root.bounds)
-        if (std::isfinite(b)) out.extent = std::max(out.extent, std::fabs(b));
     if (out.root.is_leaf()) return out;
     // Leaf references hold the first slot and the count in one word (wide_leaf_ref).
     if (bvh.prim_indices.size() > size_t(kMaxWideLeafFirst) + 1)

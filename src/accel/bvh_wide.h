@@ -62,9 +62,6 @@ struct BvhWide {
     /// stopped by the far shell, not by what lies around their origin; set per tree by
     /// whoever knows which order suits it (Accelerator: OcclusionOrder).
     bool occlusion_far_first = false;
-    /// The largest magnitude of a finite coordinate of the root box, so of every box in
-    /// the tree: the range check of the FMA box test (Bvh8RayAvx).
-    float extent = 0.0f;
 
     /// An inner child holds its node's byte offset (index * sizeof(node)), not its
     /// index: the traversal's next node address is then one addition. The address

@@ -77,10 +77,10 @@ void walk_crossings_sse2(const Bvh8& tree, std::span<const TriangleBlock4> block
 /// The same walk compiled for AVX2: 8-wide node tests, two leaf blocks in one step, and
 /// node pairing as occlusion rays have it (nothing culls a pushed node here either).
 template <bool kCountInFastLeaf, class OnHit>
-__attribute__((target("avx2,fma"))) void walk_crossings_avx2(const Bvh8& tree,
-                                                             std::span<const TriangleBlock4> blocks,
-                                                             const Ray& ray, uint32_t& fast_count,
-                                                             OnHit&& on_hit) {
+__attribute__((target("avx2"))) void walk_crossings_avx2(const Bvh8& tree,
+                                                         std::span<const TriangleBlock4> blocks,
+                                                         const Ray& ray, uint32_t& fast_count,
+                                                         OnHit&& on_hit) {
     walk_crossings<true, kCountInFastLeaf>(tree, blocks, ray, fast_count, on_hit);
 }
 

@@ -7,8 +7,7 @@ namespace sahara {
 
 bool cpu_has_avx2() {
 #if defined(__x86_64__) || defined(__i386__)
-    // The AVX2 and AVX-512 box tests use FMA (wide_box_test.h).
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    return __builtin_cpu_supports("avx2");
 #else
     return false;
 #endif

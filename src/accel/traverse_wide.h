@@ -128,7 +128,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     };
     for (;;) {
         // Made here, not before the loop: their registers then never live across a call.
-        const WideRay<N, kAvx && N == 8> rw(ray, bvh.extent);
+        const WideRay<N, kAvx && N == 8> rw(ray);
         for (;;) {  // the inner loop: no calls
             if (const uint32_t count = ref_count(cur.ref)) {
                 counters.on_prims(count);

@@ -1,17 +1,14 @@
 #pragma once
 /// The ray-box tests of a wide node: per-ray constants and one step that tests all
 /// children of a node, in SSE2 (an 8-wide node as two halves), AVX2 and AVX-512.
-/// The SSE test's robustness is that of bvh_traverse.h: NaN from 0 * inf (origin on a
-/// slab plane, zero direction component) is ignored, and the far distance is enlarged
-/// by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", 2013). The AVX2 and AVX-512
-/// tests compute each distance in one FMA with constants rounded outward (Bvh8RayAvx),
-/// conservative too. Unused child slots hold an empty box (lo = +inf, hi = -inf), which
-/// no ray with a finite origin can hit.
+/// Robustness is that of bvh_traverse.h: NaN from 0 * inf (origin on a slab plane,
+/// zero direction component) is ignored, and the far distance is enlarged by
+/// 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", 2013). Unused child slots hold an
+/// empty box (lo = +inf, hi = -inf), which no ray with a finite origin can hit.
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <type_traits>
 
 #include <immintrin.h>
@@ -66,88 +63,64 @@ __attribute__((always_inline)) inline int intersect_wide_sse(const BvhWideNode<N
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 }
 
-/// Per-ray constants of the AVX box test of an 8-wide node, the FMA form: a plane p's
-/// distance is fma(p, inv, -c) with c an origin term rounded outward (see
-/// bvh8_distances_avx and docs/performance.md, "FMA box test"), and the byte offsets of
-/// each axis's near and far planes.
-///  - inv, inv_far: BvhRay's inverse directions (inv_far enlarged by kRobustFarScale).
-///    A component whose inverse exceeds kFmaBoxTinyInv in magnitude (a direction
-///    component below 2^-64, +-0 included) takes +-kFmaBoxTinyInv instead, signed as
-///    BvhRay::neg, so no inverse is infinite and no fma meets inf - inf;
-///  - c_near >= org * inv and c_far <= org * inv_far exactly (rounded up and down), and on
-///    an axis with a replaced inverse c_far is lowered by 2 T more, T a bound of the
-///    distance to any hit (tmax, or the scene's extent over the largest component), so
-///    that axis's exit is never before a hit;
-///  - an axis where (extent + |org|) * |inv_far| exceeds kFmaBoxRange (or T does; NaN
-///    input too) is switched off: distances -FLT_MAX and FLT_MAX for every finite plane,
-///    +-inf (a miss) for the empty slots' infinite ones. No other distance can overflow.
+/// Per-ray constants of the AVX box test of an 8-wide node: broadcast origin, negated
+/// inverse direction for the near planes and inverse direction for the far planes (see
+/// BvhRay), and the byte offsets of each axis's near and far planes.
+/// The near planes' test computes (org - plane) * -inv, which rounds exactly like
+/// (plane - org) * inv (round-to-nearest is symmetric under negation) but lets the plane
+/// be a memory operand of the subtraction; the far planes' (org - plane) * inv_far is the
+/// negated exit distance that bvh8_distances_avx reduces.
 struct Bvh8RayAvx {
-    __m256 inv[3], inv_far[3], c_near[3], c_far[3];
+    __m256 org[3], ninv[3], inv_far[3];
     /// Pointer-sized, so that the addressing needs no extension of them at every node.
     size_t near_off[3], far_off[3];
 
-    /// 2^64; see above.
-    static constexpr float kFmaBoxTinyInv = 0x1p64f;
-    /// The largest |plane * inv_far| and |org * inv_far| allowed, with room for 2 T below 2^127.
-    static constexpr float kFmaBoxRange = 0x1p124f;
-
     Bvh8RayAvx() = default;
-    /// extent: the largest magnitude of a coordinate of the tree's boxes (BvhWide::extent).
     /// Not always_inline, like WideRay<8, true>::test below: it is inlined once its
     /// generic caller sits inside an AVX2 function.
-    __attribute__((target("avx2,fma"))) Bvh8RayAvx(const BvhRay& r, float extent) {
+    __attribute__((target("avx2"))) explicit Bvh8RayAvx(const BvhRay& r) {
         // lo_x, hi_x, lo_y, ... are consecutive 32-byte arrays: an axis's planes start at
         // 64 a; the near plane is `hi` (32 bytes further) for a negative direction.
         static_assert(offsetof(Bvh8Node, hi_x) == 32 && offsetof(Bvh8Node, lo_y) == 64);
         for (int a = 0; a < 3; ++a) {
+            org[a] = _mm256_set1_ps(r.org[a]);
+            ninv[a] = _mm256_set1_ps(-r.inv_dir[a]);
+            inv_far[a] = _mm256_set1_ps(r.inv_far[a]);
             near_off[a] = size_t(64 * a + 32 * r.neg[a]);
             far_off[a] = near_off[a] ^ 32;
         }
-        alignas(16) float v[4][4];
-        fma_box_constants(r, extent, v);
-        for (int a = 0; a < 3; ++a) {
-            inv[a] = _mm256_set1_ps(v[0][a]);
-            inv_far[a] = _mm256_set1_ps(v[1][a]);
-            c_near[a] = _mm256_set1_ps(v[2][a]);
-            c_far[a] = _mm256_set1_ps(v[3][a]);
-        }
     }
-
-    /// inv, inv_far, c_near and c_far of the axes x, y, z into v[0..4)[0..3). Not inlined:
-    /// in the traversal's body its size made GCC stop inlining the leaf test into the loop.
-    __attribute__((target("avx2,fma"), noinline)) static void fma_box_constants(const BvhRay& r, float extent,
-                                                                                float (*v)[4]);
 };
 
-/// The slab distances of an 8-wide node's children in one AVX step, one FMA per plane
-/// (Bvh8RayAvx), reduced as integers: one cycle where a float max or min takes four, on
-/// the chain every node step waits for. That needs tmin >= 0:
+/// The slab distances of an 8-wide node's children in one AVX step, reduced as
+/// integers: one cycle where a float max or min takes four, on the chain every node
+/// step waits for. That needs tmin >= 0:
 ///  - entry: the signed-integer max of the near distances and tmin. Non-negative
-///    floats order like their bit patterns, and every negative float is a negative
-///    integer and loses to tmin;
-///  - neg_exit: the far distances are computed negated, c_far - far * inv_far (exactly
-///    the negation of the rounded exit), and reduced with -tmax_far by an unsigned min.
-///    Negative floats (exits ahead) order by magnitude as unsigned integers; a
-///    non-negative one (an exit behind the origin) is below them all and wins, and the
-///    child is then missed.
+///    floats order like their bit patterns, and every negative float, the NaN of
+///    0 * inf (sign bit set on x86: a ray in a slab plane) included, is a negative
+///    integer and loses to tmin, so that axis is dropped as it should be;
+///  - neg_exit: the far distances are computed negated, (org - far) * inv_far = -t1
+///    exactly, and reduced with -tmax_far by an unsigned min. Negative floats (exits
+///    ahead) order by magnitude as unsigned integers; the NaN (0xFFC00000) is above
+///    them all and loses; a non-negative one (an exit behind the origin) is below them
+///    all and wins, and the child is then missed.
 /// A child is hit when neg_exit - 1 >= entry + 0x7FFFFFFF (unsigned), i.e. |exit| >=
-/// entry for a negative exit. A negated exit of +0 wraps to all ones and counts as a hit.
-/// No distance is NaN: the constants are finite and no inverse is 0 or infinite, so an
-/// empty slot's infinite planes give +-inf (a miss). Conservative: with c_near rounded up
-/// and c_far down, each rounded near distance is at most the exact one times (1 + u)^2
-/// and each far one at least the exact one times (1 - u)^3 kRobustFarScale, so a box the
-/// exact slab test hits within [tmin, tmax] is never missed (docs/performance.md, "FMA
-/// box test"). The distances are not those of intersect_bvh_node and the SSE test, which
-/// compute (plane - org) * inv.
-__attribute__((target("avx2,fma"), always_inline)) inline void bvh8_distances_avx(
-    const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry, __m256i& neg_exit) {
+/// entry for a negative exit. A negated exit of +0 (the origin exactly on the far plane
+/// of a positive direction) wraps to all ones and counts as a hit: never a miss the
+/// exact slab test would hit. Each NaN is dropped on its own, so the hits can be fewer
+/// than those of intersect_bvh_node and the SSE test, which drop a whole pair of
+/// distances around a NaN; both are conservative.
+__attribute__((target("avx2"), always_inline)) inline void bvh8_distances_avx(const Bvh8Node& n,
+                                                                              const Bvh8RayAvx& r, float tmin,
+                                                                              float tmax_far, __m256i& entry,
+                                                                              __m256i& neg_exit) {
     const char* base = reinterpret_cast<const char*>(&n);
     __m256i tn[3], ntf[3];
     for (int a = 0; a < 3; ++a) {
         const __m256 near = _mm256_load_ps(reinterpret_cast<const float*>(base + r.near_off[a]));
         const __m256 far = _mm256_load_ps(reinterpret_cast<const float*>(base + r.far_off[a]));
-        tn[a] = _mm256_castps_si256(_mm256_fmsub_ps(near, r.inv[a], r.c_near[a]));
-        ntf[a] = _mm256_castps_si256(_mm256_fnmadd_ps(far, r.inv_far[a], r.c_far[a]));
+        tn[a] = _mm256_castps_si256(_mm256_mul_ps(_mm256_sub_ps(r.org[a], near), r.ninv[a]));
+        ntf[a] = _mm256_castps_si256(_mm256_mul_ps(_mm256_sub_ps(r.org[a], far), r.inv_far[a]));
     }
     // max with 0: a tmin of -0 would be the smallest integer, not 0.
     const __m256i lo = _mm256_max_epi32(_mm256_castps_si256(_mm256_set1_ps(tmin)), _mm256_setzero_si256());
@@ -160,10 +133,9 @@ __attribute__((target("avx2,fma"), always_inline)) inline void bvh8_distances_av
 /// hit children, entry distances to t_near[0..8). AVX2 has no unsigned compare, so the
 /// hit test flips the sign bits of both sides: neg_exit - 1 >=u entry + 0x7FFFFFFF is
 /// neg_exit + 0x7FFFFFFF >=s entry - 1.
-__attribute__((target("avx2,fma"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
-                                                                                 const Bvh8RayAvx& r,
-                                                                                 float tmin, float tmax_far,
-                                                                                 float* t_near) {
+__attribute__((target("avx2"), always_inline)) inline int intersect_bvh8_avx(const Bvh8Node& n,
+                                                                             const Bvh8RayAvx& r, float tmin,
+                                                                             float tmax_far, float* t_near) {
     __m256i entry, neg_exit;
     bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
     _mm256_store_si256(reinterpret_cast<__m256i*>(t_near), entry);
@@ -183,7 +155,7 @@ struct Bvh8HitChildren {
 /// The box test of the AVX-512 node steps (bvh8_distances_avx, then one unsigned
 /// compare into a mask register): mask of the hit children, their entry distances (as
 /// bit patterns) in `entry`.
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmask8 bvh8_hits_avx512(
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline __mmask8 bvh8_hits_avx512(
     const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far, __m256i& entry) {
     __m256i neg_exit;
     bvh8_distances_avx(n, r, tmin, tmax_far, entry, neg_exit);
@@ -198,15 +170,15 @@ __attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) inline __
 }
 
 /// The words v[0..8) of the lanes in k, moved to the front (zeros after them).
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"), always_inline)) inline __m256i
 compress_words(__mmask8 k, const uint32_t* v) {
     return _mm256_maskz_compress_epi32(k, _mm256_load_si256(reinterpret_cast<const __m256i*>(v)));
 }
 
 /// Writes eight stack entries (see traverse_wide) to out[0..8): lane i of `ref` in the low
 /// word of entry i, lane i of `t` in its high word.
-__attribute__((target("avx2,fma"), always_inline)) inline void store_stack_entries(uint64_t* out, __m256i ref,
-                                                                                   __m256i t) {
+__attribute__((target("avx2"), always_inline)) inline void store_stack_entries(uint64_t* out, __m256i ref,
+                                                                               __m256i t) {
     const __m256i lo = _mm256_unpacklo_epi32(ref, t);  // entries 0, 1 | 4, 5
     const __m256i hi = _mm256_unpackhi_epi32(ref, t);  // entries 2, 3 | 6, 7
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permute2x128_si256(lo, hi, 0x20));
@@ -217,7 +189,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline void store_stack_entri
 /// distances compressed to the front of ref/t[0..8) (slot order, zeros after them). The
 /// first hit child also comes back in registers, so the next node's address waits for
 /// neither a bit scan nor a load.
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                                uint32_t* ref, float* t) {
     __m256i entry;
@@ -235,7 +207,7 @@ intersect_bvh8_compress_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmi
 /// is their number, and the first of them also comes back in registers. The two box tests
 /// depend on nothing of each other, so the out-of-order core overlaps them, where visiting
 /// b later would wait for a chain of its own.
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAvx& r, float tmin,
                            float tmax_far, uint64_t* entries) {
     __m256i entry_a, entry_b;
@@ -261,7 +233,7 @@ intersect_bvh8_pair_avx512(const Bvh8Node& a, const Bvh8Node& b, const Bvh8RayAv
 /// first, not the last (Embree's order, read back from the stack), wins on most meshes here;
 /// the order alone, without the shorter chain, wins on some meshes and loses on others, so
 /// the AVX2 step keeps Embree's.
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline Bvh8HitChildren
 intersect_bvh8_entries_avx512(const Bvh8Node& n, const Bvh8RayAvx& r, float tmin, float tmax_far,
                               uint64_t* entries) {
     __m256i entry;
@@ -283,7 +255,7 @@ struct WideRay;
 template <int N>
 struct WideRay<N, false> {
     WideRaySse<N> sse;
-    WideRay(const BvhRay& r, float /*extent: the AVX test's*/) : sse(r) {}
+    explicit WideRay(const BvhRay& r) : sse(r) {}
     /// Tests all N children against (tmin, tmax_far = tmax * kRobustFarScale): mask of
     /// hit children, entry distances in t[0..N).
     __attribute__((always_inline)) int test(const BvhWideNode<N>& n, float tmin, float tmax_far,
@@ -300,12 +272,11 @@ struct WideRay<N, false> {
 template <>
 struct WideRay<8, true> {
     Bvh8RayAvx avx;
-    __attribute__((always_inline)) WideRay(const BvhRay& r, float extent) : avx(r, extent) {}
+    __attribute__((always_inline)) explicit WideRay(const BvhRay& r) : avx(r) {}
     /// Not always_inline: GCC inlines callees into traverse_wide before traverse_wide
     /// itself is inlined into its AVX2 caller, and refuses AVX2 code in that generic
     /// body; as a plain inline function it is inlined once it sits in the AVX2 caller.
-    __attribute__((target("avx2,fma"))) int test(const Bvh8Node& n, float tmin, float tmax_far,
-                                                 float* t) const {
+    __attribute__((target("avx2"))) int test(const Bvh8Node& n, float tmin, float tmax_far, float* t) const {
         return intersect_bvh8_avx(n, avx, tmin, tmax_far, t);
     }
 };

@@ -142,9 +142,9 @@ void key_range_sse2(const RayBatch& rays, size_t lo, size_t hi, const Bounds3& b
                     uint64_t* keys, size_t* count) {
     key_range_body(rays, lo, hi, box, scale, keys, count);
 }
-__attribute__((target("avx2,fma"))) void key_range_avx2(const RayBatch& rays, size_t lo, size_t hi,
-                                                        const Bounds3& box, const float (&scale)[3],
-                                                        uint64_t* keys, size_t* count) {
+__attribute__((target("avx2"))) void key_range_avx2(const RayBatch& rays, size_t lo, size_t hi,
+                                                    const Bounds3& box, const float (&scale)[3],
+                                                    uint64_t* keys, size_t* count) {
     key_range_body(rays, lo, hi, box, scale, keys, count);
 }
 

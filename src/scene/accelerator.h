@@ -222,15 +222,15 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
     bool trace_wide_sse2(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
-    __attribute__((target("avx2,fma"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
+    __attribute__((target("avx2"))) bool trace_wide_avx2(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
-    __attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
+    __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
         Ray& ray, Hit& hit, Counters& counters) const;
     /// Names the entry points above for the files that emit them (trace_wide.inl).
     template <SimdPath, class>
     friend struct TraceWideEntry;
     /// Packets over the wide8 tree with the single-ray box and leaf tests (packet_wide8.cpp).
-    __attribute__((target("avx2,fma"))) void trace_packet8_avx2(const RayPacket& p, HitPacket& out) const;
+    __attribute__((target("avx2"))) void trace_packet8_avx2(const RayPacket& p, HitPacket& out) const;
     /// Any hit: hit.prim receives the block index of the occluder (OcclusionCache).
     template <bool kAnyHit, bool kCutouts, bool kAvx>
     bool test_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t count, float& tmax,

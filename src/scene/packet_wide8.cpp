@@ -41,8 +41,8 @@ struct FrustumAxis {
 /// slab plane with a zero direction component) makes the lane NaN, which the
 /// caller's min/max ignore, as the single-ray test ignores that slab.
 template <bool kNear>
-__attribute__((target("avx2,fma"), always_inline)) inline __m256 frustum_plane(const char* node,
-                                                                               const FrustumAxis& a) {
+__attribute__((target("avx2"), always_inline)) inline __m256 frustum_plane(const char* node,
+                                                                           const FrustumAxis& a) {
     const __m256 plane =
         _mm256_load_ps(reinterpret_cast<const float*>(node + (kNear ? a.near_off : a.far_off)));
     const __m256 x = _mm256_sub_ps(plane, kNear ? a.o_near : a.o_far);
@@ -52,7 +52,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline __m256 frustum_plane(c
 }
 
 /// The largest of 16 floats (none NaN).
-__attribute__((target("avx2,fma"), always_inline)) inline float max16(const float* v) {
+__attribute__((target("avx2"), always_inline)) inline float max16(const float* v) {
     __m256 m = _mm256_max_ps(_mm256_load_ps(v), _mm256_load_ps(v + 8));
     m = _mm256_max_ps(m, _mm256_permute2f128_ps(m, m, 1));
     m = _mm256_max_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
@@ -60,7 +60,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline float max16(const floa
 }
 
 /// The smallest of 16 floats (none NaN).
-__attribute__((target("avx2,fma"), always_inline)) inline float min16(const float* v) {
+__attribute__((target("avx2"), always_inline)) inline float min16(const float* v) {
     __m256 m = _mm256_min_ps(_mm256_load_ps(v), _mm256_load_ps(v + 8));
     m = _mm256_min_ps(m, _mm256_permute2f128_ps(m, m, 1));
     m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
@@ -78,8 +78,8 @@ struct PacketBoxRays {
 
 /// The rays whose own box test of child `lane` of `n` hits: the single-ray
 /// operations (bvh_wide.h) lane by lane, sixteen rays in two AVX steps.
-__attribute__((target("avx2,fma"), always_inline)) inline uint32_t rays_in_box(const PacketBoxRays& r,
-                                                                               const Bvh8Node& n, int lane) {
+__attribute__((target("avx2"), always_inline)) inline uint32_t rays_in_box(const PacketBoxRays& r,
+                                                                           const Bvh8Node& n, int lane) {
     const float* planes = n.lo_x;  // lo_x, hi_x, lo_y, hi_y, lo_z, hi_z: 8 floats each
     uint32_t hit = 0;
     for (int h = 0; h < 2; ++h) {
@@ -106,8 +106,8 @@ __attribute__((target("avx2,fma"), always_inline)) inline uint32_t rays_in_box(c
 // frustum constants, the frustum node step and the per-ray leaf step share those
 // constants in one body, where they stay in registers and on the stack frame; split
 // into out-of-line helpers they would be passed and reloaded on every node.
-__attribute__((target("avx2,fma"))) void Accelerator::trace_packet8_avx2(const RayPacket& p,
-                                                                         HitPacket& out) const {
+__attribute__((target("avx2"))) void Accelerator::trace_packet8_avx2(const RayPacket& p,
+                                                                     HitPacket& out) const {
     // Per-lane single-ray constants; inactive lanes are never read.
     Ray rays[kPacketSize];
     TriangleRay tr[kPacketSize];

@@ -4,8 +4,8 @@
 namespace sahara {
 
 template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
-__attribute__((target("avx2,fma"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
-                                                                      Counters& counters) const {
+__attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit& hit,
+                                                                  Counters& counters) const {
     return trace_wide_body<kAnyHit, kCutouts, true, false, kPairNodes>(ray, hit, counters);
 }
 

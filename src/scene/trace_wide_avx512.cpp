@@ -4,7 +4,7 @@
 namespace sahara {
 
 template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
-__attribute__((target("avx2,fma,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_wide_avx512(
     Ray& ray, Hit& hit, Counters& counters) const {
     return trace_wide_body<kAnyHit, kCutouts, true, true, kPairNodes>(ray, hit, counters);
 }

@@ -179,11 +179,11 @@ TEST_CASE(
 TEST_CASE(
     "rays along axes and faces and at corners agree with brute force near and far from the origin on every "
     "SIMD path") {
-    // The FMA box test (Bvh8RayAvx) replaces zero and tiny direction components and rounds
-    // its constants outward; a lost box would lose a hit here. Origins on the walls' and
-    // boxes' planes, directions along the axes (other components +0 or -0), in the axis
-    // planes (one component zero), aimed at box corners, and random ones, in the room as
-    // built, moved far away, and scaled up and down.
+    // The cases a box test gets wrong first (zero direction components, origins on slab
+    // planes, large and small coordinates); a lost box would lose a hit here. Origins on
+    // the walls' and boxes' planes, directions along the axes (other components +0 or -0),
+    // in the axis planes (one component zero), aimed at box corners, and random ones, in
+    // the room as built, moved far away, and scaled up and down.
     SimdGuard guard;
     struct Frame {
         float scale;
