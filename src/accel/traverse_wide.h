@@ -3,7 +3,6 @@
 /// visited nearest first, with the leaf tests a caller passes in (the Accelerator's
 /// triangle blocks and other primitives, scene/trace_wide.inl).
 #include <cstdint>
-#include <cstring>
 #include <utility>
 
 #include "accel/bvh_traverse.h"
@@ -48,17 +47,11 @@ enum class LeafResult : uint8_t {
 /// node step, the child ordering and the leaf calls must sit in one inlined body
 /// with no call in the inner loop (above); split into helpers that GCC does not
 /// inline, the loop would spill the ray constants on every node.
-///
-/// kFrontierCap > 0: the search starts from `frontier[0..frontier_count)` instead of the
-/// root, entries of the stack's form (reference low, entry distance high) sorted farthest
-/// first, at most kFrontierCap of them (a ray stream's per-ray remainder, ray_stream.h).
-template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false,
-          int kFrontierCap = 0, int N, class Counters, class FastLeaf, class SlowLeaf>
+template <bool kAnyHit, bool kAvx = false, bool kAvx512 = false, bool kPairNodes = false, int N,
+          class Counters, class FastLeaf, class SlowLeaf>
 __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, BvhRay& ray,
                                                          FastLeaf&& fast_leaf, SlowLeaf&& slow_leaf,
-                                                         Counters& counters,
-                                                         const uint64_t* frontier = nullptr,
-                                                         int frontier_count = 0) {
+                                                         Counters& counters) {
     if (bvh.empty) return false;
     // No test of the root box: nodes[0] tests the root's children, which lie inside it.
     if (bvh.root.is_leaf()) {
@@ -78,8 +71,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     // top <= kPairMaxTop; above that the steps push N - 1 per level of one path down the
     // tree, so the stack stays below kPairMaxTop + 2 N + (N - 1) * kBvhMaxDepth.
     constexpr int kPairMaxTop = (N - 1) * kBvhMaxDepth;
-    // + 8: the AVX-512 any-hit step writes 8 entries.
-    Entry stack[2 * (N - 1) * kBvhMaxDepth + 2 * N + 8 + kFrontierCap];
+    Entry stack[2 * (N - 1) * kBvhMaxDepth + 2 * N + 8];  // + 8: the AVX-512 any-hit step writes 8 entries
     int top = 0;
     bool found = false;
     Entry cur{0, ray.tmin};
@@ -134,11 +126,6 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
             if (kAnyHit || cur.t <= tmax_far) return true;
         }
     };
-    if constexpr (kFrontierCap > 0) {
-        std::memcpy(stack, frontier, sizeof(Entry) * size_t(frontier_count));
-        top = frontier_count;
-        if (!pop()) return false;
-    }
     for (;;) {
         // Made here, not before the loop: their registers then never live across a call.
         const WideRay<N, kAvx && N == 8> rw(ray);

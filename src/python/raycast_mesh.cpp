@@ -4,11 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <span>
 
 #include "accel/crossings.h"
-#include "accel/ray_stream.h"
 #include "geometry/triangle.h"
 #include "python/ray_order.h"
 #include "scene/accelerator.h"
@@ -149,41 +147,7 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
     }
 }
 
-void CastMesh::nearest_streamed(TraceOrder& rays, RaySlice slice) const {
-    const auto first = int64_t(slice.first), last = int64_t(slice.last);
-    const int threads = team_size(slice);
-    const int64_t streams = (last - first + kMaxStreamRays - 1) / kMaxStreamRays;
-    const SortedRay* in = rays.rays.data();
-    const uint64_t* keys = rays.keys.data();
-    SortedHit* hits = rays.hits.data();
-#pragma omp parallel num_threads(threads)
-    {
-        // Per thread and kept: a fresh one would be zero-filled by the kernel on every slice.
-        // Uninitialised: add() and the walk write what they read.
-        thread_local const std::unique_ptr<RayStream> stream(new RayStream);
-#pragma omp for schedule(dynamic, 1)
-        for (int64_t s = 0; s < streams; ++s) {
-            const int64_t k0 = first + s * kMaxStreamRays, k1 = std::min(last, k0 + kMaxStreamRays);
-            stream->clear();
-            for (int64_t k = k0; k < k1; ++k) stream->add(BvhRay(in[uint32_t(keys[k])].ray()));
-            trace_stream_frontiers(accel_->bvh8(), *stream, nullptr);
-            for (int64_t k = k0; k < k1; ++k) {
-                const auto i = size_t(k - k0);
-                const uint32_t slot = uint32_t(keys[k]);
-                Ray r = in[slot].ray();
-                Hit h;
-                if (stream->overflow[i])
-                    accel_->intersect(r, h);
-                else if (stream->frontier_count[i] > 0)
-                    accel_->intersect_frontier(r, h, stream->frontier[i], stream->frontier_count[i]);
-                hits[slot] = SortedHit{h.t, h.prim, h.u, h.v};
-            }
-        }
-    }
-}
-
 void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
-    if (accel_ && accel_->stream_traversal_supported()) return nearest_streamed(rays, slice);
     const auto first = int64_t(slice.first), last = int64_t(slice.last);
     const int threads = team_size(slice);
     const int64_t item = work_item(slice, threads, 1);

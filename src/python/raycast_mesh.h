@@ -93,9 +93,6 @@ class CastMesh {
     Vec3 unit_normal(uint32_t triangle) const;
     /// nearest() of a sorted order: its contiguous rays, hits kept in sorted order.
     void nearest_sorted(TraceOrder& rays, RaySlice slice) const;
-    /// nearest_sorted() as ray streams (accel/ray_stream.h): runs of kMaxStreamRays sorted
-    /// rays go down the tree's upper levels together, then each finishes alone.
-    void nearest_streamed(TraceOrder& rays, RaySlice slice) const;
     /// The largest origin spread of a packet the packet traversal takes.
     float packet_max_offset() const;
     /// unit_normal of every triangle, computed once: a hit then reads one row instead of

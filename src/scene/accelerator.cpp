@@ -487,23 +487,6 @@ bool Accelerator::intersect(Ray& ray, Hit& hit) const {
     return trace<false>(ray, hit, none);
 }
 
-bool Accelerator::stream_traversal_supported() const {
-    const SimdPath path = active_simd_path();
-    return layout_ == BvhLayout::wide8 && alpha_.empty() && !wide8_.empty && !wide8_.root.is_leaf() &&
-           (path == SimdPath::avx512 || path == SimdPath::avx2);
-}
-
-bool Accelerator::intersect_frontier(Ray& ray, Hit& hit, const uint64_t* frontier, int count) const {
-    // The pairing rule of trace_layout for closest-hit rays.
-    const bool pair =
-        pair_rays_ != PairRays::none && (pair_rays_ == PairRays::all || bounds_.contains(ray.origin));
-    if (active_simd_path() == SimdPath::avx512)
-        return pair ? trace_frontier_avx512<true>(ray, hit, frontier, count)
-                    : trace_frontier_avx512<false>(ray, hit, frontier, count);
-    return pair ? trace_frontier_avx2<true>(ray, hit, frontier, count)
-                : trace_frontier_avx2<false>(ray, hit, frontier, count);
-}
-
 bool Accelerator::occluded(const Ray& ray) const {
     NoTraversalCounters none;
     Hit h;

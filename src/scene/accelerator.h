@@ -164,14 +164,6 @@ class Accelerator {
     uint32_t lane_prim(uint32_t lane) const {
         return lane & TriangleBlock4::kOtherKind ? others_[lane & ~TriangleBlock4::kOtherKind] : lane;
     }
-    /// intersect() from a ray stream's remainder (accel/ray_stream.h) instead of the root:
-    /// `frontier[0..count)` are the subtrees the ray's box tests left, as stack entries
-    /// sorted farthest first. Wide8 layouts without cut-outs on the AVX2 and AVX-512
-    /// paths only (stream_traversal_supported). The answer is intersect()'s up to ties
-    /// between primitives at exactly the same distance.
-    bool intersect_frontier(Ray& ray, Hit& hit, const uint64_t* frontier, int count) const;
-    /// Whether intersect_frontier can run here.
-    bool stream_traversal_supported() const;
     /// Reference answer: tests every primitive, no tree (for tests).
     bool intersect_brute_force(Ray& ray, Hit& hit) const;
 
@@ -225,10 +217,8 @@ class Accelerator {
     /// The wide8 traversal (trace_wide.inl) and its entry point per instruction set, each
     /// compiled in its own file (trace_wide_sse2.cpp, trace_wide_avx2.cpp,
     /// trace_wide_avx512.cpp), which emits every form trace_layout calls (TraceForm).
-    template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, int kFrontierCap = 0,
-              class Counters>
-    bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters, const uint64_t* frontier = nullptr,
-                         int frontier_count = 0) const;
+    template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, class Counters>
+    bool trace_wide_body(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
     bool trace_wide_sse2(Ray& ray, Hit& hit, Counters& counters) const;
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
@@ -236,13 +226,6 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
     __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
         Ray& ray, Hit& hit, Counters& counters) const;
-    /// intersect_frontier's closest-hit forms (trace_wide_avx2.cpp, trace_wide_avx512.cpp).
-    template <bool kPairNodes>
-    __attribute__((target("avx2"))) bool trace_frontier_avx2(Ray& ray, Hit& hit, const uint64_t* frontier,
-                                                             int count) const;
-    template <bool kPairNodes>
-    __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_frontier_avx512(
-        Ray& ray, Hit& hit, const uint64_t* frontier, int count) const;
     /// Names the entry points above for the files that emit them (trace_wide.inl).
     template <SimdPath, class>
     friend struct TraceWideEntry;

@@ -11,7 +11,6 @@
 #include <utility>
 
 #include "scene/accelerator.h"
-#include "accel/ray_stream.h"
 #include "accel/traverse_wide.h"
 #include "scene/leaf_blocks.inl"
 
@@ -21,12 +20,9 @@ namespace sahara {
 /// (both inline this body, so each gets its own instruction selection; an
 /// 8-wide node is tested in one AVX step there, as two SSE halves otherwise), and
 /// trace_wide_avx512 for AVX-512 (kAvx512: its node step compresses the hit children).
-template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, int kFrontierCap,
-          class Counters>
+template <bool kAnyHit, bool kCutouts, bool kAvx, bool kAvx512, bool kPairNodes, class Counters>
 __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray, Hit& hit,
-                                                                        Counters& counters,
-                                                                        const uint64_t* frontier,
-                                                                        int frontier_count) const {
+                                                                        Counters& counters) const {
     // The triangle constants (axes and shear): a closest-hit ray that starts inside the
     // scene's bounds (a bounce) makes them before the first node, where the out-of-order
     // core overlaps them with the box tests. Other rays make them at their first leaf, as
@@ -54,7 +50,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
     if constexpr (!kAnyHit)
         if (bounds_.contains(ray.origin)) triangle_ray();
     Hit best;
-    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512, kPairNodes, kFrontierCap>(
+    const bool found = traverse_wide<kAnyHit, kAvx, kAvx512, kPairNodes>(
         wide8_, br,
         [&](uint32_t first, uint32_t count, uint32_t next_first, uint32_t next_count, bool& paired,
             float& tmax) __attribute__((always_inline)) {
@@ -64,7 +60,7 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
         [&](uint32_t first, uint32_t count, float& tmax) __attribute__((always_inline)) {
             return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
         },
-        counters, frontier, frontier_count);
+        counters);
     if (found && !kAnyHit) {
         hit = best;
         ray.tmax = best.t;

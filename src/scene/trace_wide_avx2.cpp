@@ -9,17 +9,6 @@ __attribute__((target("avx2"))) bool Accelerator::trace_wide_avx2(Ray& ray, Hit&
     return trace_wide_body<kAnyHit, kCutouts, true, false, kPairNodes>(ray, hit, counters);
 }
 
-template <bool kPairNodes>
-__attribute__((target("avx2"))) bool Accelerator::trace_frontier_avx2(Ray& ray, Hit& hit,
-                                                                      const uint64_t* frontier,
-                                                                      int count) const {
-    NoTraversalCounters none;
-    return trace_wide_body<false, false, true, false, kPairNodes, kStreamFrontierCap>(ray, hit, none,
-                                                                                      frontier, count);
-}
-template bool Accelerator::trace_frontier_avx2<false>(Ray&, Hit&, const uint64_t*, int) const;
-template bool Accelerator::trace_frontier_avx2<true>(Ray&, Hit&, const uint64_t*, int) const;
-
 template <class Form>
 struct TraceWideEntry<SimdPath::avx2, Form> {
     static constexpr auto ptr = &Accelerator::trace_wide_avx2<Form::kAnyHit, Form::kCutouts, Form::kPairNodes,

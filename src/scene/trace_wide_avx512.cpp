@@ -9,16 +9,6 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelera
     return trace_wide_body<kAnyHit, kCutouts, true, true, kPairNodes>(ray, hit, counters);
 }
 
-template <bool kPairNodes>
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool Accelerator::trace_frontier_avx512(
-    Ray& ray, Hit& hit, const uint64_t* frontier, int count) const {
-    NoTraversalCounters none;
-    return trace_wide_body<false, false, true, true, kPairNodes, kStreamFrontierCap>(ray, hit, none, frontier,
-                                                                                     count);
-}
-template bool Accelerator::trace_frontier_avx512<false>(Ray&, Hit&, const uint64_t*, int) const;
-template bool Accelerator::trace_frontier_avx512<true>(Ray&, Hit&, const uint64_t*, int) const;
-
 template <class Form>
 struct TraceWideEntry<SimdPath::avx512, Form> {
     static constexpr auto ptr = &Accelerator::trace_wide_avx512<Form::kAnyHit, Form::kCutouts,
