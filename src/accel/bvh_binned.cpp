@@ -16,6 +16,7 @@
 #include "accel/bvh_bins.h"
 #include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
+#include "accel/build_team.h"
 
 #include <algorithm>
 #include <memory>
@@ -59,13 +60,8 @@ class BinnedBuild {
         nodes_ = BuildArray<BvhNode>(2 * size_t(n_));
         used_pairs_.assign(n_, 0);
         if (n_ > kParallelScanThreshold) scratch_ = BuildArray<PrimRef>(n_);
-#pragma omp parallel
-#pragma omp master
-        {
-            // On the main thread, not any one: compact() allocates, and a worker's malloc
-            // arena would hand out fresh pages where the main thread's reuses freed ones.
-            // The other threads run the tasks from the region's end barrier. A taskgroup,
-            // not the region's end, waits for the subtrees: the compaction runs on all threads.
+        // A taskgroup waits for the subtrees: the compaction runs on all threads.
+        build::with_build_team([&] {
 #pragma omp taskgroup
             {
                 const Range root = init_refs();
@@ -75,7 +71,7 @@ class BinnedBuild {
             refs_ = {};
             scratch_ = {};
             compact();
-        }
+        });
     }
 
    private:

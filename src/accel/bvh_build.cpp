@@ -15,6 +15,7 @@
 #include "accel/bvh_sbvh.h"
 #include "accel/bvh_small_sweep.h"
 #include "accel/build_chunks.h"
+#include "accel/build_team.h"
 
 namespace sahara {
 
@@ -42,9 +43,7 @@ class BvhBuildJob {
         if (n == 0) return;
         out_.nodes.resize(2 * size_t(n));  // at most 2n - 1 nodes, plus the padding node
         node_count_ = Bvh::kFirstPair;
-#pragma omp parallel
-#pragma omp single
-        build_node(0, 0, n, 0);
+        build::with_build_team([&] { build_node(0, 0, n, 0); });
         out_.nodes.resize(out_.nodes[0].is_leaf() ? 1 : node_count_.load());
         if (out_.nodes.size() > 1) out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
     }
@@ -82,7 +81,7 @@ class BvhBuildJob {
         node.index = first_child;
         node.count = 0;
         if (n > params_.parallel_threshold) {
-            // No taskwait (see BinnedBuild::build): the parallel region's end waits for all tasks.
+            // No taskwait (see BinnedBuild::build): with_build_team waits for all tasks.
 #pragma omp task default(shared) firstprivate(first_child, begin, mid, depth)
             build_node(first_child, begin, mid, depth + 1);
             build_node(first_child + 1, mid, end, depth + 1);

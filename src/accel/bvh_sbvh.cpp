@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "accel/bvh_sbvh.h"
+#include "accel/build_team.h"
 
 namespace sahara {
 
@@ -152,9 +153,7 @@ class SbvhBuild {
         out_.prim_indices.resize(budget_);
         out_.nodes.resize(2 * budget_);
         node_count_ = Bvh::kFirstPair;
-#pragma omp parallel
-#pragma omp single
-        build_node(0, std::move(refs), 0, budget_ - n);
+        build::with_build_team([&] { build_node(0, std::move(refs), 0, budget_ - n); });
         out_.nodes.resize(out_.nodes[0].is_leaf() ? 1 : node_count_.load());
         if (out_.nodes.size() > 1) out_.nodes[1] = BvhNode{{0, 0, 0, 0, 0, 0}, 0, 0};
         out_.prim_indices.resize(slot_count_.load());

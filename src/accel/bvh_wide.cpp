@@ -1,4 +1,5 @@
 #include "accel/bvh_wide.h"
+#include "accel/build_team.h"
 
 #include <array>
 #include <atomic>
@@ -38,9 +39,7 @@ class CollapsePlan {
             solve(0);
             return;
         }
-#pragma omp parallel
-#pragma omp single
-        spawn(0, 1);
+        build::with_build_team([&] { spawn(0, 1); });
     }
 
     /// One child of a wide node: binary node `node`, or the leaf of slots [first, first + count).

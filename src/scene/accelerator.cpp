@@ -12,6 +12,7 @@
 #include <span>
 #include <string>
 
+#include "accel/build_team.h"
 #include "base/error.h"
 #include "base/process_usage.h"
 #include "geometry/spawn.h"
@@ -233,20 +234,25 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
         return *share;
     };
     builder_ = resolve_builder(prims.size(), options, largest_share);
-    bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
-    // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
-    // straight from the scene into the layout's leaf storage.
-    const SlotIds ids{prims.ids, bvh_.prim_indices};
-    const bool has_others = prims.size() > scene.triangles.size();
     layout_ = options.layout;
-    if (layout_ == BvhLayout::pairs) {
-        pairs_ = make_bvh_pairs(bvh_);
-        fill_slots(ids, scene.triangles);
-    } else {
-        wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
-        // The tree and the blocks are all the block layout keeps (plus others_).
-        make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
-    }
+    // One team for the binary tree, its collapse and the leaf storage (accel/build_team.h).
+    build::with_build_team(
+        [&] {
+            bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
+            // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
+            // straight from the scene into the layout's leaf storage.
+            const SlotIds ids{prims.ids, bvh_.prim_indices};
+            const bool has_others = prims.size() > scene.triangles.size();
+            if (layout_ == BvhLayout::pairs) {
+                pairs_ = make_bvh_pairs(bvh_);
+                fill_slots(ids, scene.triangles);
+            } else {
+                wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
+                // The tree and the blocks are all the block layout keeps (plus others_).
+                make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
+            }
+        },
+        uses_tree_ && int64_t(prims.size()) > kParallelLoopMin);
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
     unique_primitive_count_ = prims.size();
@@ -266,7 +272,8 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
 void Accelerator::fill_slots(const SlotIds& ids, const TriangleSoup& soup) {
     const size_t slots = ids.size();
     slots_.resize(slots);
-#pragma omp parallel for schedule(static) if (int64_t(slots) > kParallelLoopMin)
+    // Tasks of the build's team (Accelerator::build); a thread that comes late takes a share.
+#pragma omp taskloop default(shared) grainsize(kParallelLoopMin) if (int64_t(slots) > kParallelLoopMin)
     for (size_t s = 0; s < slots; ++s) {
         const uint32_t id = ids[s];
         slots_[s] =
@@ -330,7 +337,7 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
 /// Rewrites every wide-tree leaf (first slot, count) to (first block, count), its
 /// slots' triangles copied from the scene into blocks of four; lanes of other kinds and
 /// padding get NaN vertices. The blocks are in node order, leaves numbered by a serial
-/// prefix sum, filled in parallel (each block written once, by the thread that fills it).
+/// prefix sum, filled by tasks (each block written once, by the thread that fills it).
 template <int N>
 void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool has_others,
                                    const TriangleSoup& soup) {
@@ -376,7 +383,9 @@ void Accelerator::make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool ha
         for (int c = 0; c < N; ++c) total += blocks_of(tree.nodes[size_t(i)].leaf_count(c));
     }
     blocks_.resize(total);
-#pragma omp parallel for schedule(static) if (nodes > kParallelLoopMin / N)
+    // Tasks of the build's team (Accelerator::build), in small pieces: a thread that comes
+    // late still takes a share.
+#pragma omp taskloop default(shared) grainsize(kParallelLoopMin / (4 * N)) if (nodes > kParallelLoopMin / N)
     for (int64_t i = 0; i < nodes; ++i) {
         BvhWideNode<N>& n = tree.nodes[size_t(i)];
         uint32_t block = first_block[size_t(i)];
