@@ -58,12 +58,13 @@ struct alignas(32) SortedRay {
 static_assert(sizeof(SortedRay) == 32);
 static_assert(std::is_trivially_default_constructible_v<SortedRay> && offsetof(SortedRay, dir) == 12);
 
-/// A nearest hit as it waits in sorted order for the write-back (Hit without its
-/// instance field: 16 bytes, four per cache line).
+/// A nearest hit as it waits in sorted order for the write-back: Hit without its
+/// instance field, with the length of the ray's direction (20 bytes).
 struct SortedHit {
     float t;
     uint32_t prim;
     float u, v;
+    float dir_length;  ///< of the ray's direction: refine's test needs the hit's distance
 };
 static_assert(std::is_trivially_default_constructible_v<SortedHit>);
 

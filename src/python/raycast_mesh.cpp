@@ -54,36 +54,65 @@ CastMesh::CastMesh(std::vector<Vec3> positions, std::vector<uint32_t> indices) {
         accel_ = std::make_unique<Accelerator>(scene, crossings_accelerator_options());
     positions_ = std::move(scene.triangles.positions);
     indices_ = std::move(scene.triangles.indices);
-    normals_.resize(triangle_count());
-    const auto m = int64_t(normals_.size());
+    facts_.resize(triangle_count());
+    const auto m = int64_t(facts_.size());
 #pragma omp parallel for schedule(static)
-    for (int64_t i = 0; i < m; ++i) normals_[size_t(i)] = unit_normal(uint32_t(i));
+    for (int64_t i = 0; i < m; ++i) facts_[size_t(i)] = facts(uint32_t(i));
 }
 
 CastMesh::~CastMesh() = default;
 
 size_t CastMesh::bvh_bytes() const { return accel_ ? accel_->bytes() : 0; }
 
-Vec3 CastMesh::unit_normal(uint32_t triangle) const {
+CastMesh::TriangleFacts CastMesh::facts(uint32_t triangle) const {
     const uint32_t* v = &indices_[3 * size_t(triangle)];
     // In double: a sliver's cross product loses most of its bits in float.
-    const Vec3 &p0 = positions_[v[0]], &p1 = positions_[v[1]], &p2 = positions_[v[2]];
-    const double e1[3] = {double(p1.x) - double(p0.x), double(p1.y) - double(p0.y),
-                          double(p1.z) - double(p0.z)};
-    const double e2[3] = {double(p2.x) - double(p0.x), double(p2.y) - double(p0.y),
-                          double(p2.z) - double(p0.z)};
-    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                         e1[0] * e2[1] - e1[1] * e2[0]};
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 0.0)) return Vec3(0.0f);
-    return Vec3(float(n[0] / len), float(n[1] / len), float(n[2] / len));
+    const Vec3d p0(positions_[v[0]]), p1(positions_[v[1]]), p2(positions_[v[2]]);
+    const Vec3d n = cross(p1 - p0, p2 - p0);
+    const double len = length(n);
+    if (!(len > 0.0)) return {Vec3(0.0f), kInfinity};
+    // The test's t is a sum of edge functions times vertex depths, divided by their sum
+    // (twice the area): its rounding error, relative to t, grows like
+    // extent * (extent^2 / area) / t. Below kRefineFactor times that length it is
+    // recomputed; beyond, the error is a small fraction of a float rounding.
+    constexpr double kRefineFactor = 8.0;
+    const double extent = std::max({length(p1 - p0), length(p2 - p1), length(p0 - p2)});
+    const double below = kRefineFactor * extent * extent * extent / len;
+    return {Vec3(n / len), float(std::min(below, double(kInfinity)))};
+}
+
+void CastMesh::refine(const Ray& ray, Hit& hit) const {
+    // The watertight test decides which triangle is hit; its t and barycentrics come from
+    // sheared edge functions whose rounding grows with the triangle's extent, so on long
+    // slivers (skirting boards, CAD strips) a near hit's t can be off by 1e-3 relative.
+    // In double, with the float inputs exact, the plane intersection is off by about one
+    // float rounding. Where the plane disagrees with the test (a ray along the plane, or
+    // a hit the test placed just inside tmin/tmax that the plane puts outside), the
+    // test's answer stands.
+    const uint32_t tri = prim_index(hit.prim);
+    if (!needs_refine(hit.t * length(ray.dir), tri)) return;
+    const uint32_t* v = &indices_[3 * size_t(tri)];
+    const Vec3d p0(positions_[v[0]]), e1 = Vec3d(positions_[v[1]]) - p0, e2 = Vec3d(positions_[v[2]]) - p0;
+    const Vec3d n = cross(e1, e2), o(ray.origin), d(ray.dir);
+    const double nd = dot(n, d);
+    if (nd == 0.0) return;
+    const double t = dot(n, p0 - o) / nd;
+    const auto tf = float(t);
+    if (!(tf > ray.tmin && tf < ray.tmax)) return;
+    const Vec3d q = o + d * t - p0;
+    const double nn = dot(n, n);
+    // On an edge the plane's barycentrics may dip below 0 by a rounding: clamped, so
+    // (u, v) stays in the triangle as the test's did.
+    const double b1 = std::max(dot(n, cross(q, e2)) / nn, 0.0), b2 = std::max(dot(n, cross(e1, q)) / nn, 0.0);
+    const double sum = std::max(b1 + b2, 1.0);
+    hit.t = tf, hit.u = float(b1 / sum), hit.v = float(b2 / sum);
 }
 
 void CastMesh::store(size_t k, const Hit& hit, const NearestHits& out) const {
     // Selects, not a branch: after a sort, hits and misses alternate at random.
     const bool found = hit.hit();
     const uint32_t tri = found ? prim_index(hit.prim) : 0;
-    const Vec3 nrm = found ? normals_[tri] : Vec3(0.0f);
+    const Vec3 nrm = found ? facts_[tri].normal : Vec3(0.0f);
     out.t[k] = found ? hit.t : kInfinity;
     out.prim[k] = found ? int64_t(tri) : int64_t(-1);
     out.uv[2 * k] = found ? hit.u : 0.0f;
@@ -128,8 +157,8 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
     const uint32_t* slot_of = rays.slot_of.data();
     const SortedHit* hits = rays.hits.data();
     // The hits come from one sequential stream per bucket, too many streams for the
-    // hardware prefetcher: they are prefetched kHitsAhead rays ahead, and the normal of
-    // a hit (a table of the mesh's size, read at random) half as far ahead.
+    // hardware prefetcher: they are prefetched kHitsAhead rays ahead, and the facts of
+    // a hit's triangle (a table of the mesh's size, read at random) half as far ahead.
     constexpr int64_t kHitsAhead = 32;
     // Dynamic: on a shared machine a thread held back delays the pass by one chunk only.
     constexpr int64_t kResultChunk = 16384;
@@ -138,11 +167,14 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
         if (i + kHitsAhead < n) __builtin_prefetch(&hits[slot_of[size_t(i + kHitsAhead)]]);
         if (i + kHitsAhead / 2 < n) {
             const SortedHit& ahead = hits[slot_of[size_t(i + kHitsAhead / 2)]];
-            if (ahead.prim != kNoPrim) __builtin_prefetch(&normals_[prim_index(ahead.prim)]);
+            if (ahead.prim != kNoPrim) __builtin_prefetch(&facts_[prim_index(ahead.prim)]);
         }
         const SortedHit& h = hits[slot_of[size_t(i)]];
         Hit hit;
         hit.t = h.t, hit.prim = h.prim, hit.u = h.u, hit.v = h.v;
+        // The batch's ray is read only for the few hits refine changes.
+        if (hit.hit() && needs_refine(h.t * h.dir_length, prim_index(h.prim)))
+            refine(rays.batch.ray(size_t(i)), hit);
         store(size_t(i), hit, out);
     }
 }
@@ -164,7 +196,8 @@ void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
         Ray r = in[slot].ray();
         Hit h;
         if (accel_) accel_->intersect(r, h);
-        hits[slot] = SortedHit{h.t, h.prim, h.u, h.v};
+        // Refined in write_sorted_hits, which reads the triangle's row anyway.
+        hits[slot] = SortedHit{h.t, h.prim, h.u, h.v, length(r.dir)};
     }
 }
 
@@ -188,13 +221,18 @@ void CastMesh::nearest(TraceOrder& rays, RaySlice slice, const NearestHits& out)
         for (int l = 0; l < lanes; ++l) packet.set(l, rays.ray(size_t(start + l)));
         if (lanes > 1 && packet_is_coherent(packet, kPacketMaxChord, max_offset)) {
             accel_->intersect_packet(packet, hits);
-            for (int l = 0; l < lanes; ++l) store(size_t(start + l), hits.hit(l), out);
+            for (int l = 0; l < lanes; ++l) {
+                Hit h = hits.hit(l);
+                if (h.hit()) refine(rays.ray(size_t(start + l)), h);
+                store(size_t(start + l), h, out);
+            }
             continue;
         }
         for (int l = 0; l < lanes; ++l) {
-            Ray r = packet.ray(l);
+            const Ray ray = packet.ray(l);
+            Ray r = ray;
             Hit h;
-            accel_->intersect(r, h);
+            if (accel_->intersect(r, h)) refine(ray, h);
             store(size_t(start + l), h, out);
         }
     }
@@ -235,7 +273,10 @@ Crossings CastMesh::crossings(const RayBatch& rays) const {
         auto& r = out.ray_of[size_t(c)];
         for (int64_t i = c * kRayChunk; i < std::min(n, (c + 1) * kRayChunk); ++i) {
             const size_t first = h.size();
-            collect_crossings(accel_->bvh8(), blocks, rays.ray(size_t(i)), h);
+            const Ray ray = rays.ray(size_t(i));
+            collect_crossings(accel_->bvh8(), blocks, ray, h);
+            // The same t and barycentrics as cast_rays gives for the nearest crossing.
+            for (size_t k = first; k < h.size(); ++k) refine(ray, h[k]);
             std::sort(h.begin() + ptrdiff_t(first), h.end(), [](const Hit& a, const Hit& b) {
                 return a.t < b.t || (a.t == b.t && a.prim < b.prim);
             });

@@ -90,14 +90,30 @@ class CastMesh {
     void set_slice_rate(double rate) const { slice_rate_.store(rate, std::memory_order_relaxed); }
 
    private:
-    Vec3 unit_normal(uint32_t triangle) const;
+    /// What a hit needs of its triangle, in one 16-byte row: the unit normal, and the
+    /// distance along the ray below which the test's t may be off by more than a few
+    /// float roundings and refine() recomputes it.
+    struct TriangleFacts {
+        Vec3 normal;
+        float refine_below;
+    };
+    TriangleFacts facts(uint32_t triangle) const;
+    /// Whether a hit at `distance` along its ray (t times the direction's length) on
+    /// `triangle` is near enough for refine to change it.
+    bool needs_refine(float distance, uint32_t triangle) const {
+        return distance < facts_[triangle].refine_below;
+    }
+    /// Replaces the t and barycentrics of `hit` on `ray` (the ray as cast, before the
+    /// traversal shortened it) by the plane intersection of its triangle in double,
+    /// when the hit is nearer than the triangle's refine_below.
+    void refine(const Ray& ray, Hit& hit) const;
     /// nearest() of a sorted order: its contiguous rays, hits kept in sorted order.
     void nearest_sorted(TraceOrder& rays, RaySlice slice) const;
     /// The largest origin spread of a packet the packet traversal takes.
     float packet_max_offset() const;
-    /// unit_normal of every triangle, computed once: a hit then reads one row instead of
-    /// three indices and three vertices.
-    std::vector<Vec3> normals_;
+    /// Of every triangle, computed once: a hit then reads one row instead of three
+    /// indices and three vertices.
+    std::vector<TriangleFacts> facts_;
     /// Writes ray k's entry of `out` (a miss when !hit.hit()).
     void store(size_t k, const Hit& hit, const NearestHits& out) const;
 
