@@ -69,6 +69,24 @@ inline TriangleMesh unit_grid(int n, float z, uint32_t material) {
     return m;
 }
 
+/// A closed box [-h, h]^2 x [0, thickness] with outward (counter-clockwise) faces,
+/// all of material 1: a slab of glass in the volume and dispersion tests.
+inline TriangleMesh make_slab(float half_width, float thickness) {
+    TriangleMesh m;
+    m.material = 1;
+    const float a = -half_width, b = half_width;
+    const Vec3 X(b - a, 0, 0), Y(0, b - a, 0), Z(0, 0, thickness);
+    // Each face: a corner and two edges whose cross product points outwards.
+    const Vec3 faces[6][3] = {{{a, a, thickness}, X, Y}, {{a, a, 0}, Y, X}, {{b, a, 0}, Y, Z},
+                              {{a, a, 0}, Z, Y},         {{a, b, 0}, Z, X}, {{a, a, 0}, X, Z}};
+    for (const auto& f : faces) {
+        const auto base = uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), {f[0], f[0] + f[1], f[0] + f[1] + f[2], f[0] + f[2]});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    return m;
+}
+
 /// n x n grid of tiny, separated triangles in the z = 0 plane.
 inline TriangleMesh make_tiny_grid(int n, float cell = 1.0f, float size = 1e-3f) {
     TriangleMesh m;

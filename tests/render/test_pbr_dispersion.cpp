@@ -5,6 +5,7 @@
 
 #include "pbr_test_util.h"
 #include "render/dispersion.h"
+#include "mesh_fixtures.h"
 #include "render_test_util.h"
 
 using namespace sahara;
@@ -25,22 +26,6 @@ Bsdf bsdf_at(const MaterialDesc& m, float wavelength_nm) {
     SurfaceInteraction si;
     si.ng = si.ns = Vec3(0, 0, 1);
     return make_bsdf(m, si, {}, wavelength_nm);
-}
-
-/// A closed box [-8, 8]^2 x [0, thickness] with outward faces, material 1.
-TriangleMesh slab(float thickness) {
-    TriangleMesh m;
-    m.material = 1;
-    const float a = -8.0f, b = 8.0f;
-    const Vec3 X(b - a, 0, 0), Y(0, b - a, 0), Z(0, 0, thickness);
-    const Vec3 faces[6][3] = {{{a, a, thickness}, X, Y}, {{a, a, 0}, Y, X}, {{b, a, 0}, Y, Z},
-                              {{a, a, 0}, Z, Y},         {{a, b, 0}, Z, X}, {{a, a, 0}, X, Z}};
-    for (const auto& f : faces) {
-        const auto base = uint32_t(m.positions.size());
-        m.positions.insert(m.positions.end(), {f[0], f[0] + f[1], f[0] + f[1] + f[2], f[0] + f[2]});
-        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-    return m;
 }
 
 /// A horizontal quad at height z over x in [x0, x1], y in [-8, 8], facing +z, material 2.
@@ -142,7 +127,7 @@ TEST_CASE("dispersion: a tilted glass slab sends red and blue to different place
         SceneDesc d = empty_scene(Rgb(0.0f));
         d.materials.push_back(dispersive_glass(dispersion));
         d.materials.push_back(emissive(Rgb(1.0f)));
-        d.meshes.push_back(slab(thickness));
+        d.meshes.push_back(make_slab(8.0f, thickness));
         d.meshes.push_back(floor_strip(strip_start, strip_start + 3.0f, strip_z));
         return radiance_stats(build_scene(d), Ray{origin, dir, 0.0f, kInfinity, 0.0f}, scaled(6000), 8);
     };
@@ -161,7 +146,7 @@ TEST_CASE("dispersion: a tilted glass slab sends red and blue to different place
 TEST_CASE("white furnace: a dispersive slab under a white sky stays white") {
     SceneDesc d = empty_scene(Rgb(1.0f));
     d.materials.push_back(dispersive_glass(1.5f));
-    d.meshes.push_back(slab(1.0f));
+    d.meshes.push_back(make_slab(8.0f, 1.0f));
     const Scene scene = build_scene(d);
     for (const Vec3& dir : {Vec3(0, 0, -1), normalize(Vec3(1, 0.3f, -1))}) {
         const Stat s =

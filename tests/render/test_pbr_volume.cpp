@@ -2,29 +2,13 @@
 // volume decays by Beer-Lambert, to attenuation_color after attenuation_distance.
 #include <doctest/doctest.h>
 
+#include "mesh_fixtures.h"
 #include "render_test_util.h"
 
 using namespace sahara;
 using namespace sahara::test;
 
 namespace {
-
-/// A closed box [-5, 5]^2 x [0, thickness] with outward (counter-clockwise) faces, material 1.
-TriangleMesh slab(float thickness) {
-    TriangleMesh m;
-    m.material = 1;
-    const float a = -5.0f, b = 5.0f;
-    const Vec3 X(b - a, 0, 0), Y(0, b - a, 0), Z(0, 0, thickness);
-    // Each face: a corner and two edges whose cross product points outwards.
-    const Vec3 faces[6][3] = {{{a, a, thickness}, X, Y}, {{a, a, 0}, Y, X}, {{b, a, 0}, Y, Z},
-                              {{a, a, 0}, Z, Y},         {{a, b, 0}, Z, X}, {{a, a, 0}, X, Z}};
-    for (const auto& f : faces) {
-        const auto base = uint32_t(m.positions.size());
-        m.positions.insert(m.positions.end(), {f[0], f[0] + f[1], f[0] + f[1] + f[2], f[0] + f[2]});
-        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    }
-    return m;
-}
 
 /// Clear glass (ior 1.5, nearly smooth) whose volume decays to `color` over `distance`.
 MaterialDesc tinted_glass(Rgb color, float distance) {
@@ -44,7 +28,7 @@ MaterialDesc tinted_glass(Rgb color, float distance) {
 Stat through_slab(float thickness, const MaterialDesc& glass) {
     SceneDesc d = empty_scene(Rgb(1.0f));
     d.materials.push_back(glass);
-    d.meshes.push_back(slab(thickness));
+    d.meshes.push_back(make_slab(5.0f, thickness));
     const Scene scene = build_scene(d);
     return radiance_stats(scene, Ray{{0.1f, 0.2f, 3.0f}, {0, 0, -1}, 0.0f, kInfinity, 0.0f}, scaled(4000),
                           16);

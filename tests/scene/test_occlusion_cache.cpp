@@ -70,6 +70,29 @@ struct SimdGuard {
     ~SimdGuard() { force_simd_path(best_simd_path()); }
 };
 
+/// Closest hits and occlusion of `rays` against brute force over every primitive.
+struct BruteForceTally {
+    int wrong_hit = 0, wrong_occluded = 0, hits = 0, free = 0;
+};
+
+/// `rel_t` 0: the traversal's t (and the ray's shortened tmax) equal brute force's bit
+/// for bit; otherwise t within that fraction of it.
+BruteForceTally against_brute_force(const Accelerator& accel, const std::vector<Ray>& rays, float rel_t) {
+    BruteForceTally n;
+    for (const Ray& r : rays) {
+        Ray a = r, b = r;
+        Hit ha, hb;
+        const bool fa = accel.intersect(a, ha), fb = accel.intersect_brute_force(b, hb);
+        const bool t_differs =
+            rel_t == 0.0f ? (ha.t != hb.t || a.tmax != ha.t) : std::fabs(ha.t - hb.t) > rel_t * hb.t;
+        n.wrong_hit += int(fa != fb || (fa && t_differs));
+        n.wrong_occluded += int(accel.occluded(r) != fb);
+        n.hits += int(fb);
+        n.free += int(!fb);
+    }
+    return n;
+}
+
 }  // namespace
 
 TEST_CASE("occlusion cache and child order: brute-force answers on a generated room on every SIMD path") {
@@ -157,21 +180,12 @@ TEST_CASE(
             force_simd_path(path);
             INFO("far first ", int(order == OcclusionOrder::far_first), " path ",
                  std::string(simd_path_name(path)));
-            int wrong_hit = 0, wrong_occluded = 0, hits = 0, free = 0;
-            for (const Ray& r : rays) {
-                Ray a = r, b = r;
-                Hit ha, hb;
-                const bool fa = accel.intersect(a, ha), fb = accel.intersect_brute_force(b, hb);
-                wrong_hit += int(fa != fb || (fa && (ha.t != hb.t || a.tmax != ha.t)));
-                wrong_occluded += int(accel.occluded(r) != fb);
-                hits += int(fb);
-                free += int(!fb);
-            }
-            CHECK(wrong_hit == 0);
-            CHECK(wrong_occluded == 0);
+            const BruteForceTally tally = against_brute_force(accel, rays, 0.0f);
+            CHECK(tally.wrong_hit == 0);
+            CHECK(tally.wrong_occluded == 0);
             // Both answers are common, so a traversal that lost or invented hits would show.
-            CHECK(hits > int(rays.size()) / 8);
-            CHECK(free > int(rays.size()) / 8);
+            CHECK(tally.hits > int(rays.size()) / 8);
+            CHECK(tally.free > int(rays.size()) / 8);
         }
     }
 }
@@ -229,20 +243,11 @@ TEST_CASE(
         for (SimdPath path : runnable_simd_paths()) {
             force_simd_path(path);
             INFO("scale ", f.scale, " path ", std::string(simd_path_name(path)));
-            int wrong_hit = 0, wrong_occluded = 0, hits = 0, free = 0;
-            for (const Ray& r : rays) {
-                Ray a = r, b = r;
-                Hit ha, hb;
-                const bool fa = accel.intersect(a, ha), fb = accel.intersect_brute_force(b, hb);
-                wrong_hit += int(fa != fb || (fa && std::fabs(ha.t - hb.t) > 1e-6f * hb.t));
-                wrong_occluded += int(accel.occluded(r) != fb);
-                hits += int(fb);
-                free += int(!fb);
-            }
-            CHECK(wrong_hit == 0);
-            CHECK(wrong_occluded == 0);
-            CHECK(hits > int(rays.size()) / 8);
-            CHECK(free > 0);
+            const BruteForceTally tally = against_brute_force(accel, rays, 1e-6f);
+            CHECK(tally.wrong_hit == 0);
+            CHECK(tally.wrong_occluded == 0);
+            CHECK(tally.hits > int(rays.size()) / 8);
+            CHECK(tally.free > 0);
         }
     }
 }
