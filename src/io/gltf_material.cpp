@@ -321,14 +321,11 @@ void Materials::set_anisotropy(MaterialDesc& out, const tinygltf::Value& ext, co
 /// textures, read linear. A value that is not a number or outside the
 /// extension's schema (weight in [0, 1], ior >= 1, thicknesses >= 0) is refused.
 void Materials::set_iridescence(MaterialDesc& out, const tinygltf::Value& ext, const std::string& element) {
-    const auto read = [&](const char* key, double fallback, double low, double high) {
-        return bounded_number(ext, key, fallback, low, high, element);
-    };
     IridescenceDesc& d = out.iridescence;
-    d.factor = read("iridescenceFactor", 0.0, 0.0, 1.0);
-    d.ior = read("iridescenceIor", 1.3, 1.0, -1);
-    d.thickness_min = read("iridescenceThicknessMinimum", 100.0, 0.0, -1);
-    d.thickness_max = read("iridescenceThicknessMaximum", 400.0, 0.0, -1);
+    d.factor = bounded_number(ext, "iridescenceFactor", 0.0, 0.0, 1.0, element);
+    d.ior = bounded_number(ext, "iridescenceIor", 1.3, 1.0, -1, element);
+    d.thickness_min = bounded_number(ext, "iridescenceThicknessMinimum", 100.0, 0.0, -1, element);
+    d.thickness_max = bounded_number(ext, "iridescenceThicknessMaximum", 400.0, 0.0, -1, element);
     if (auto info = texture_info(ext, "iridescenceTexture"))
         d.texture = texture(*info, false, element + ".iridescenceTexture");
     if (auto info = texture_info(ext, "iridescenceThicknessTexture"))
