@@ -103,8 +103,9 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     Entry cur{0, ray.tmin};
     // tmax scaled for the far planes; changes only when a leaf lowers tmax.
     float tmax_far = ray.tmax * kRobustFarScale;
-    auto push_sorted = [&](int base, Entry in)
-                           __attribute__((always_inline)) { push_sorted_entry(stack, top, base, in); };
+    auto push_sorted = [&](int base, Entry in) __attribute__((always_inline)) {
+        push_sorted_entry(stack, top, base, in);
+    };
     // Asks for the child boxes of the node at `p` (its first three cache lines; the fourth,
     // child links, is read only on a hit). The paired forms run on trees larger than the L2
     // cache (AcceleratorOptions::node_pairing), where a pushed node is often still in L3 or

@@ -207,7 +207,8 @@ void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
         if (accel_) accel_->intersect(std::span(r, n), std::span(h, n));
         // Refined in write_sorted_hits, which reads the triangle's row anyway.
         for (size_t i = 0; i < n; ++i)
-            hits[uint32_t(keys[start + int64_t(i)])] = SortedHit{h[i].t, h[i].prim, h[i].u, h[i].v, length(r[i].dir)};
+            hits[uint32_t(keys[start + int64_t(i)])] =
+                SortedHit{h[i].t, h[i].prim, h[i].u, h[i].v, length(r[i].dir)};
     }
 }
 
