@@ -2,7 +2,6 @@
 /// Ordered traversal of a wide BVH: the hit children are sorted by entry distance and
 /// visited nearest first, with the leaf tests a caller passes in (the Accelerator's
 /// triangle blocks and other primitives, scene/trace_wide.inl).
-#include <bit>
 #include <cstdint>
 #include <utility>
 
@@ -19,37 +18,6 @@ enum class LeafResult : uint8_t {
     hit,   ///< a hit: `tmax` lowered (closest hit) or the search may end (any hit)
     slow,  ///< not decided and nothing changed: the leaf needs the full test
 };
-
-/// A stack entry of traverse_wide: a child reference and its entry distance, 8 bytes (the
-/// AVX-512 steps write them as words: reference low, distance high).
-struct WideStackEntry {
-    uint32_t ref;
-    float t;
-};
-static_assert(sizeof(WideStackEntry) == 8);
-
-/// Inserts `in` among stack[base, top), which are sorted farthest deepest.
-__attribute__((always_inline)) inline void push_sorted_entry(WideStackEntry* stack, int& top, int base,
-                                                             WideStackEntry in) {
-    int k = top++;
-    while (k > base && stack[k - 1].t < in.t) {
-        stack[k] = stack[k - 1];
-        --k;
-    }
-    stack[k] = in;
-}
-
-/// Puts the nearer of a and b into a without a branch: which of two hit children is
-/// nearer is a coin toss for the predictor. Entry distances are at least tmin >= 0, so
-/// their bit patterns order like the floats (were one negative, only the order of
-/// visits would suffer, not the answer); on a tie, a stays.
-__attribute__((always_inline)) inline void nearer_first_entry(WideStackEntry& a, WideStackEntry& b) {
-    const uint32_t ta = std::bit_cast<uint32_t>(a.t), tb = std::bit_cast<uint32_t>(b.t);
-    const uint32_t swap = uint32_t(0) - uint32_t(tb < ta);
-    const uint32_t dr = (a.ref ^ b.ref) & swap, dt = (ta ^ tb) & swap;
-    a.ref ^= dr, b.ref ^= dr;
-    a.t = std::bit_cast<float>(ta ^ dt), b.t = std::bit_cast<float>(tb ^ dt);
-}
 
 /// Ordered traversal of an N-wide BVH, with the contract of traverse_bvh
 /// (bvh_traverse.h): the nearest hit child is visited next, the others are
@@ -90,7 +58,13 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
         counters.on_prims(bvh.root.count);
         return slow_leaf(bvh.root.index, bvh.root.count, ray.tmax);
     }
-    using Entry = WideStackEntry;
+    // A stack entry: a child reference and its entry distance, 8 bytes (the AVX-512 steps
+    // write them as words: reference low, distance high).
+    struct Entry {
+        uint32_t ref;
+        float t;
+    };
+    static_assert(sizeof(Entry) == 8);
     const char* const nodes = reinterpret_cast<const char*>(bvh.nodes.data());
     // Each node pushes at most N - 1 entries per level, plus slack. A paired step (any
     // kPairNodes form) pops one entry and pushes up to 2 N - 1, and pairs only while
@@ -103,8 +77,25 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
     Entry cur{0, ray.tmin};
     // tmax scaled for the far planes; changes only when a leaf lowers tmax.
     float tmax_far = ray.tmax * kRobustFarScale;
+    // Inserts `in` among the entries pushed since `base`, which are sorted farthest deepest.
     auto push_sorted = [&](int base, Entry in) __attribute__((always_inline)) {
-        push_sorted_entry(stack, top, base, in);
+        int k = top++;
+        while (k > base && stack[k - 1].t < in.t) {
+            stack[k] = stack[k - 1];
+            --k;
+        }
+        stack[k] = in;
+    };
+    // Puts the nearer of a and b into a without a branch: which of two hit children is
+    // nearer is a coin toss for the predictor. Entry distances are at least tmin >= 0, so
+    // their bit patterns order like the floats (were one negative, only the order of
+    // visits would suffer, not the answer); on a tie, a stays.
+    auto nearer_first = [](Entry & a, Entry & b) __attribute__((always_inline)) {
+        const uint32_t ta = std::bit_cast<uint32_t>(a.t), tb = std::bit_cast<uint32_t>(b.t);
+        const uint32_t swap = uint32_t(0) - uint32_t(tb < ta);
+        const uint32_t dr = (a.ref ^ b.ref) & swap, dt = (ta ^ tb) & swap;
+        a.ref ^= dr, b.ref ^= dr;
+        a.t = std::bit_cast<float>(ta ^ dt), b.t = std::bit_cast<float>(tb ^ dt);
     };
     // Asks for the child boxes of the node at `p` (its first three cache lines; the fourth,
     // child links, is read only on a hit). The paired forms run on trees larger than the L2
@@ -175,7 +166,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         const int hits = __builtin_popcount(h.mask), base = top;
                         for (int i = 1; i < hits; ++i) {
                             Entry in{ref[i], far_key(t[i])};
-                            nearer_first_entry(cur, in);
+                            nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         continue;
@@ -207,7 +198,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                             for (int i = 1; i < int(h.mask); ++i) {
                                 prefetch_planes(uint32_t(hit[i]));
                                 Entry in = std::bit_cast<Entry>(hit[i]);
-                                nearer_first_entry(cur, in);
+                                nearer_first(cur, in);
                                 push_sorted(base, in);
                             }
                             continue;
@@ -229,7 +220,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                                 prefetch_planes(ref[i]);
                             }
                             Entry in{ref[i], t[i]};
-                            nearer_first_entry(cur, in);
+                            nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         continue;
@@ -286,14 +277,14 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                             const unsigned c = unsigned(__builtin_ctz(unsigned(ma)));
                             prefetch_planes(n.child[c]);
                             Entry in{n.child[c], ta[c]};
-                            nearer_first_entry(cur, in);
+                            nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         for (; mb; mb &= mb - 1) {
                             const unsigned c = unsigned(__builtin_ctz(unsigned(mb)));
                             prefetch_planes(b.child[c]);
                             Entry in{b.child[c], tb[c]};
-                            nearer_first_entry(cur, in);
+                            nearer_first(cur, in);
                             push_sorted(base, in);
                         }
                         continue;
@@ -315,7 +306,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                                 c = unsigned(__builtin_ctz(unsigned(mask)));
                                 mask &= mask - 1;
                                 Entry in{n.child[c], far_key(t[c])};
-                                nearer_first_entry(cur, in);
+                                nearer_first(cur, in);
                                 push_sorted(base, in);
                             } while (mask);
                             continue;
@@ -339,7 +330,7 @@ __attribute__((always_inline)) inline bool traverse_wide(const BvhWide<N>& bvh, 
                         c = unsigned(__builtin_ctz(unsigned(mask)));
                         mask &= mask - 1;
                         Entry in{n.child[c], t[c]};
-                        nearer_first_entry(cur, in);
+                        nearer_first(cur, in);
                         push_sorted(base, in);
                     } while (mask);
                     continue;

@@ -20,10 +20,6 @@ namespace {
 /// uneven rays (long misses beside early hits) still balance across threads.
 constexpr int64_t kRayChunk = 256;
 
-/// Sorted rays go to Accelerator::intersect in batches of this many, which it traces a
-/// few at a time, interleaved.
-constexpr int64_t kSortedBatch = 32;
-
 /// Runs of kPacketSize rays take the packet traversal when their unit directions lie
 /// within this chord of the first ray's (about 1.7 degrees; a camera's neighbouring
 /// pixels are far closer) and their origins within this fraction of the mesh's
@@ -186,29 +182,22 @@ void CastMesh::write_sorted_hits(const TraceOrder& rays, int threads, const Near
 void CastMesh::nearest_sorted(TraceOrder& rays, RaySlice slice) const {
     const auto first = int64_t(slice.first), last = int64_t(slice.last);
     const int threads = team_size(slice);
-    const int64_t batches = (last - first + kSortedBatch - 1) / kSortedBatch;
-    const int64_t item = work_item(slice, threads, kSortedBatch);
+    const int64_t item = work_item(slice, threads, 1);
     const SortedRay* in = rays.rays.data();
     const uint64_t* keys = rays.keys.data();
     SortedHit* hits = rays.hits.data();
+    // The copies of a bucket are read in its sorted order, at random within the bucket's
+    // few tens of kB: asked for a few rays ahead, as the hardware prefetcher cannot guess.
+    constexpr int64_t kRaysAhead = 8;
 #pragma omp parallel for schedule(dynamic, item) num_threads(threads)
-    for (int64_t b = 0; b < batches; ++b) {
-        const int64_t start = first + b * kSortedBatch;
-        const auto n = size_t(std::min<int64_t>(kSortedBatch, last - start));
-        // The copies of a bucket are read in its sorted order, at random within the
-        // bucket's few tens of kB: the next batch's are asked for while this one traces,
-        // as the hardware prefetcher cannot guess them.
-        for (size_t i = 0; i < n; ++i)
-            if (start + int64_t(kSortedBatch + i) < last)
-                __builtin_prefetch(&in[uint32_t(keys[start + kSortedBatch + int64_t(i)])]);
-        Ray r[kSortedBatch];
-        Hit h[kSortedBatch];
-        for (size_t i = 0; i < n; ++i) r[i] = in[uint32_t(keys[start + int64_t(i)])].ray();
-        if (accel_) accel_->intersect(std::span(r, n), std::span(h, n));
+    for (int64_t k = first; k < last; ++k) {
+        if (k + kRaysAhead < last) __builtin_prefetch(&in[uint32_t(keys[k + kRaysAhead])]);
+        const uint32_t slot = uint32_t(keys[k]);
+        Ray r = in[slot].ray();
+        Hit h;
+        if (accel_) accel_->intersect(r, h);
         // Refined in write_sorted_hits, which reads the triangle's row anyway.
-        for (size_t i = 0; i < n; ++i)
-            hits[uint32_t(keys[start + int64_t(i)])] =
-                SortedHit{h[i].t, h[i].prim, h[i].u, h[i].v, length(r[i].dir)};
+        hits[slot] = SortedHit{h.t, h.prim, h.u, h.v, length(r.dir)};
     }
 }
 

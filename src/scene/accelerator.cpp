@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -497,24 +496,6 @@ __attribute__((noinline)) bool Accelerator::trace_pairs(Ray& ray, Hit& hit, Coun
 bool Accelerator::intersect(Ray& ray, Hit& hit) const {
     NoTraversalCounters none;
     return trace<false>(ray, hit, none);
-}
-
-void Accelerator::intersect(std::span<Ray> rays, std::span<Hit> hits) const {
-    static const int k = [] {
-        const char* e = std::getenv("SAHARA_INTERLEAVE");
-        return e ? std::atoi(e) : 2;
-    }();
-    if (layout_ == BvhLayout::wide8 && alpha_.empty() && !wide8_.empty && !wide8_.root.is_leaf() &&
-        active_simd_path() == SimdPath::avx512) {
-        if (k == 2) return trace_interleaved_avx512<2>(rays, hits);
-        if (k == 3) return trace_interleaved_avx512<3>(rays, hits);
-        if (k == 4) return trace_interleaved_avx512<4>(rays, hits);
-        if (k == 1) return trace_interleaved_avx512<1>(rays, hits);
-    }
-    for (size_t i = 0; i < rays.size(); ++i) {
-        hits[i] = Hit{};
-        intersect(rays[i], hits[i]);
-    }
 }
 
 bool Accelerator::occluded(const Ray& ray) const {

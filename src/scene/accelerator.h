@@ -12,7 +12,6 @@
 /// a hit on their back is dropped by a per-triangle flag at hit acceptance, in
 /// every traversal (single rays and packets), so they keep the fast paths.
 #include <algorithm>
-#include <span>
 #include <string_view>
 #include <vector>
 
@@ -143,11 +142,6 @@ class Accelerator {
 
     /// Nearest hit with t in (ray.tmin, ray.tmax); on a hit, ray.tmax becomes hit.t.
     bool intersect(Ray& ray, Hit& hit) const;
-    /// intersect() of every ray of a batch: hits[i] is what intersect(rays[i], hit) leaves
-    /// in a default Hit, bit for bit, and rays[i].tmax is lowered as there. On the AVX-512
-    /// path a thread traces several rays in turn, one traversal step each, so the core
-    /// overlaps their dependent node steps (Accelerator::trace_interleaved_avx512).
-    void intersect(std::span<Ray> rays, std::span<Hit> hits) const;
     /// Whether any primitive blocks the ray in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
     /// occluded() that tests `cache`'s block first and remembers the occluder there
@@ -232,11 +226,6 @@ class Accelerator {
     template <bool kAnyHit, bool kCutouts, bool kPairNodes, class Counters>
     __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) bool trace_wide_avx512(
         Ray& ray, Hit& hit, Counters& counters) const;
-    /// intersect(rays, hits) on the wide8 tree without cut-outs: K rays at a time
-    /// (trace_interleaved_avx512.cpp).
-    template <int K>
-    __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) void trace_interleaved_avx512(
-        std::span<Ray> rays, std::span<Hit> hits) const;
     /// Names the entry points above for the files that emit them (trace_wide.inl).
     template <SimdPath, class>
     friend struct TraceWideEntry;
