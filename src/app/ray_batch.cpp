@@ -21,15 +21,18 @@ size_t RayAnswers::hits() const {
 
 namespace {
 
-/// Runs `trace_one(i, t, prim)` for every ray index on `threads` threads and times the whole pass.
+/// CPU time of the calling thread.
 double thread_cpu_seconds() {
     timespec ts{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-template <class TraceOne>
-PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceOne&& trace_one) {
+/// Clears `out` to `count` misses and runs `loop()`, an orphaned `omp for` that fills
+/// it, on `threads` threads with flush-to-zero as `ftz` asks; the pass's wall-clock
+/// time and the threads' summed CPU time.
+template <class Loop>
+PassTime timed_parallel(size_t count, int threads, bool ftz, RayAnswers& out, Loop&& loop) {
     out.t.assign(count, kInfinity);
     out.prim.assign(count, kNoPrim);
     double cpu = 0;
@@ -38,31 +41,32 @@ PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceO
     {
         const double cpu_start = thread_cpu_seconds();
         set_flush_denormals(ftz);
-        // Chunks of 1024 rays: coherent primary rays stay together, dynamic balances the rest.
-#pragma omp for schedule(dynamic, 1024) nowait
-        for (size_t i = 0; i < count; ++i) trace_one(i, out.t[i], out.prim[i]);
+        loop();
         set_flush_denormals(false);
         cpu += thread_cpu_seconds() - cpu_start;
     }
     return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
 }
 
+/// Runs `trace_one(i, t, prim)` for every ray index on `threads` threads and times the whole pass,
+/// in chunks of 1024 rays: coherent primary rays stay together, dynamic balances the rest.
+template <class TraceOne>
+PassTime timed_pass(size_t count, int threads, bool ftz, RayAnswers& out, TraceOne&& trace_one) {
+    return timed_parallel(count, threads, ftz, out, [&] {
+#pragma omp for schedule(dynamic, 1024) nowait
+        for (size_t i = 0; i < count; ++i) trace_one(i, out.t[i], out.prim[i]);
+    });
+}
+
 /// Runs `trace_tile(packet, lane_to_ray)` for every 4x4 tile of the image on
-/// `threads` threads and times the pass; the functor stores per-ray answers.
+/// `threads` threads and times the pass; the functor stores per-ray answers. Chunks of
+/// 64 tiles = 1024 rays, as the single-ray passes.
 template <class TraceTile>
 PassTime timed_tile_pass(const std::vector<Ray>& rays, int width, int height, int threads, bool ftz,
                          RayAnswers& out, TraceTile&& trace_tile) {
-    out.t.assign(rays.size(), kInfinity);
-    out.prim.assign(rays.size(), kNoPrim);
     const int tiles_x = (width + 3) / 4, tiles_y = (height + 3) / 4;
     const int tiles = tiles_x * tiles_y;
-    double cpu = 0;
-    const auto start = std::chrono::steady_clock::now();
-#pragma omp parallel num_threads(threads) reduction(+ : cpu)
-    {
-        const double cpu_start = thread_cpu_seconds();
-        set_flush_denormals(ftz);
-        // 64 tiles = 1024 rays per chunk, as the single-ray passes.
+    return timed_parallel(rays.size(), threads, ftz, out, [&] {
 #pragma omp for schedule(dynamic, 64) nowait
         for (int tile = 0; tile < tiles; ++tile) {
             const int x0 = 4 * (tile % tiles_x), y0 = 4 * (tile / tiles_x);
@@ -80,10 +84,7 @@ PassTime timed_tile_pass(const std::vector<Ray>& rays, int width, int height, in
             for (int i = 0; i < kPacketSize; ++i)
                 if (p.active >> i & 1) out.t[index[i]] = t[i], out.prim[index[i]] = prim[i];
         }
-        set_flush_denormals(false);
-        cpu += thread_cpu_seconds() - cpu_start;
-    }
-    return {std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cpu};
+    });
 }
 
 }  // namespace

@@ -59,11 +59,9 @@ GgxAlbedo GgxAlbedoTable::at(float mu, float roughness) const {
     float t, s;
     albedo_table_cell(roughness, kRoughnessSteps, &i, &t);
     albedo_table_cell(mu, kMuSteps, &j, &s);
-    auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
     auto lerp2 = [&](float GgxAlbedo::*f) {
-        const float row0 = (1 - s) * entry(i, j).*f + s * entry(i, j + 1).*f;
-        const float row1 = (1 - s) * entry(i + 1, j).*f + s * entry(i + 1, j + 1).*f;
-        return (1 - t) * row0 + t * row1;
+        return albedo_table_lerp([&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)].*f; }, i,
+                                 t, j, s);
     };
     return {lerp2(&GgxAlbedo::e), lerp2(&GgxAlbedo::e_schlick)};
 }

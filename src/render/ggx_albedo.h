@@ -18,6 +18,15 @@ inline void albedo_table_cell(float x, int n, int* i, float* t) {
     *t = f - float(*i);
 }
 
+/// The bilinear blend in an albedo table's cell (i, t) x (j, s) from albedo_table_cell:
+/// `entry(r, m)` is the table's value at row r, column m.
+template <class Entry>
+float albedo_table_lerp(Entry entry, int i, float t, int j, float s) {
+    const float row0 = (1 - s) * entry(i, j) + s * entry(i, j + 1);
+    const float row1 = (1 - s) * entry(i + 1, j) + s * entry(i + 1, j + 1);
+    return (1 - t) * row0 + t * row1;
+}
+
 /// GGX alpha never goes below this in the glTF material: alpha = roughness^2 = 0
 /// would be a delta lobe, and 1e-3 already reflects like a mirror.
 inline constexpr float kMinPbrAlpha = 1e-3f;

@@ -89,10 +89,8 @@ float SheenAlbedoTable::at(float mu, float roughness) const {
     float t, s;
     albedo_table_cell(roughness, kRoughnessSteps, &i, &t);
     albedo_table_cell(std::sqrt(std::max(mu, 0.0f)), kMuSteps, &j, &s);
-    auto entry = [&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; };
-    const float row0 = (1 - s) * entry(i, j) + s * entry(i, j + 1);
-    const float row1 = (1 - s) * entry(i + 1, j) + s * entry(i + 1, j + 1);
-    return (1 - t) * row0 + t * row1;
+    return albedo_table_lerp([&](int r, int m) { return table_[size_t(r) * kMuSteps + size_t(m)]; }, i, t, j,
+                             s);
 }
 
 }  // namespace sahara

@@ -15,6 +15,7 @@
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
+#include "error_message.h"
 #include "scratch_dir.h"
 
 namespace sahara::test::gltf {
@@ -164,15 +165,7 @@ inline Bounds3 bounds(const LoadedModel& m) {
     return b;
 }
 
-template <class F>
-inline std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no InputError)";
-}
+using sahara::test::error_of;
 
 inline const std::vector<float> kTriangle = {0, 0, 0, 1, 0, 0, 0, 1, 0};
 

@@ -10,6 +10,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "error_message.h"
 #include "io/image_io.h"
 #include "io/mesh_utils.h"
 #include "io/model_loader.h"
@@ -19,6 +20,7 @@
 
 using namespace sahara;
 using sahara::test::count_repeated_corner_triangles;
+using sahara::test::error_of;
 using sahara::test::kTestData;
 using sahara::test::make_scan_mesh_70k;
 namespace fs = std::filesystem;
@@ -77,16 +79,6 @@ double area(const TriangleMesh& m) {
         a += 0.5 * length(cross(p1 - p0, p2 - p0));
     }
     return a;
-}
-
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no InputError)";
 }
 
 /// What load_model must give for an OBJ file: its triangles (counted from the file)

@@ -10,9 +10,11 @@
 #include "base/error.h"
 #include "io/image_io.h"
 #include "io/model_loader.h"
+#include "error_message.h"
 #include "scratch_dir.h"
 
 using namespace sahara;
+using sahara::test::error_of;
 namespace fs = std::filesystem;
 
 namespace {
@@ -38,16 +40,6 @@ std::string stderr_of(const fs::path& dir, F&& f) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
-}
-
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no InputError)";
 }
 
 const char* kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n";

@@ -108,6 +108,23 @@ std::vector<SimdPath> simd_paths() { return runnable_simd_paths(); }
 
 constexpr BvhLayout kLayouts[] = {BvhLayout::wide8, BvhLayout::pairs};
 
+/// Runs `check(acc)` on an Accelerator of `scene` in each layout on each SIMD path
+/// this CPU runs, with the layout and path named in failure messages.
+template <class Check>
+void for_each_layout_and_path(const Scene& scene, Check&& check) {
+    SimdGuard guard;
+    for (BvhLayout layout : kLayouts)
+        for (SimdPath path : simd_paths()) {
+            force_simd_path(path);
+            AcceleratorOptions opt;
+            opt.layout = layout;
+            const Accelerator acc(scene, opt);
+            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
+                 std::string(simd_path_name(path)));
+            check(acc);
+        }
+}
+
 /// 4 standard deviations of a binomial fraction with probability p over n trials.
 double four_sigma(double p, int n) { return 4.0 * std::sqrt(p * (1.0 - p) / double(n)); }
 
@@ -120,27 +137,19 @@ TEST_CASE("cut-outs: shadow rays pass exactly the transparent checker squares") 
     const Vec3 point(0.5f, 0.5f, -1.0f);
     const int n = 20000 / kSanitizerDivisor;
     const std::vector<Vec2> pts = uniform_points(n, 7);
-    SimdGuard guard;
-    for (BvhLayout layout : kLayouts)
-        for (SimdPath path : simd_paths()) {
-            force_simd_path(path);
-            AcceleratorOptions opt;
-            opt.layout = layout;
-            const Accelerator acc(scene, opt);
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
-                 std::string(simd_path_name(path)));
-            for (Vec2 c : square_centres())
-                CHECK(acc.occluded(ray_through(point, c)) != checker_transparent(c.x, c.y));
-            int through = 0, wrong = 0;
-            for (Vec2 q : pts) {
-                const bool open = !acc.occluded(ray_through(point, q));
-                through += open ? 1 : 0;
-                if (open != checker_transparent(q.x, q.y) && !near_square_edge(q, 1e-4f)) ++wrong;
-            }
-            CHECK(wrong == 0);
-            // Half the area is transparent.
-            CHECK(std::abs(double(through) / n - 0.5) < four_sigma(0.5, n));
+    for_each_layout_and_path(scene, [&](const Accelerator& acc) {
+        for (Vec2 c : square_centres())
+            CHECK(acc.occluded(ray_through(point, c)) != checker_transparent(c.x, c.y));
+        int through = 0, wrong = 0;
+        for (Vec2 q : pts) {
+            const bool open = !acc.occluded(ray_through(point, q));
+            through += open ? 1 : 0;
+            if (open != checker_transparent(q.x, q.y) && !near_square_edge(q, 1e-4f)) ++wrong;
         }
+        CHECK(wrong == 0);
+        // Half the area is transparent.
+        CHECK(std::abs(double(through) / n - 0.5) < four_sigma(0.5, n));
+    });
     // The Scene's own query (the renderer's shadow rays) too.
     int through = 0;
     for (Vec2 q : pts) through += scene.occluded(ray_through(point, q)) ? 0 : 1;
@@ -156,29 +165,21 @@ TEST_CASE("cut-outs: camera rays reach the background through the transparent sq
     const size_t quad_tris = d.meshes[0].triangle_count();
     const Vec3 eye(0.5f, 0.5f, 2.0f);
     const int n = 20000 / kSanitizerDivisor;
-    SimdGuard guard;
-    for (BvhLayout layout : kLayouts)
-        for (SimdPath path : simd_paths()) {
-            force_simd_path(path);
-            AcceleratorOptions opt;
-            opt.layout = layout;
-            const Accelerator acc(scene, opt);
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
-                 std::string(simd_path_name(path)));
-            int background = 0, wrong = 0;
-            for (Vec2 q : uniform_points(n, 11)) {
-                Ray r = ray_through(eye, q);
-                Hit h;
-                REQUIRE(acc.intersect(r, h));
-                const bool behind = prim_index(h.prim) >= quad_tris;
-                // The quad is at t = 1, the background at t = 1.5 (in units of the direction).
-                CHECK(std::abs(h.t - (behind ? 1.5f : 1.0f)) < 1e-4f);
-                background += behind ? 1 : 0;
-                if (behind != checker_transparent(q.x, q.y) && !near_square_edge(q, 1e-4f)) ++wrong;
-            }
-            CHECK(wrong == 0);
-            CHECK(std::abs(double(background) / n - 0.5) < four_sigma(0.5, n));
+    for_each_layout_and_path(scene, [&](const Accelerator& acc) {
+        int background = 0, wrong = 0;
+        for (Vec2 q : uniform_points(n, 11)) {
+            Ray r = ray_through(eye, q);
+            Hit h;
+            REQUIRE(acc.intersect(r, h));
+            const bool behind = prim_index(h.prim) >= quad_tris;
+            // The quad is at t = 1, the background at t = 1.5 (in units of the direction).
+            CHECK(std::abs(h.t - (behind ? 1.5f : 1.0f)) < 1e-4f);
+            background += behind ? 1 : 0;
+            if (behind != checker_transparent(q.x, q.y) && !near_square_edge(q, 1e-4f)) ++wrong;
         }
+        CHECK(wrong == 0);
+        CHECK(std::abs(double(background) / n - 0.5) < four_sigma(0.5, n));
+    });
 }
 
 TEST_CASE("cut-outs: constant alpha 0.3 blends stochastically and reproducibly") {
@@ -335,25 +336,17 @@ TEST_CASE("cut-outs: BVH layouts agree with brute force with the filter on") {
         changed += fa != fb || ha.prim != hb.prim ? 1 : 0;
     }
     CHECK(changed > hits / 5);
-    SimdGuard guard;
-    for (BvhLayout layout : kLayouts)
-        for (SimdPath path : simd_paths()) {
-            force_simd_path(path);
-            AcceleratorOptions opt;
-            opt.layout = layout;
-            const Accelerator acc(scene, opt);
-            REQUIRE(acc.has_cutouts());
-            INFO("layout ", std::string(bvh_layout_name(layout)), " path ",
-                 std::string(simd_path_name(path)));
-            int bad = 0;
-            for (const Ray& r0 : rays) {
-                Ray a = r0, b = r0;
-                Hit ha, hb;
-                const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
-                if (fa != fb || acc.occluded(r0) != fb || (fa && (ha.t != hb.t || ha.prim != hb.prim))) ++bad;
-            }
-            CHECK(bad == 0);
+    for_each_layout_and_path(scene, [&](const Accelerator& acc) {
+        REQUIRE(acc.has_cutouts());
+        int bad = 0;
+        for (const Ray& r0 : rays) {
+            Ray a = r0, b = r0;
+            Hit ha, hb;
+            const bool fa = acc.intersect(a, ha), fb = acc.intersect_brute_force(b, hb);
+            if (fa != fb || acc.occluded(r0) != fb || (fa && (ha.t != hb.t || ha.prim != hb.prim))) ++bad;
         }
+        CHECK(bad == 0);
+    });
 }
 
 namespace {
