@@ -42,6 +42,18 @@ inline int other_lanes(const TriangleBlock4& block) {
     return _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(block.slot))));
 }
 
+/// max(|a[0]|, |a[1]|, |a[2]|) per lane: the maxima t_scaled_error_bound takes.
+__attribute__((always_inline)) inline __m128 max_abs3(const __m128 a[3]) {
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    return _mm_max_ps(_mm_max_ps(_mm_andnot_ps(sign, a[0]), _mm_andnot_ps(sign, a[1])),
+                      _mm_andnot_ps(sign, a[2]));
+}
+__attribute__((target("avx2"), always_inline)) inline __m256 max_abs3(const __m256 a[3]) {
+    const __m256 sign = _mm256_set1_ps(-0.0f);
+    return _mm256_max_ps(_mm256_max_ps(_mm256_andnot_ps(sign, a[0]), _mm256_andnot_ps(sign, a[1])),
+                         _mm256_andnot_ps(sign, a[2]));
+}
+
 /// Scalar redo of the lanes of `b` in `lanes` (bit l: lane l) whose edge
 /// function was exactly 0 (double fallback included); returns the hit lanes as
 /// bits `shift + l`, their answers written to t/u/v_out[shift + l].
@@ -114,7 +126,11 @@ __attribute__((always_inline)) inline int intersect_triangle_block4_simd(const T
         const __m128 t = _mm_mul_ps(t_scaled, inv_det);
         // Rounding of the division can push t onto the interval's boundary.
         const __m128 in = _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(tmin)), _mm_cmplt_ps(t, _mm_set1_ps(tmax)));
-        result = mask & _mm_movemask_ps(in);
+        // Hit candidates only: within the rounding error of 0 the hit may lie behind the origin.
+        __m128 bound;
+        t_scaled_error_bound(max_abs3(x), max_abs3(y), max_abs3(rz), abs_det,
+                             _mm_andnot_ps(_mm_set1_ps(-0.0f), sz), bound);
+        result = mask & _mm_movemask_ps(_mm_and_ps(in, _mm_cmpgt_ps(t_signed, bound)));
         _mm_storeu_ps(t_out, t);
         _mm_storeu_ps(u_out, _mm_mul_ps(v, inv_det));
         _mm_storeu_ps(v_out, _mm_mul_ps(w, inv_det));
@@ -185,7 +201,10 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
         const __m256 t = _mm256_mul_ps(t_scaled, inv_det);
         const __m256 in = _mm256_and_ps(_mm256_cmp_ps(t, _mm256_set1_ps(tmin), _CMP_GT_OQ),
                                         _mm256_cmp_ps(t, _mm256_set1_ps(tmax), _CMP_LT_OQ));
-        result = mask & _mm256_movemask_ps(in);
+        __m256 bound;
+        t_scaled_error_bound(max_abs3(x), max_abs3(y), max_abs3(rz), abs_det,
+                             _mm256_andnot_ps(_mm256_set1_ps(-0.0f), sz), bound);
+        result = mask & _mm256_movemask_ps(_mm256_and_ps(in, _mm256_cmp_ps(t_signed, bound, _CMP_GT_OQ)));
         _mm256_storeu_ps(t_out, t);
         _mm256_storeu_ps(u_out, _mm256_mul_ps(v, inv_det));
         _mm256_storeu_ps(v_out, _mm256_mul_ps(w, inv_det));

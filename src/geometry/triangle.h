@@ -11,6 +11,7 @@
 /// sign of the shared edge. What an edge function that is 0 even in double means
 /// (the ray passes exactly through an edge or a vertex) is the test's tie-break
 /// policy: EdgesInclusive (the renderer's) or EdgesPerturbed (crossing counts).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -92,6 +93,35 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
     return float(double(ax) * double(by) - double(ay) * double(bx));
 }
 }  // namespace detail
+
+/// Forward error bound on the watertight test's scaled distance T = sz ((u a_z + v b_z) + w c_z),
+/// after the conservative-t analysis of Pharr, Jakob and Humphreys (Physically Based
+/// Rendering, 4th ed., 6.5.3), redone for this test's order of operations. A hit whose
+/// T, signed by det, is at most this bound may lie behind the ray's origin (its float
+/// t came out positive through rounding), so the test rejects it. Every path (scalar,
+/// SSE, AVX, packets) calls this one definition with the maxima over the three sheared
+/// vertices of |x|, |y| and |z| (the depth before the sz scale) and with |det|, |sz|; V
+/// is float or a GCC vector of floats, so all paths round alike (by reference: an AVX vector
+/// passed by value to code compiled without AVX would change the calling convention).
+///
+/// The error terms, with gamma(n) = n eps / (1 - n eps) and eps = 2^-24: a depth is one
+/// subtraction (gamma(1) Z); a sheared x or y three more roundings on operands of at
+/// most X + Z, as |sx|, |sy| <= 1 (gamma(5) (X + Z)); an edge function two products and
+/// a difference of those, 2 (gamma(2) X Y + dy X + dx Y); the sum over three vertices
+/// 3 (gamma(3) E Z + de Z + dz E), with E = max |edge function| <= |det| (the three share a
+/// sign). Collected: |sz| Z (k_det |det| + k_xy X Y + k_z Z (X + Y)). The constants are
+/// rounded up by a margin that covers the bound's own rounding and second-order terms.
+template <class V>
+[[gnu::always_inline]] inline void t_scaled_error_bound(const V& max_x, const V& max_y, const V& max_z,
+                                                        const V& abs_det, const V& abs_sz, V& bound) {
+    constexpr double kEps = 0x1p-24;
+    constexpr auto gamma = [](int n) { return n * kEps / (1.0 - n * kEps); };
+    constexpr double kMargin = 1.0 + 64.0 * kEps;
+    constexpr auto k_det = float(3.0 * (gamma(3) + gamma(1)) * kMargin);
+    constexpr auto k_xy = float((6.0 * gamma(2) + 12.0 * gamma(5)) * kMargin);
+    constexpr auto k_z = float(6.0 * gamma(5) * kMargin);
+    bound = abs_sz * (max_z * ((k_det * abs_det + k_xy * (max_x * max_y)) + k_z * (max_z * (max_x + max_y))));
+}
 
 /// Tie-break policies of the watertight test: what an edge function that is 0 even in
 /// double means (a ray exactly through an edge or a vertex). With kDecidesZeros the
@@ -202,6 +232,14 @@ inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, f
     const float abs_det = std::fabs(det);
     const float t_signed = det < 0.0f ? -t_scaled : t_scaled;
     if (!(t_signed > tmin * abs_det) || !(t_signed < tmax * abs_det)) return std::nullopt;
+    // Within the rounding error of 0, the hit may lie behind the origin.
+    const auto max_abs = [](float p, float q, float r) {
+        return std::max(std::max(std::fabs(p), std::fabs(q)), std::fabs(r));
+    };
+    float bound;
+    t_scaled_error_bound(max_abs(ax, bx, cx), max_abs(ay, by, cy), max_abs(a_z, b_z, c_z), abs_det,
+                         std::fabs(tr.sz), bound);
+    if (!(t_signed > bound)) return std::nullopt;
     const float inv_det = 1.0f / det;
     const float t = t_scaled * inv_det;
     // Rounding of the division can push t onto the interval's boundary.

@@ -228,7 +228,15 @@ template <int kIsa>
         const F inv_det = 1.0f / det;
         const F t = t_scaled * inv_det;
         // Rounding of the division can push t onto the interval's boundary.
-        const I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
+        // Within the rounding error of 0 the hit may lie behind the origin.
+        const auto max_abs = [](const F a[3]) __attribute__((always_inline)) {
+            const auto abs = [](F f) { return std::bit_cast<F>(std::bit_cast<I>(f) & 0x7FFFFFFF); };
+            return vmax<kIsa>(vmax<kIsa>(abs(a[0]), abs(a[1])), abs(a[2]));
+        };
+        F bound;
+        t_scaled_error_bound(max_abs(x), max_abs(y), max_abs(z), abs_det,
+                             std::bit_cast<F>(std::bit_cast<I>(s.sz) & 0x7FFFFFFF), bound);
+        const I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax) & (t_signed > bound);
         take_hits<kIsa>(s, take, t, int32_t(id), v * inv_det, w * inv_det);
     }
     // Lanes with an exactly-zero edge function: the scalar test (double fallback included).
