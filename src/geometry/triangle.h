@@ -192,6 +192,25 @@ struct TriangleVerts {
 static_assert(sizeof(TriangleVerts) == 36);
 static_assert(Shape<TriangleVerts>);
 
+namespace detail {
+/// Whether the ray meets the plane of `tri` at t > 0: the test's shear and distance in
+/// double from the same float inputs (differences and products of floats are then exact
+/// or within 2^-53), for hits whose float t lies within its rounding bound of 0.
+[[gnu::noinline]] inline bool hit_ahead_double(const TriangleVerts& tri, const TriangleRay& tr) {
+    double x[3], y[3], z[3];
+    for (int i = 0; i < 3; ++i) {
+        z[i] = double(tri.p[i][tr.kz]) - double(tr.org[tr.kz]);
+        x[i] = double(tri.p[i][tr.kx]) - double(tr.org[tr.kx]) - double(tr.sx) * z[i];
+        y[i] = double(tri.p[i][tr.ky]) - double(tr.org[tr.ky]) - double(tr.sy) * z[i];
+    }
+    const double u = x[2] * y[1] - y[2] * x[1], v = x[0] * y[2] - y[0] * x[2], w = x[1] * y[0] - y[1] * x[0];
+    const double det = u + v + w, t_scaled = u * z[0] + v * z[1] + w * z[2];
+    if (det == 0.0 || t_scaled == 0.0) return false;
+    // t = sz t_scaled / det: positive when an even number of the three are negative.
+    return (t_scaled > 0.0) == ((det > 0.0) == (tr.sz > 0.0f));
+}
+}  // namespace detail
+
 /// Watertight test of one triangle; a hit needs tmin < t < tmax. Degenerate
 /// (zero-area) triangles never hit.
 template <class TieBreak>
@@ -232,18 +251,24 @@ inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, f
     const float abs_det = std::fabs(det);
     const float t_signed = det < 0.0f ? -t_scaled : t_scaled;
     if (!(t_signed > tmin * abs_det) || !(t_signed < tmax * abs_det)) return std::nullopt;
-    // Within the rounding error of 0, the hit may lie behind the origin.
-    const auto max_abs = [](float p, float q, float r) {
-        return std::max(std::max(std::fabs(p), std::fabs(q)), std::fabs(r));
-    };
-    float bound;
-    t_scaled_error_bound(max_abs(ax, bx, cx), max_abs(ay, by, cy), max_abs(a_z, b_z, c_z), abs_det,
-                         std::fabs(tr.sz), bound);
-    if (!(t_signed > bound)) return std::nullopt;
     const float inv_det = 1.0f / det;
     const float t = t_scaled * inv_det;
     // Rounding of the division can push t onto the interval's boundary.
     if (!(t > tmin && t < tmax)) return std::nullopt;
+    // A triangle wholly ahead of the origin along the dominant axis is hit at t > 0. On
+    // one that is not, a t within its rounding bound of 0 may belong to a plane behind
+    // the origin: double decides (the SIMD steps leave exactly these lanes to this test).
+    const bool ahead =
+        tr.sz < 0.0f ? std::max(std::max(a_z, b_z), c_z) < 0.0f : std::min(std::min(a_z, b_z), c_z) > 0.0f;
+    if (!ahead) {
+        const auto max_abs = [](float p, float q, float r) {
+            return std::max(std::max(std::fabs(p), std::fabs(q)), std::fabs(r));
+        };
+        float bound;
+        t_scaled_error_bound(max_abs(ax, bx, cx), max_abs(ay, by, cy), max_abs(a_z, b_z, c_z), abs_det,
+                             std::fabs(tr.sz), bound);
+        if (!(t_signed > bound) && !detail::hit_ahead_double(tri, tr)) return std::nullopt;
+    }
     return ShapeHit{t, v * inv_det, w * inv_det};
 }
 
