@@ -235,10 +235,11 @@ __attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx_simd(
 
 /// intersect_triangle_block4 over the two blocks b[0], b[1] in one AVX step (lanes as
 /// in intersect_triangle_blocks2_avx_simd), the lanes it leaves redone by the scalar test.
-__attribute__((target("avx2"))) inline int intersect_triangle_blocks2_avx(const TriangleRay& tr,
-                                                                          const TriangleBlock4* b, float tmin,
-                                                                          float tmax, float t_out[8],
-                                                                          float u_out[8], float v_out[8]) {
+/// Out of line: the traversal calls it only for leaves its call-free step cannot answer,
+/// and inlined there it would crowd the hot loop.
+__attribute__((target("avx2"), noinline)) inline int intersect_triangle_blocks2_avx(
+    const TriangleRay& tr, const TriangleBlock4* b, float tmin, float tmax, float t_out[8], float u_out[8],
+    float v_out[8]) {
     int scalar_lanes = 0;
     int result =
         intersect_triangle_blocks2_avx_simd(tr, b, b + 1, tmin, tmax, t_out, u_out, v_out, scalar_lanes);

@@ -177,6 +177,7 @@ TEST_CASE("no hit on a triangle just behind the ray origin and none lost just in
     CHECK(tally.front > 1000);
     CHECK(tally.wrong_hits == 0);
     CHECK(tally.lost_hits == 0);
+    CHECK(tally.near_missed * 100 < tally.near);  // hits within the bound are decided, not dropped
 }
 
 TEST_CASE(
@@ -220,5 +221,8 @@ TEST_CASE(
             CHECK(closest.lost_hits == 0);
             CHECK(any.lost_hits == 0);
             CHECK(packets.lost_hits == 0);
+            CHECK(closest.near_missed * 100 < closest.near);
+            CHECK(any.near_missed * 100 < any.near);
+            CHECK(packets.near_missed * 100 < packets.near);
         }
 }
