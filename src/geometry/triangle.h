@@ -98,7 +98,8 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
 /// after the conservative-t analysis of Pharr, Jakob and Humphreys (Physically Based
 /// Rendering, 4th ed., 6.5.3), redone for this test's order of operations. A hit whose
 /// T, signed by det, is at most this bound may lie behind the ray's origin (its float
-/// t came out positive through rounding), so the test rejects it. Every path (scalar,
+/// t came out positive through rounding): TriangleVerts::intersect then decides its
+/// side in double (detail::hit_ahead_double). Every path (scalar,
 /// SSE, AVX, packets) calls this one definition with the maxima over the three sheared
 /// vertices of |x|, |y| and |z| (the depth before the sz scale) and with |det|, |sz|; V
 /// is float or a GCC vector of floats, so all paths round alike (by reference: an AVX vector
