@@ -11,6 +11,7 @@
 /// sign of the shared edge. What an edge function that is 0 even in double means
 /// (the ray passes exactly through an edge or a vertex) is the test's tie-break
 /// policy: EdgesInclusive (the renderer's) or EdgesPerturbed (crossing counts).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -93,6 +94,36 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
 }
 }  // namespace detail
 
+/// Forward error bound on the watertight test's scaled distance T = sz ((u a_z + v b_z) + w c_z),
+/// after the conservative-t analysis of Pharr, Jakob and Humphreys (Physically Based
+/// Rendering, 4th ed., 6.5.3), redone for this test's order of operations. A hit whose
+/// T, signed by det, is at most this bound may lie behind the ray's origin (its float
+/// t came out positive through rounding): TriangleVerts::intersect then decides its
+/// side in double (detail::hit_ahead_double). Every path (scalar,
+/// SSE, AVX, packets) calls this one definition with the maxima over the three sheared
+/// vertices of |x|, |y| and |z| (the depth before the sz scale) and with |det|, |sz|; V
+/// is float or a GCC vector of floats, so all paths round alike (by reference: an AVX vector
+/// passed by value to code compiled without AVX would change the calling convention).
+///
+/// The error terms, with gamma(n) = n eps / (1 - n eps) and eps = 2^-24: a depth is one
+/// subtraction (gamma(1) Z); a sheared x or y three more roundings on operands of at
+/// most X + Z, as |sx|, |sy| <= 1 (gamma(5) (X + Z)); an edge function two products and
+/// a difference of those, 2 (gamma(2) X Y + dy X + dx Y); the sum over three vertices
+/// 3 (gamma(3) E Z + de Z + dz E), with E = max |edge function| <= |det| (the three share a
+/// sign). Collected: |sz| Z (k_det |det| + k_xy X Y + k_z Z (X + Y)). The constants are
+/// rounded up by a margin that covers the bound's own rounding and second-order terms.
+template <class V>
+[[gnu::always_inline]] inline void t_scaled_error_bound(const V& max_x, const V& max_y, const V& max_z,
+                                                        const V& abs_det, const V& abs_sz, V& bound) {
+    constexpr double kEps = 0x1p-24;
+    constexpr auto gamma = [](int n) { return n * kEps / (1.0 - n * kEps); };
+    constexpr double kMargin = 1.0 + 64.0 * kEps;
+    constexpr auto k_det = float(3.0 * (gamma(3) + gamma(1)) * kMargin);
+    constexpr auto k_xy = float((6.0 * gamma(2) + 12.0 * gamma(5)) * kMargin);
+    constexpr auto k_z = float(6.0 * gamma(5) * kMargin);
+    bound = abs_sz * (max_z * ((k_det * abs_det + k_xy * (max_x * max_y)) + k_z * (max_z * (max_x + max_y))));
+}
+
 /// Tie-break policies of the watertight test: what an edge function that is 0 even in
 /// double means (a ray exactly through an edge or a vertex). With kDecidesZeros the
 /// policy's inside(u, v, w, sheared vertices) decides such a hit; without, the sign
@@ -162,6 +193,25 @@ struct TriangleVerts {
 static_assert(sizeof(TriangleVerts) == 36);
 static_assert(Shape<TriangleVerts>);
 
+namespace detail {
+/// Whether the ray meets the plane of `tri` at t > 0: the test's shear and distance in
+/// double from the same float inputs (differences and products of floats are then exact
+/// or within 2^-53), for hits whose float t lies within its rounding bound of 0.
+[[gnu::noinline]] inline bool hit_ahead_double(const TriangleVerts& tri, const TriangleRay& tr) {
+    double x[3], y[3], z[3];
+    for (int i = 0; i < 3; ++i) {
+        z[i] = double(tri.p[i][tr.kz]) - double(tr.org[tr.kz]);
+        x[i] = double(tri.p[i][tr.kx]) - double(tr.org[tr.kx]) - double(tr.sx) * z[i];
+        y[i] = double(tri.p[i][tr.ky]) - double(tr.org[tr.ky]) - double(tr.sy) * z[i];
+    }
+    const double u = x[2] * y[1] - y[2] * x[1], v = x[0] * y[2] - y[0] * x[2], w = x[1] * y[0] - y[1] * x[0];
+    const double det = u + v + w, t_scaled = u * z[0] + v * z[1] + w * z[2];
+    if (det == 0.0 || t_scaled == 0.0) return false;
+    // t = sz t_scaled / det: positive when an even number of the three are negative.
+    return (t_scaled > 0.0) == ((det > 0.0) == (tr.sz > 0.0f));
+}
+}  // namespace detail
+
 /// Watertight test of one triangle; a hit needs tmin < t < tmax. Degenerate
 /// (zero-area) triangles never hit.
 template <class TieBreak>
@@ -206,6 +256,20 @@ inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, f
     const float t = t_scaled * inv_det;
     // Rounding of the division can push t onto the interval's boundary.
     if (!(t > tmin && t < tmax)) return std::nullopt;
+    // A triangle wholly ahead of the origin along the dominant axis is hit at t > 0. On
+    // one that is not, a t within its rounding bound of 0 may belong to a plane behind
+    // the origin: double decides (the SIMD steps leave exactly these lanes to this test).
+    const bool ahead =
+        tr.sz < 0.0f ? std::max(std::max(a_z, b_z), c_z) < 0.0f : std::min(std::min(a_z, b_z), c_z) > 0.0f;
+    if (!ahead) {
+        const auto max_abs = [](float p, float q, float r) {
+            return std::max(std::max(std::fabs(p), std::fabs(q)), std::fabs(r));
+        };
+        float bound;
+        t_scaled_error_bound(max_abs(ax, bx, cx), max_abs(ay, by, cy), max_abs(a_z, b_z, c_z), abs_det,
+                             std::fabs(tr.sz), bound);
+        if (!(t_signed > bound) && !detail::hit_ahead_double(tri, tr)) return std::nullopt;
+    }
     return ShapeHit{t, v * inv_det, w * inv_det};
 }
 

@@ -54,8 +54,8 @@ __attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ra
 }
 
 /// The common leaf, one or two blocks of triangles, without a call: a leaf with
-/// other kinds or more blocks, a lane with an exactly-zero edge function (the
-/// scalar redo) and every leaf of a scene with cut-outs (the alpha test) are
+/// other kinds or more blocks, a lane the SIMD step leaves to the scalar test
+/// (redo_scalar_lanes) and every leaf of a scene with cut-outs (the alpha test) are
 /// `slow`, answered by test_blocks with nothing changed here.
 ///
 /// A one-block leaf is tested together with the entry the traversal would visit
@@ -75,18 +75,18 @@ __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(
     const bool pair = !two && next_count - 1 < 4 && !other_lanes(blocks_[next_first]);  // next_count 1..4
     if (pair) b1 = &blocks_[next_first], two = true;
     alignas(32) float t[8], u[8], v[8];
-    int exact_zero = 0, mask = 0;
+    int scalar_lanes = 0, mask = 0;
     if (kAvx && two) {
-        mask = intersect_triangle_blocks2_avx_simd(tr, b0, b1, ray.tmin, tmax, t, u, v, exact_zero);
+        mask = intersect_triangle_blocks2_avx_simd(tr, b0, b1, ray.tmin, tmax, t, u, v, scalar_lanes);
     } else {
-        mask = intersect_triangle_block4_simd(tr, *b0, ray.tmin, tmax, t, u, v, exact_zero);
+        mask = intersect_triangle_block4_simd(tr, *b0, ray.tmin, tmax, t, u, v, scalar_lanes);
         // Distances of the first block's hits are not yet below tmax here: the
         // nearest of all eight lanes is picked below, as the AVX step does.
-        if (two && !exact_zero)
-            mask |= intersect_triangle_block4_simd(tr, *b1, ray.tmin, tmax, t + 4, u + 4, v + 4, exact_zero)
+        if (two && !scalar_lanes)
+            mask |= intersect_triangle_block4_simd(tr, *b1, ray.tmin, tmax, t + 4, u + 4, v + 4, scalar_lanes)
                     << 4;
     }
-    if (exact_zero) return LeafResult::slow;
+    if (scalar_lanes) return LeafResult::slow;
     paired = pair;
     if (mask && !one_sided_.empty()) mask = cull_block_lanes(ray, b0, b1, mask);
     if (!mask) return LeafResult::miss;

@@ -223,16 +223,35 @@ template <int kIsa>
     // det != 0 needs no test: the lanes kept have u, v, w non-zero and of one sign.
     const I ok = ~(any_neg & any_pos) & (t_signed > s.tmin * abs_det) & (t_signed < s.tmax * abs_det);
     const uint32_t bits = mask_of<kIsa>(ok) & mask & ~exact_zero;
+    uint32_t redo = exact_zero;
     const uint32_t id = b.slot[l];  // a triangle lane holds its primitive id
     if (bits) {
         const F inv_det = 1.0f / det;
         const F t = t_scaled * inv_det;
         // Rounding of the division can push t onto the interval's boundary.
-        const I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
+        I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
+        // A triangle wholly ahead of the origin along the dominant axis is hit at t > 0; on
+        // one that is not, a t within its rounding bound of 0 is decided by the scalar test.
+        const I dz_sign = std::bit_cast<I>(s.sz) & int32_t(0x80000000u);
+        const auto flip = [&](F f) __attribute__((always_inline)) {
+            return std::bit_cast<F>(std::bit_cast<I>(f) ^ dz_sign);
+        };
+        const F nearest = vmin<kIsa>(vmin<kIsa>(flip(z[0]), flip(z[1])), flip(z[2]));
+        if (const uint32_t straddling = mask_of<kIsa>(take & ~(nearest > zero))) {
+            const auto max_abs = [](const F a[3]) __attribute__((always_inline)) {
+                const auto abs = [](F f) { return std::bit_cast<F>(std::bit_cast<I>(f) & 0x7FFFFFFF); };
+                return vmax<kIsa>(vmax<kIsa>(abs(a[0]), abs(a[1])), abs(a[2]));
+            };
+            F bound;
+            t_scaled_error_bound(max_abs(x), max_abs(y), max_abs(z), abs_det, flip(s.sz), bound);
+            const uint32_t near_zero = straddling & ~mask_of<kIsa>(t_signed > bound);
+            take &= ~lanes_of<kIsa>(near_zero);
+            redo |= near_zero;
+        }
         take_hits<kIsa>(s, take, t, int32_t(id), v * inv_det, w * inv_det);
     }
-    // Lanes with an exactly-zero edge function: the scalar test (double fallback included).
-    for (uint32_t m = exact_zero; m; m &= m - 1) {
+    // Lanes left to the scalar test (double fallback included).
+    for (uint32_t m = redo; m; m &= m - 1) {
         const int i = __builtin_ctz(m);
         Ray r = c.rays->ray(i);
         const TriangleRay tr(r);

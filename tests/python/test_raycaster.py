@@ -363,3 +363,42 @@ def test_near_hits_on_long_slivers_have_float_accurate_t_and_barycentrics(cohere
     all_hits = caster.intersect_all(rays)
     first = np.unique(all_hits["ray_ids"], return_index=True)[1]
     np.testing.assert_allclose(all_hits["t"][first], got["t_hit"][hit], rtol=1e-7)
+
+
+
+def test_no_hits_on_a_strip_just_behind_the_origin():
+    # A skirting-board strip (6 x 0.015) in a random orientation, rays through random
+    # points of it in random directions, their origins 1e-7 to 1e-5 of its length off its
+    # plane: where the plane lies behind the origin (double plane t < 0) nothing may be
+    # hit; on the other side the float test still hits (all but rays whose float t comes
+    # out <= 0, a few percent on this sliver).
+    rng = np.random.default_rng(5)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    strip = np.array([[0, 0, 0], [0.015, 6, 0], [0, 6, 0], [0.015, 0, 0]])
+    v = (strip @ q.T + [0.3, -0.2, 0.1]).astype(np.float32)
+    f = np.array([[0, 1, 2], [0, 3, 1]], np.int32)
+    caster = sahara.RayCaster(v, f)
+    p = v.astype(np.float64)
+    normal = np.cross(p[1] - p[0], p[2] - p[0])
+    normal /= np.linalg.norm(normal)
+    n = 20000
+    tri = rng.integers(0, 2, n)
+    b = rng.uniform(0.1, 0.45, size=(n, 2))
+    corner = p[f[tri, 0]]
+    target = corner + b[:, :1] * (p[f[tri, 1]] - corner) + b[:, 1:] * (p[f[tri, 2]] - corner)
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    cos = d @ normal
+    keep = np.abs(cos) > 0.05
+    d, target, cos = d[keep], target[keep], cos[keep]
+    offset = 6.0 * 10.0 ** rng.uniform(-7, -5, len(d))
+    side = np.where(rng.uniform(size=len(d)) < 0.5, -1.0, 1.0)  # -1: the plane behind the origin
+    rays = np.hstack([target - d * (side * offset / np.abs(cos))[:, None], d]).astype(np.float32)
+    r = rays.astype(np.float64)
+    behind = ((p[0] - r[:, :3]) @ normal) / (r[:, 3:] @ normal) < 0
+    assert behind.sum() > 5000 and (~behind).sum() > 5000
+    got = caster.cast_rays(rays)
+    assert (got["primitive_ids"][behind] == -1).all()
+    assert not caster.occluded(rays)[behind].any()
+    assert (got["primitive_ids"][~behind] >= 0).mean() > 0.9
+    assert (got["t_hit"][~behind][got["primitive_ids"][~behind] >= 0] > 0).all()
