@@ -250,6 +250,21 @@ void Accelerator::build_stages(const Scene& scene, const AcceleratorOptions& opt
     // straight from the scene into the layout's leaf storage.
     const SlotIds ids{prims.ids, bvh_.prim_indices};
     const bool has_others = prims.size() > scene.triangles.size();
+    // Node pairing below asks for the share when the tree outgrows the cache, which the leaf
+    // blocks alone (at least one per four slots) may already show: then a task computes it
+    // while this thread emits the wide nodes, a serial pass.
+    const size_t least_block_bytes = (bvh_.prim_indices.size() + 3) / 4 * sizeof(TriangleBlock4);
+    if (layout_ == BvhLayout::wide8 && options.node_pairing == NodePairing::automatic && !share &&
+        least_block_bytes > l2_cache_bytes()) {
+#pragma omp task default(shared)
+        share = largest_box_area_share(prims.box_span(), kAutoMinLargestShare);
+    }
+    // The task reads prims and writes share: it ends before they go, also on an exception.
+    struct EndOfTasks {
+        ~EndOfTasks() {
+#pragma omp taskwait
+        }
+    } const end_of_tasks;
     if (layout_ == BvhLayout::pairs) {
         pairs_ = make_bvh_pairs(bvh_);
         fill_slots(ids, scene.triangles);
@@ -258,6 +273,7 @@ void Accelerator::build_stages(const Scene& scene, const AcceleratorOptions& opt
         // The tree and the blocks are all the block layout keeps (plus others_).
         make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
     }
+#pragma omp taskwait  // the share's task
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
     unique_primitive_count_ = prims.size();
