@@ -1,6 +1,7 @@
 #pragma once
 /// The thread team of a build. Accelerator::build opens one parallel region for all its
-/// stages (binary tree, collapse, leaf storage), so the workers wait for tasks between
+/// stages (primitive boxes, binary tree, collapse, leaf storage, the largest-box share and
+/// the occlusion order's sample rays), so the workers wait for tasks between
 /// stages instead of being woken for each stage's own region (a worker woken late did
 /// none of a short stage). Each stage runs its tasks in that team, or in a region of its
 /// own when it is called alone (tests, tools).

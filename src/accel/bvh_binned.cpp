@@ -341,12 +341,28 @@ class BinnedBuild {
             return;
         }
         used_pairs_[0] = 1;
-        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
+        // The pairs' new numbers: a count per chunk, then each chunk numbers its own from
+        // the chunks before it.
+        uint32_t first_pair[kScanChunks] = {};
+        for_chunks(0, n_, [&](uint32_t c, uint32_t b, uint32_t e) {
+            uint32_t used = 0;
+            for (uint32_t k = b; k < e; ++k) used += used_pairs_[k];
+            first_pair[c] = used;
+        });
         uint32_t pairs = 0;
-        for (uint32_t k = 0; k < n_; ++k) {
-            new_pair[k] = pairs;
-            pairs += used_pairs_[k];
+        for (uint32_t& f : first_pair) {
+            const uint32_t used = f;
+            f = pairs;
+            pairs += used;
         }
+        const BuildArray<uint32_t> new_pair(n_);  // every entry written below
+        for_chunks(0, n_, [&](uint32_t c, uint32_t b, uint32_t e) {
+            uint32_t next = first_pair[c];
+            for (uint32_t k = b; k < e; ++k) {
+                new_pair[k] = next;
+                next += used_pairs_[k];
+            }
+        });
         out_.nodes.resize(2 * size_t(pairs));
         for_chunks(0, n_, [&](uint32_t, uint32_t b, uint32_t e) {
             for (uint32_t k = b; k < e; ++k) {

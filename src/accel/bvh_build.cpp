@@ -219,31 +219,57 @@ BvhBuilder choose_bvh_builder(const BvhWorkload& w) {
 }
 
 double largest_box_area_share(std::span<const Bounds3> boxes, double threshold) {
-    const auto n = int64_t(boxes.size());
+    const auto n = uint32_t(boxes.size());
     const size_t k = std::max<size_t>(1, boxes.size() / 100);
+    // Sums per fixed chunk (build::for_chunks), added in chunk order: the same share at any
+    // thread count. The chunks are tasks of the build's team when it calls this from inside
+    // one (Accelerator::build), else of a region of their own.
+    const bool parallel = n > build::kParallelScanThreshold;
+    double totals[build::kScanChunks] = {};
+    auto sum = [&totals] {
+        double total = 0;
+        for (const double t : totals) total += t;
+        return total;
+    };
     if (threshold > 0.0) {
         // The selection below is serial (most of this function's time at two threads); a
         // pass without it settles most meshes, whose largest box is far from the threshold.
-        double total = 0;
-        float largest = 0.0f;
-#pragma omp parallel for reduction(+ : total) reduction(max : largest) schedule(static) if (n >= 65536)
-        for (int64_t i = 0; i < n; ++i) {
-            const float a = boxes[size_t(i)].surface_area();
-            total += double(a);
-            largest = std::max(largest, a);
-        }
+        float largest[build::kScanChunks] = {};
+        build::with_build_team(
+            [&] {
+                build::for_chunks(0, n, [&](uint32_t c, uint32_t b, uint32_t e) {
+                    double t = 0;
+                    float l = 0.0f;
+                    for (uint32_t i = b; i < e; ++i) {
+                        const float a = boxes[i].surface_area();
+                        t += double(a);
+                        l = std::max(l, a);
+                    }
+                    totals[c] = t;
+                    largest[c] = l;
+                });
+            },
+            parallel);
+        const double total = sum();
         if (!(total > 0)) return 0.0;
+        const float most = *std::max_element(std::begin(largest), std::end(largest));
         // The margin covers the rounding of the summed areas (far below 1e-9 of the total).
-        const double bound = double(k) * double(largest) * (1.0 + 1e-9) / total;
+        const double bound = double(k) * double(most) * (1.0 + 1e-9) / total;
         if (bound < threshold) return bound;
     }
-    // Areas are floats already; keeping them as floats halves the selection's memory,
-    // and the pass runs on every thread, since it sits in front of the build. The array
-    // is not zero-filled first: that was a serial pass (and its page faults) on one thread.
+    // Areas are floats already; keeping them as floats halves the selection's memory. The
+    // array is not zero-filled first: that was a serial pass (and its page faults) on one thread.
     const BuildArray<float> areas(boxes.size());
-    double total = 0;
-#pragma omp parallel for reduction(+ : total) schedule(static) if (n >= 65536)
-    for (int64_t i = 0; i < n; ++i) total += double(areas[size_t(i)] = boxes[size_t(i)].surface_area());
+    build::with_build_team(
+        [&] {
+            build::for_chunks(0, n, [&](uint32_t c, uint32_t b, uint32_t e) {
+                double t = 0;
+                for (uint32_t i = b; i < e; ++i) t += double(areas[i] = boxes[i].surface_area());
+                totals[c] = t;
+            });
+        },
+        parallel);
+    const double total = sum();
     if (!(total > 0)) return 0.0;
     float* const a = areas.get();
     std::nth_element(a, a + std::ptrdiff_t(k - 1), a + boxes.size(), std::greater<>());

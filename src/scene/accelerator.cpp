@@ -89,7 +89,8 @@ PrimitiveList collect_primitives(const Scene& scene) {
     const size_t n = soup.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
     PrimitiveList list(n);
     const auto triangles = int64_t(soup.size());
-#pragma omp parallel for schedule(static) if (triangles > kParallelLoopMin)
+    // Tasks of the build's team (Accelerator::build).
+#pragma omp taskloop default(shared) grainsize(kParallelLoopMin) if (triangles > kParallelLoopMin)
     for (int64_t i = 0; i < triangles; ++i) list.set_triangle(soup, uint32_t(i));
     size_t k = soup.size();
     for (uint32_t i = 0; i < scene.spheres.size(); ++i)
@@ -218,6 +219,15 @@ Accelerator::Accelerator(const Scene& scene, const AcceleratorOptions& options)
 }
 
 void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
+    const size_t count =
+        scene.triangles.size() + scene.spheres.size() + scene.boxes.size() + scene.quadrics.size();
+    // One team for every stage (accel/build_team.h): the primitive boxes, the largest-box
+    // share, the binary tree, its collapse and the leaf storage.
+    build::with_build_team([&] { build_stages(scene, options); },
+                           count > options.flat_loop_max_prims && int64_t(count) > kParallelLoopMin);
+}
+
+void Accelerator::build_stages(const Scene& scene, const AcceleratorOptions& options) {
     // Each phase below takes its arrays from the memory the phases before it freed.
     const HugeBlockReuse reuse;
     const PrimitiveList prims = collect_primitives(scene);
@@ -235,24 +245,35 @@ void Accelerator::build(const Scene& scene, const AcceleratorOptions& options) {
     };
     builder_ = resolve_builder(prims.size(), options, largest_share);
     layout_ = options.layout;
-    // One team for the binary tree, its collapse and the leaf storage (accel/build_team.h).
-    build::with_build_team(
-        [&] {
-            bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
-            // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
-            // straight from the scene into the layout's leaf storage.
-            const SlotIds ids{prims.ids, bvh_.prim_indices};
-            const bool has_others = prims.size() > scene.triangles.size();
-            if (layout_ == BvhLayout::pairs) {
-                pairs_ = make_bvh_pairs(bvh_);
-                fill_slots(ids, scene.triangles);
-            } else {
-                wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
-                // The tree and the blocks are all the block layout keeps (plus others_).
-                make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
-            }
-        },
-        uses_tree_ && int64_t(prims.size()) > kParallelLoopMin);
+    bvh_ = uses_tree_ ? build_bvh(input, builder_, params) : single_leaf_bvh(prims);
+    // Leaf-ordered primitive data: slot s holds primitive bvh_.prim_indices[s], written
+    // straight from the scene into the layout's leaf storage.
+    const SlotIds ids{prims.ids, bvh_.prim_indices};
+    const bool has_others = prims.size() > scene.triangles.size();
+    // Node pairing below asks for the share when the tree outgrows the cache, which the leaf
+    // blocks alone (at least one per four slots) may already show: then a task computes it
+    // while this thread emits the wide nodes, a serial pass.
+    const size_t least_block_bytes = (bvh_.prim_indices.size() + 3) / 4 * sizeof(TriangleBlock4);
+    if (layout_ == BvhLayout::wide8 && options.node_pairing == NodePairing::automatic && !share &&
+        least_block_bytes > l2_cache_bytes()) {
+#pragma omp task default(shared)
+        share = largest_box_area_share(prims.box_span(), kAutoMinLargestShare);
+    }
+    // The task reads prims and writes share: it ends before they go, also on an exception.
+    struct EndOfTasks {
+        ~EndOfTasks() {
+#pragma omp taskwait
+        }
+    } const end_of_tasks;
+    if (layout_ == BvhLayout::pairs) {
+        pairs_ = make_bvh_pairs(bvh_);
+        fill_slots(ids, scene.triangles);
+    } else {
+        wide8_ = make_bvh_wide<8>(bvh_, options.collapse);
+        // The tree and the blocks are all the block layout keeps (plus others_).
+        make_leaf_blocks(wide8_, ids, has_others, scene.triangles);
+    }
+#pragma omp taskwait  // the share's task
     if (!bvh_.empty()) bounds_ = bvh_.nodes[0].box();
     primitive_count_ = bvh_.prim_indices.size();
     unique_primitive_count_ = prims.size();
@@ -327,9 +348,20 @@ void Accelerator::choose_occlusion_order(OcclusionOrder order) {
     uint64_t work[2] = {0, 0};
     for (int far = 0; far < 2; ++far) {
         wide8_.occlusion_far_first = far != 0;
-        TraversalCounters c;
-        for (const Ray& r : rays) occluded_counted(r, c);
-        work[far] = c.nodes_visited + c.prims_tested;
+        // Tasks of the build's team (Accelerator::build), a fixed split of the rays.
+        constexpr size_t kTasks = 8;
+        uint64_t part[kTasks] = {};
+        for (size_t t = 0; t < kTasks; ++t) {
+#pragma omp task default(shared) firstprivate(t)
+            {
+                TraversalCounters c;
+                for (size_t i = rays.size() * t / kTasks; i < rays.size() * (t + 1) / kTasks; ++i)
+                    occluded_counted(rays[i], c);
+                part[t] = c.nodes_visited + c.prims_tested;
+            }
+        }
+#pragma omp taskwait
+        for (const uint64_t p : part) work[far] += p;
     }
     wide8_.occlusion_far_first = double(work[1]) < kFarFirstMaxWork * double(work[0]);
 }

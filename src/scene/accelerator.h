@@ -242,8 +242,10 @@ class Accelerator {
                                 Hit& hit) const;
     /// Resolves OcclusionOrder::automatic: traces sample occlusion rays in both orders.
     void choose_occlusion_order(OcclusionOrder order);
-    /// The constructor's work: primitive boxes, tree, leaf data.
+    /// The constructor's work: build_stages in the build's thread team.
     void build(const Scene& scene, const AcceleratorOptions& options);
+    /// Primitive boxes, tree, leaf data, node pairing and occlusion order.
+    void build_stages(const Scene& scene, const AcceleratorOptions& options);
     void fill_slots(const SlotIds& ids, const TriangleSoup& soup);
     template <int N>
     void make_leaf_blocks(BvhWide<N>& tree, const SlotIds& ids, bool has_others, const TriangleSoup& soup);

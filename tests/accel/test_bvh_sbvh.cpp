@@ -276,6 +276,31 @@ TEST_CASE("largest_box_area_share with a threshold settles a mesh without the se
     CHECK(share == doctest::Approx(101.0 / 299.0));
 }
 
+TEST_CASE("largest_box_area_share is the same at 1 to 3 threads") {
+    // Areas over twelve orders of magnitude: their double sum rounds, so a sum whose
+    // order followed the thread count would differ in the last bits.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> exponent(-3.0f, 3.0f);
+    std::vector<Bounds3> boxes(100000);
+    for (Bounds3& b : boxes) {
+        const float side = std::pow(10.0f, exponent(rng));
+        b = Bounds3{{0, 0, 0}, {side, side * 0.5f, side * 0.25f}};
+    }
+    const int saved = omp_get_max_threads();
+    std::vector<double> shares, bounds;
+    for (int threads = 1; threads <= 3; ++threads) {
+        omp_set_num_threads(threads);
+        shares.push_back(largest_box_area_share(boxes));
+        bounds.push_back(largest_box_area_share(boxes, 1.0));
+    }
+    omp_set_num_threads(saved);
+    for (int t = 1; t < 3; ++t) {
+        CHECK(std::memcmp(&shares[t], &shares[0], sizeof(double)) == 0);
+        CHECK(std::memcmp(&bounds[t], &bounds[0], sizeof(double)) == 0);
+    }
+    CHECK(bounds[0] >= shares[0]);
+}
+
 TEST_CASE("automatic node pairing leaves out interiors and trees that fit in the cache") {
     CHECK(looks_like_interior(1000, kAutoMinLargestShare));
     CHECK_FALSE(looks_like_interior(999, 1.0));  // too small to matter
