@@ -476,22 +476,20 @@ bool Accelerator::occluded_other(const Ray& ray, uint32_t id, float tmax) const 
 
 template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
-    return alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
-                          : trace_layout<kAnyHit, true>(ray, hit, counters);
+    const bool found = alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
+                                      : trace_layout<kAnyHit, true>(ray, hit, counters);
+    if (found && hit.instance == kRetraceScalar) [[unlikely]]
+        return retrace_scalar<kAnyHit>(ray, hit, counters);
+    return found;
 }
 
 /// The final hit lay on a plane behind the origin (trace_wide_body). Rare, so the ray is
 /// traced again the slow way: the same tree, every leaf by the scalar test (as the
 /// brute force), which rejects such hits itself. Raising tmin to the rejected hit's t
 /// instead loses hits on faces through the origin: their leaf boxes end at t = 0 while
-/// their float t comes out a rounding above it. Its node visits and tests are not counted.
-bool Accelerator::retrace_scalar(Ray& ray, Hit& hit, bool any_hit) const {
-    return any_hit ? retrace_scalar<true>(ray, hit) : retrace_scalar<false>(ray, hit);
-}
-
-template <bool kAnyHit>
-bool Accelerator::retrace_scalar(Ray& ray, Hit& hit) const {
-    NoTraversalCounters counters;
+/// their float t comes out a rounding above it.
+template <bool kAnyHit, class Counters>
+__attribute__((noinline)) bool Accelerator::retrace_scalar(Ray& ray, Hit& hit, Counters& counters) const {
     const TriangleRay tr(ray);
     BvhRay br(ray);
     Hit best;
@@ -510,6 +508,7 @@ bool Accelerator::retrace_scalar(Ray& ray, Hit& hit) const {
         ray.tmax = best.t;
     } else {
         hit.prim = best.prim;
+        hit.instance = kNoInstance;
     }
     return true;
 }

@@ -278,7 +278,10 @@ class Accelerator {
     /// Inside a trace, Hit::instance of a triangle hit from the leaf blocks holds its
     /// lane's position, block index * 4 + lane (lane_position), so that the final hit can
     /// be checked for lying behind the origin (lane_hit_behind_origin, accel/bvh4_leaf.h);
-    /// the traversal resets it before returning. Position of lane l (0-3) of block *b.
+    /// the traversal resets it before returning, or sets kRetraceScalar: the final hit lay
+    /// behind the origin, and trace() traces the ray again (retrace_scalar).
+    static constexpr uint32_t kRetraceScalar = kNoInstance - 1;
+    /// Position of lane l (0-3) of block *b (see kRetraceScalar).
     uint32_t lane_position(const TriangleBlock4* b, int l) const {
         return uint32_t(b - blocks_.data()) * 4 + uint32_t(l);
     }
@@ -288,11 +291,9 @@ class Accelerator {
         return hit.instance != kNoInstance &&
                lane_hit_behind_origin(tr, blocks_[hit.instance >> 2], int(hit.instance & 3));
     }
-    /// The rare case of the traversal: the ray traced again with every leaf by the scalar
-    /// test (any_hit: as occluded(), hit.prim the occluder's block). Out of line.
-    [[gnu::noinline]] bool retrace_scalar(Ray& ray, Hit& hit, bool any_hit) const;
-    template <bool kAnyHit>
-    bool retrace_scalar(Ray& ray, Hit& hit) const;
+    /// The rare case of trace(): the ray traced again with every leaf by the scalar test.
+    template <bool kAnyHit, class Counters>
+    bool retrace_scalar(Ray& ray, Hit& hit, Counters& counters) const;
     /// The scalar test over the blocks [first, end), one-sided and cut-out triangles
     /// included; the closest hit lowers `tmax` (kAnyHit: the first, hit.prim its block).
     template <bool kAnyHit>

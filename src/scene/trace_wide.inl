@@ -63,8 +63,10 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
         counters);
     if (!found) return false;
     // The SIMD leaf steps keep hits that may lie behind the origin: the final one is checked.
-    if (final_hit_behind_origin(triangle_ray(), best)) [[unlikely]]
-        return retrace_scalar(ray, hit, kAnyHit);
+    if (final_hit_behind_origin(triangle_ray(), best)) [[unlikely]] {
+        hit.instance = kRetraceScalar;
+        return true;
+    }
     if constexpr (!kAnyHit) {
         hit = best;
         hit.instance = kNoInstance;
