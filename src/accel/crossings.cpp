@@ -14,9 +14,9 @@ namespace {
 ///
 /// The fast leaf (no call, see traverse_wide) tests one- and two-block leaves with the
 /// SIMD step, whose lanes without an exactly-zero edge function need no tie-break.
-/// A leaf with such a lane, other primitive kinds or more blocks goes to the slow leaf,
-/// which tests it with the EdgesPerturbed tie-break; so does every leaf with a
-/// crossing unless kCountInFastLeaf (a count needs no hit record, only the number).
+/// A leaf with a lane the SIMD step leaves to the scalar test, other primitive kinds or more blocks goes to
+/// the slow leaf, which tests it with the EdgesPerturbed tie-break; so does every leaf with a crossing unless
+/// kCountInFastLeaf (a count needs no hit record, only the number).
 template <bool kAvx, bool kCountInFastLeaf, class OnHit>
 __attribute__((always_inline)) inline void walk_crossings(const Bvh8& tree,
                                                           std::span<const TriangleBlock4> blocks,
@@ -33,21 +33,17 @@ __attribute__((always_inline)) inline void walk_crossings(const Bvh8& tree,
         const bool two = count > 4;
         if (other_lanes(b[0]) | (two ? other_lanes(b[1]) : 0)) return LeafResult::slow;
         alignas(32) float t[8], u[8], v[8];
-        int exact_zero = 0, mask = 0;
+        int scalar_lanes = 0, mask = 0;
         if (kAvx && two) {
-            mask = intersect_triangle_blocks2_avx_simd(tr, b, b + 1, tmin, tmax, t, u, v, exact_zero);
+            mask = intersect_triangle_blocks2_avx_simd(tr, b, b + 1, tmin, tmax, t, u, v, scalar_lanes);
         } else {
-            mask = intersect_triangle_block4_simd(tr, b[0], tmin, tmax, t, u, v, exact_zero);
-            if (two && !exact_zero)
-                mask |= intersect_triangle_block4_simd(tr, b[1], tmin, tmax, t + 4, u + 4, v + 4, exact_zero)
-                        << 4;
+            mask = intersect_triangle_block4_simd(tr, b[0], tmin, tmax, t, u, v, scalar_lanes);
+            if (two && !scalar_lanes)
+                mask |=
+                    intersect_triangle_block4_simd(tr, b[1], tmin, tmax, t + 4, u + 4, v + 4, scalar_lanes)
+                    << 4;
         }
-        if (exact_zero || (!kCountInFastLeaf && mask)) return LeafResult::slow;
-        // The SIMD step keeps hits that may lie behind the origin: every crossing is checked.
-        for (int m = mask; m; m &= m - 1) {
-            const int l = __builtin_ctz(unsigned(m));
-            if (lane_hit_behind_origin<EdgesPerturbed>(tr, b[l >> 2], l & 3)) mask &= ~(1 << l);
-        }
+        if (scalar_lanes || (!kCountInFastLeaf && mask)) return LeafResult::slow;
         fast_count += uint32_t(__builtin_popcount(unsigned(mask)));
         return LeafResult::miss;
     };
@@ -57,14 +53,12 @@ __attribute__((always_inline)) inline void walk_crossings(const Bvh8& tree,
             if (other_lanes(block[b]) == 0xF) continue;
             alignas(16) float t[4], u[4], v[4];
             // intersect_triangle_block4 with the crossings' tie-break in the scalar redo.
-            int exact_zero = 0;
-            int mask = intersect_triangle_block4_simd(tr, block[b], tmin, tmax, t, u, v, exact_zero);
-            if (exact_zero)
-                mask |=
-                    redo_exact_zero_lanes<EdgesPerturbed>(tr, block[b], exact_zero, 0, tmin, tmax, t, u, v);
+            int scalar_lanes = 0;
+            int mask = intersect_triangle_block4_simd(tr, block[b], tmin, tmax, t, u, v, scalar_lanes);
+            if (scalar_lanes)
+                mask |= redo_scalar_lanes<EdgesPerturbed>(tr, block[b], scalar_lanes, 0, tmin, tmax, t, u, v);
             for (; mask; mask &= mask - 1) {
                 const int l = __builtin_ctz(unsigned(mask));
-                if (lane_hit_behind_origin<EdgesPerturbed>(tr, block[b], l)) continue;
                 on_hit(Hit{t[l], block[b].slot[l], u[l], v[l]});
             }
         }

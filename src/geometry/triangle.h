@@ -99,12 +99,11 @@ inline float edge_function_double(float ax, float ay, float bx, float by) {
 /// Rendering, 4th ed., 6.5.3), redone for this test's order of operations. A hit whose
 /// T, signed by det, is at most this bound may lie behind the ray's origin (its float
 /// t came out positive through rounding): TriangleVerts::intersect then decides its
-/// side in double (detail::hit_ahead_double). The SIMD leaf steps do not check: the
-/// traversals ask this test about the one hit a ray ends with (lane_hit_behind_origin,
-/// accel/bvh4_leaf.h). Called with the maxima over the three sheared vertices of |x|,
-/// |y| and |z| (the depth before the sz scale) and with |det|, |sz|; V is float or a GCC
-/// vector of floats (by reference: an AVX vector passed by value to code compiled
-/// without AVX would change the calling convention).
+/// side in double (detail::hit_ahead_double). Every path (scalar,
+/// SSE, AVX, packets) calls this one definition with the maxima over the three sheared
+/// vertices of |x|, |y| and |z| (the depth before the sz scale) and with |det|, |sz|; V
+/// is float or a GCC vector of floats, so all paths round alike (by reference: an AVX vector
+/// passed by value to code compiled without AVX would change the calling convention).
 ///
 /// The error terms, with gamma(n) = n eps / (1 - n eps) and eps = 2^-24: a depth is one
 /// subtraction (gamma(1) Z); a sheared x or y three more roundings on operands of at
@@ -259,7 +258,7 @@ inline std::optional<ShapeHit> TriangleVerts::intersect(const TriangleRay& tr, f
     if (!(t > tmin && t < tmax)) return std::nullopt;
     // A triangle wholly ahead of the origin along the dominant axis is hit at t > 0. On
     // one that is not, a t within its rounding bound of 0 may belong to a plane behind
-    // the origin: double decides (the SIMD steps' final hits are checked through this test).
+    // the origin: double decides (the SIMD steps leave exactly these lanes to this test).
     const bool ahead =
         tr.sz < 0.0f ? std::max(std::max(a_z, b_z), c_z) < 0.0f : std::min(std::min(a_z, b_z), c_z) > 0.0f;
     if (!ahead) {

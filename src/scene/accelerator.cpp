@@ -476,41 +476,8 @@ bool Accelerator::occluded_other(const Ray& ray, uint32_t id, float tmax) const 
 
 template <bool kAnyHit, class Counters>
 bool Accelerator::trace(Ray& ray, Hit& hit, Counters& counters) const {
-    const bool found = alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
-                                      : trace_layout<kAnyHit, true>(ray, hit, counters);
-    if (found && hit.instance == kRetraceScalar) [[unlikely]]
-        return retrace_scalar<kAnyHit>(ray, hit, counters);
-    return found;
-}
-
-/// The final hit lay on a plane behind the origin (trace_wide_body). Rare, so the ray is
-/// traced again the slow way: the same tree, every leaf by the scalar test (as the
-/// brute force), which rejects such hits itself. Raising tmin to the rejected hit's t
-/// instead loses hits on faces through the origin: their leaf boxes end at t = 0 while
-/// their float t comes out a rounding above it.
-template <bool kAnyHit, class Counters>
-__attribute__((noinline)) bool Accelerator::retrace_scalar(Ray& ray, Hit& hit, Counters& counters) const {
-    const TriangleRay tr(ray);
-    BvhRay br(ray);
-    Hit best;
-    const bool found = traverse_wide<kAnyHit>(
-        wide8_, br, [](uint32_t, uint32_t, uint32_t, uint32_t, bool&, float&) { return LeafResult::slow; },
-        [&](uint32_t first, uint32_t count, float& tmax) {
-            return scalar_blocks<kAnyHit>(ray, tr, first, first + (count + 3) / 4, tmax, best);
-        },
-        counters);
-    if (!found) {
-        hit = Hit{};
-        return false;
-    }
-    if constexpr (!kAnyHit) {
-        hit = best;
-        ray.tmax = best.t;
-    } else {
-        hit.prim = best.prim;
-        hit.instance = kNoInstance;
-    }
-    return true;
+    return alpha_.empty() ? trace_layout<kAnyHit, false>(ray, hit, counters)
+                          : trace_layout<kAnyHit, true>(ray, hit, counters);
 }
 
 template <bool kAnyHit, bool kCutouts, class Counters>
@@ -576,9 +543,8 @@ bool Accelerator::occluded(const Ray& ray, OcclusionCache& cache) const {
         const TriangleRay tr(ray);  // as the any-hit traversal makes it: the same leaf test
         float tmax = ray.tmax;
         Hit h;
-        if ((alpha_.empty() ? test_blocks<true, false, false>(ray, tr, cache.block, 4, tmax, h)
-                            : test_blocks<true, true, false>(ray, tr, cache.block, 4, tmax, h)) &&
-            !final_hit_behind_origin(tr, h))
+        if (alpha_.empty() ? test_blocks<true, false, false>(ray, tr, cache.block, 4, tmax, h)
+                           : test_blocks<true, true, false>(ray, tr, cache.block, 4, tmax, h))
             return true;
     }
     NoTraversalCounters none;
@@ -600,16 +566,9 @@ bool Accelerator::occluded_counted(const Ray& ray, TraversalCounters& counters) 
 
 /// The block layout's brute force: every lane of every block, triangles by the scalar test.
 bool Accelerator::brute_force_blocks(const Ray& ray, const TriangleRay& tr, float& tmax, Hit& hit) const {
-    return scalar_blocks<false>(ray, tr, 0, uint32_t(blocks_.size()), tmax, hit);
-}
-
-template <bool kAnyHit>
-bool Accelerator::scalar_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t end,
-                                float& tmax, Hit& hit) const {
     bool found = false;
-    for (uint32_t i = first; i < end; ++i)
+    for (const TriangleBlock4& b : blocks_)
         for (int l = 0; l < 4; ++l) {
-            const TriangleBlock4& b = blocks_[i];
             if (b.slot[l] == TriangleBlock4::kEmptyLane) continue;
             const uint32_t id = lane_prim(b.slot[l]);
             std::optional<ShapeHit> h;
@@ -626,10 +585,6 @@ bool Accelerator::scalar_blocks(const Ray& ray, const TriangleRay& tr, uint32_t 
                 h = intersect_other(ray, id, tmax);
             }
             if (!h) continue;
-            if constexpr (kAnyHit) {
-                hit.prim = i;  // the occluder's block (OcclusionCache)
-                return true;
-            }
             tmax = h->t;
             hit = Hit{h->t, id, h->u, h->v};
             found = true;

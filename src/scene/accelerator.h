@@ -275,30 +275,6 @@ class Accelerator {
     template <bool kAnyHit>
     int keep_block_lanes(const Ray& ray, uint32_t first, int mask, const float* t, const float* u,
                          const float* v) const;
-    /// Inside a trace, Hit::instance of a triangle hit from the leaf blocks holds its
-    /// lane's position, block index * 4 + lane (lane_position), so that the final hit can
-    /// be checked for lying behind the origin (lane_hit_behind_origin, accel/bvh4_leaf.h);
-    /// the traversal resets it before returning, or sets kRetraceScalar: the final hit lay
-    /// behind the origin, and trace() traces the ray again (retrace_scalar).
-    static constexpr uint32_t kRetraceScalar = kNoInstance - 1;
-    /// Position of lane l (0-3) of block *b (see kRetraceScalar).
-    uint32_t lane_position(const TriangleBlock4* b, int l) const {
-        return uint32_t(b - blocks_.data()) * 4 + uint32_t(l);
-    }
-    /// Whether the final hit `hit` (instance: its lane position, or kNoInstance for
-    /// other kinds) may lie behind the origin of the ray of `tr`.
-    bool final_hit_behind_origin(const TriangleRay& tr, const Hit& hit) const {
-        return hit.instance != kNoInstance &&
-               lane_hit_behind_origin(tr, blocks_[hit.instance >> 2], int(hit.instance & 3));
-    }
-    /// The rare case of trace(): the ray traced again with every leaf by the scalar test.
-    template <bool kAnyHit, class Counters>
-    bool retrace_scalar(Ray& ray, Hit& hit, Counters& counters) const;
-    /// The scalar test over the blocks [first, end), one-sided and cut-out triangles
-    /// included; the closest hit lowers `tmax` (kAnyHit: the first, hit.prim its block).
-    template <bool kAnyHit>
-    bool scalar_blocks(const Ray& ray, const TriangleRay& tr, uint32_t first, uint32_t end, float& tmax,
-                       Hit& hit) const;
     /// Leaf slot of lane l of the blocks from `first`.
     uint32_t block_slot(uint32_t first, int l) const { return blocks_[first + uint32_t(l >> 2)].slot[l & 3]; }
 

@@ -54,8 +54,8 @@ __attribute__((always_inline)) inline int Accelerator::cull_block_lanes(const Ra
 }
 
 /// The common leaf, one or two blocks of triangles, without a call: a leaf with
-/// other kinds or more blocks, a lane with an exactly-zero edge function (the
-/// scalar redo) and every leaf of a scene with cut-outs (the alpha test) are
+/// other kinds or more blocks, a lane the SIMD step leaves to the scalar test
+/// (redo_scalar_lanes) and every leaf of a scene with cut-outs (the alpha test) are
 /// `slow`, answered by test_blocks with nothing changed here.
 ///
 /// A one-block leaf is tested together with the entry the traversal would visit
@@ -75,31 +75,27 @@ __attribute__((always_inline)) inline LeafResult Accelerator::test_blocks_fast(
     const bool pair = !two && next_count - 1 < 4 && !other_lanes(blocks_[next_first]);  // next_count 1..4
     if (pair) b1 = &blocks_[next_first], two = true;
     alignas(32) float t[8], u[8], v[8];
-    int exact_zero = 0, mask = 0;
+    int scalar_lanes = 0, mask = 0;
     if (kAvx && two) {
-        mask = intersect_triangle_blocks2_avx_simd(tr, b0, b1, ray.tmin, tmax, t, u, v, exact_zero);
+        mask = intersect_triangle_blocks2_avx_simd(tr, b0, b1, ray.tmin, tmax, t, u, v, scalar_lanes);
     } else {
-        mask = intersect_triangle_block4_simd(tr, *b0, ray.tmin, tmax, t, u, v, exact_zero);
+        mask = intersect_triangle_block4_simd(tr, *b0, ray.tmin, tmax, t, u, v, scalar_lanes);
         // Distances of the first block's hits are not yet below tmax here: the
         // nearest of all eight lanes is picked below, as the AVX step does.
-        if (two && !exact_zero)
-            mask |= intersect_triangle_block4_simd(tr, *b1, ray.tmin, tmax, t + 4, u + 4, v + 4, exact_zero)
+        if (two && !scalar_lanes)
+            mask |= intersect_triangle_block4_simd(tr, *b1, ray.tmin, tmax, t + 4, u + 4, v + 4, scalar_lanes)
                     << 4;
     }
-    if (exact_zero) return LeafResult::slow;
+    if (scalar_lanes) return LeafResult::slow;
     paired = pair;
     if (mask && !one_sided_.empty()) mask = cull_block_lanes(ray, b0, b1, mask);
     if (!mask) return LeafResult::miss;
     if constexpr (!kAnyHit) {
         const int best = nearest_lane(mask, t);
         tmax = t[best];
-        const TriangleBlock4* b = best < 4 ? b0 : b1;
-        hit = Hit{t[best], b->slot[best & 3], u[best], v[best], lane_position(b, best & 3)};
+        hit = Hit{t[best], (best < 4 ? b0 : b1)->slot[best & 3], u[best], v[best]};
     } else {
-        const int l = __builtin_ctz(unsigned(mask));
-        const TriangleBlock4* b = l < 4 ? b0 : b1;
-        hit.prim = uint32_t(b - blocks_.data());  // for OcclusionCache
-        hit.instance = lane_position(b, l & 3);
+        hit.prim = uint32_t(((mask & 0xF) ? b0 : b1) - blocks_.data());  // for OcclusionCache
     }
     return LeafResult::hit;
 }
@@ -133,14 +129,12 @@ __attribute__((always_inline)) inline bool Accelerator::test_blocks(const Ray& r
             if (mask) mask = keep_block_lanes<kAnyHit>(ray, b, mask, t, u, v);
         if (mask) {
             if constexpr (kAnyHit) {
-                const int l = __builtin_ctz(unsigned(mask));
-                hit.prim = b + uint32_t(l >> 2);  // the occluder's block, for OcclusionCache
-                hit.instance = lane_position(&blocks_[hit.prim], l & 3);
+                hit.prim = b + ((mask & 0xF) ? 0 : 1);  // the occluder's block, for OcclusionCache
                 return true;
             }
             const int best = nearest_lane(mask, t);
             tmax = t[best];
-            hit = Hit{t[best], block_slot(b, best), u[best], v[best], lane_position(&blocks_[b], best)};
+            hit = Hit{t[best], block_slot(b, best), u[best], v[best]};
             found = true;
         }
         for (int m = other; m; m &= m - 1) {

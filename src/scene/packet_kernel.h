@@ -143,7 +143,6 @@ struct alignas(64) State {
     F ox, oy, oz, sx, sy, sz;  ///< origin in the common (kx, ky, kz) order; shear constants
     F hu, hv;
     I prim;
-    I pos;  ///< the hit's triangle lane, block * 4 + lane (-1: another kind), for check_final_hits
 };
 
 /// Slab test of one box against every lane; `near`/`far` are the box's planes
@@ -163,22 +162,20 @@ template <int kIsa>
     return mask_of<kIsa>(t0 <= t1 * kRobustFarScale);
 }
 
-/// Lane i takes (t, prim, u, v) of the triangle lane at `pos` where `take` is set.
+/// Lane i takes (t, prim, u, v) where `take` is set.
 template <int kIsa>
-[[gnu::always_inline]] inline void take_hits(State& s, I take, F t, int32_t prim, F u, F v, int32_t pos) {
+[[gnu::always_inline]] inline void take_hits(State& s, I take, F t, int32_t prim, F u, F v) {
     s.tmax = select<kIsa>(take, t, s.tmax);
     s.prim = select<kIsa>(take, I{} + prim, s.prim);
-    s.pos = select<kIsa>(take, I{} + pos, s.pos);
     s.hu = select<kIsa>(take, u, s.hu);
     s.hv = select<kIsa>(take, v, s.hv);
 }
 
 /// Lane i takes a scalar hit.
 template <int kIsa>
-[[gnu::always_inline]] inline void take_hit(State& s, int i, const Hit& h, int32_t pos) {
+[[gnu::always_inline]] inline void take_hit(State& s, int i, const Hit& h) {
     s.tmax[i] = h.t;
     s.prim[i] = int32_t(h.prim);
-    s.pos[i] = pos;
     s.hu[i] = h.u;
     s.hv[i] = h.v;
 }
@@ -226,17 +223,35 @@ template <int kIsa>
     // det != 0 needs no test: the lanes kept have u, v, w non-zero and of one sign.
     const I ok = ~(any_neg & any_pos) & (t_signed > s.tmin * abs_det) & (t_signed < s.tmax * abs_det);
     const uint32_t bits = mask_of<kIsa>(ok) & mask & ~exact_zero;
+    uint32_t redo = exact_zero;
     const uint32_t id = b.slot[l];  // a triangle lane holds its primitive id
-    const auto pos = int32_t(&b - c.blocks) * 4 + l;
     if (bits) {
         const F inv_det = 1.0f / det;
         const F t = t_scaled * inv_det;
         // Rounding of the division can push t onto the interval's boundary.
-        const I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
-        take_hits<kIsa>(s, take, t, int32_t(id), v * inv_det, w * inv_det, pos);
+        I take = lanes_of<kIsa>(bits) & (t > s.tmin) & (t < s.tmax);
+        // A triangle wholly ahead of the origin along the dominant axis is hit at t > 0; on
+        // one that is not, a t within its rounding bound of 0 is decided by the scalar test.
+        const I dz_sign = std::bit_cast<I>(s.sz) & int32_t(0x80000000u);
+        const auto flip = [&](F f) __attribute__((always_inline)) {
+            return std::bit_cast<F>(std::bit_cast<I>(f) ^ dz_sign);
+        };
+        const F nearest = vmin<kIsa>(vmin<kIsa>(flip(z[0]), flip(z[1])), flip(z[2]));
+        if (const uint32_t straddling = mask_of<kIsa>(take & ~(nearest > zero))) {
+            const auto max_abs = [](const F a[3]) __attribute__((always_inline)) {
+                const auto abs = [](F f) { return std::bit_cast<F>(std::bit_cast<I>(f) & 0x7FFFFFFF); };
+                return vmax<kIsa>(vmax<kIsa>(abs(a[0]), abs(a[1])), abs(a[2]));
+            };
+            F bound;
+            t_scaled_error_bound(max_abs(x), max_abs(y), max_abs(z), abs_det, flip(s.sz), bound);
+            const uint32_t near_zero = straddling & ~mask_of<kIsa>(t_signed > bound);
+            take &= ~lanes_of<kIsa>(near_zero);
+            redo |= near_zero;
+        }
+        take_hits<kIsa>(s, take, t, int32_t(id), v * inv_det, w * inv_det);
     }
-    // Lanes with an exactly-zero edge function: the scalar test (double fallback included).
-    for (uint32_t m = exact_zero; m; m &= m - 1) {
+    // Lanes left to the scalar test (double fallback included).
+    for (uint32_t m = redo; m; m &= m - 1) {
         const int i = __builtin_ctz(m);
         Ray r = c.rays->ray(i);
         const TriangleRay tr(r);
@@ -244,7 +259,7 @@ template <int kIsa>
                                  {b.p[1][0][l], b.p[1][1][l], b.p[1][2][l]},
                                  {b.p[2][0][l], b.p[2][1][l], b.p[2][2][l]}}};
         if (const std::optional<ShapeHit> th = tri.intersect(tr, s.tmin[i], s.tmax[i]))
-            take_hit<kIsa>(s, i, Hit{th->t, id, th->u, th->v}, pos);
+            take_hit<kIsa>(s, i, Hit{th->t, id, th->u, th->v});
     }
 }
 
@@ -271,7 +286,7 @@ template <int kIsa>
                 Ray r = c.rays->ray(i);
                 r.tmax = s.tmax[i];
                 Hit h;
-                if (c.accel->intersect_slot(r, slot, h)) take_hit<kIsa>(s, i, h, -1);
+                if (c.accel->intersect_slot(r, slot, h)) take_hit<kIsa>(s, i, h);
             }
         }
     }
@@ -296,7 +311,6 @@ template <int kIsa>
     s.sz = 1.0f / dz, s.sx = dx * s.sz, s.sy = dy * s.sz;  // as in TriangleRay::shear
     s.hu = s.hv = F{};
     s.prim = I{} + int32_t(kNoPrim);
-    s.pos = I{} - 1;
 }
 
 /// A pending subtree: node or leaf, the rays that entered its box and their entry distances.
@@ -316,32 +330,6 @@ template <int kIsa, int N>
     }
     F tn;
     return box_test<kIsa>(s, near, far, tn);
-}
-
-/// The triangle steps keep hits that may lie behind the origin: the hit each ray ends
-/// with is checked (lane_hit_behind_origin, accel/bvh4_leaf.h), and a ray whose hit is
-/// behind is traced again alone (Accelerator::intersect, which then takes retrace_scalar).
-template <int kIsa>
-[[gnu::always_inline]] inline void check_final_hits(State& s, const PacketContext& c) {
-    for (uint32_t m = c.rays->active & mask_of<kIsa>(s.pos >= 0); m; m &= m - 1) {
-        const int i = __builtin_ctz(m);
-        const TriangleBlock4& b = c.blocks[s.pos[i] >> 2];
-        const int l = s.pos[i] & 3;
-        // The cheap test first (the z of test_triangle): a triangle wholly ahead is hit at t > 0.
-        const float a_z = b.p[0][c.kz][l] - s.oz[i], b_z = b.p[1][c.kz][l] - s.oz[i],
-                    c_z = b.p[2][c.kz][l] - s.oz[i];
-        if (s.sz[i] < 0.0f ? (a_z < 0.0f && b_z < 0.0f && c_z < 0.0f)
-                           : (a_z > 0.0f && b_z > 0.0f && c_z > 0.0f))
-            continue;
-        Ray r = c.rays->ray(i);
-        if (!lane_hit_behind_origin_slow(TriangleRay(r), b, l)) continue;
-        Hit h;
-        if (c.accel->intersect(r, h)) {
-            take_hit<kIsa>(s, i, h, -1);
-        } else {
-            s.prim[i] = int32_t(kNoPrim);
-        }
-    }
 }
 
 /// Copies the nearest hits out; a lane without one gets t = infinity.
@@ -424,7 +412,6 @@ void trace_packet(const PacketContext& c, const BvhWide<N>& bvh, HitPacket& out)
             }
         }
     }
-    check_final_hits<kIsa>(s, c);
     store_hits<kIsa>(s, out);
 }
 

@@ -249,12 +249,6 @@ done:
     for (uint32_t m = p.active; m; m &= m - 1) {
         const int i = std::countr_zero(m);
         if (!hits[i].hit()) continue;
-        // The leaf steps keep hits that may lie behind the origin: the final one is checked.
-        if (final_hit_behind_origin(tr[i], hits[i])) [[unlikely]] {
-            Ray r = p.ray(i);  // intersect() finds that hit again, then retraces (retrace_scalar)
-            hits[i] = Hit{};
-            if (!intersect(r, hits[i])) continue;
-        }
         out.t[i] = hits[i].t, out.prim[i] = hits[i].prim, out.u[i] = hits[i].u, out.v[i] = hits[i].v;
     }
 }

@@ -61,20 +61,12 @@ __attribute__((always_inline)) inline bool Accelerator::trace_wide_body(Ray& ray
             return test_blocks<kAnyHit, kCutouts, kAvx>(ray, triangle_ray(), first, count, tmax, best);
         },
         counters);
-    if (!found) return false;
-    // The SIMD leaf steps keep hits that may lie behind the origin: the final one is checked.
-    if (final_hit_behind_origin(triangle_ray(), best)) [[unlikely]] {
-        hit.instance = kRetraceScalar;
-        return true;
-    }
-    if constexpr (!kAnyHit) {
+    if (found && !kAnyHit) {
         hit = best;
-        hit.instance = kNoInstance;
         ray.tmax = best.t;
-    } else {
-        hit.prim = best.prim;  // the occluder's block (OcclusionCache)
     }
-    return true;
+    if (found && kAnyHit) hit.prim = best.prim;  // the occluder's block (OcclusionCache)
+    return found;
 }
 
 /// One form of the traversal, by index: bit 0 kAnyHit, bit 1 kCutouts, bit 2 counted
